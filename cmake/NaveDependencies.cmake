@@ -1,0 +1,36 @@
+# Finds every third-party library nave uses, as Debian 12 packages them. scripts/setup-debian.sh installs them.
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(TBB REQUIRED)
+find_package(embree 3 REQUIRED)                  # target: embree
+find_package(draco REQUIRED)                     # target: draco::draco
+find_package(OpenImageIO REQUIRED)               # target: OpenImageIO::OpenImageIO
+find_package(tomlplusplus REQUIRED)              # target: tomlplusplus::tomlplusplus
+find_package(CLI11 REQUIRED)                     # target: CLI11::CLI11
+find_package(spdlog REQUIRED)                    # target: spdlog::spdlog
+find_package(fmt REQUIRED)                       # target: fmt::fmt
+find_package(TinyGLTF REQUIRED)                  # target: TinyGLTF::TinyGLTF
+find_package(assimp REQUIRED)                    # target: assimp::assimp
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
+
+# OpenImageIO's exported target names /usr/include/opencv4, which exists only when OpenCV is installed.
+foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+  get_target_property(dirs OpenImageIO::OpenImageIO ${prop})
+  if(dirs)
+    list(FILTER dirs EXCLUDE REGEX "opencv4")
+    set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${prop} "${dirs}")
+  endif()
+endforeach()
+
+# OpenVDB (participating media, a later stage) ships only a Find module on Debian.
+list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
+find_package(OpenVDB QUIET)
+
+if(NAVE_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+  include(GoogleTest)
+endif()
+if(NAVE_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages nave needs to build, test and run, only those missing: `apt-get update` runs
+# once and only when something must be installed, so a machine that has everything is left untouched.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libembree-dev            # Embree 3: ray tracing inside a brick
+  libdraco-dev             # Draco: brick mesh compression
+  libopenvdb-dev libboost-iostreams-dev  # OpenVDB (participating media); it needs boost-iostreams but does not pull it in
+  libopenimageio-dev       # OpenImageIO: EXR/PNG output, textures
+  liblz4-dev               # LZ4: side sections and temporary bins
+  libxxhash-dev            # xxHash: checksums of every stored section
+  libtbb-dev               # TBB: thread pools
+  libgtest-dev libgmock-dev googletest  # GoogleTest
+  libbenchmark-dev         # Google Benchmark
+  libtomlplusplus-dev      # toml++: scene configs
+  libcli11-dev             # CLI11: command-line parsing
+  libspdlog-dev libfmt-dev # logging and formatting
+  libtinygltf-dev          # glTF 2.0 / GLB import
+  libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS...)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+echo "nave setup: installing ${#missing[@]} missing Debian packages: ${missing[*]}" >&2
+as_root=()
+if [[ $(id -u) -ne 0 ]]; then as_root=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "nave setup: done" >&2

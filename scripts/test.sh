@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds and runs nave's default test suite (everything not labelled "slow").
+# `scripts/test.sh asan` runs it under AddressSanitizer + UndefinedBehaviorSanitizer instead;
+# `NAVE_TEST_LABEL=slow scripts/test.sh` runs only the long checks.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-release}
+if [[ ${CI:-} == true && $preset == release ]]; then preset=ci; fi  # warnings are errors in CI
+bash scripts/build.sh "$preset"
+if [[ -n ${NAVE_TEST_LABEL:-} ]]; then
+  ctest --test-dir "build/$preset" --output-on-failure -j "$(nproc)" -L "$NAVE_TEST_LABEL"
+else
+  ctest --preset "$preset" -j "$(nproc)"
+fi

@@ -1,0 +1,24 @@
+// `nave version`: the version and the libraries nave was built with, for bug reports.
+#include <cstdio>
+
+#include "cli/commands.h"
+
+namespace nave::cli {
+
+void RegisterVersionCommand(CLI::App& app, CommandRun& run) {
+    CLI::App* cmd = app.add_subcommand("version", "Print nave's version and build configuration");
+    cmd->callback([&run] {
+        run = [] {
+            std::printf("nave %s (C++%ld, %s build)\n", NAVE_VERSION, __cplusplus / 100 % 100,
+#ifdef NDEBUG
+                        "release"
+#else
+                        "debug"
+#endif
+            );
+            return Status::Ok();
+        };
+    });
+}
+
+}  // namespace nave::cli

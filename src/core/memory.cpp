@@ -1,0 +1,67 @@
+#include "core/memory.h"
+
+#include <unistd.h>
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <string>
+
+namespace nave {
+
+StatusOr<uint64_t> ParseByteSize(std::string_view text) {
+    auto bad = [&] {
+        return InvalidArgumentError("'{}' is not a size: expected a number with an optional unit, "
+                                    "as in 512M, 1.5G, 2GiB or 1048576", text);
+    };
+    size_t i = 0;
+    while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
+    if (i == 0) return bad();
+    double number = 0;
+    auto [ptr, ec] = std::from_chars(text.data(), text.data() + i, number);
+    if (ec != std::errc() || ptr != text.data() + i || !std::isfinite(number) || number < 0) return bad();
+    std::string unit;
+    for (char c : text.substr(i)) unit += char(std::toupper(static_cast<unsigned char>(c)));
+    double scale = 1;
+    if (unit.empty() || unit == "B") scale = 1;
+    else if (unit == "K" || unit == "KB" || unit == "KIB") scale = 1024.0;
+    else if (unit == "M" || unit == "MB" || unit == "MIB") scale = 1024.0 * 1024;
+    else if (unit == "G" || unit == "GB" || unit == "GIB") scale = 1024.0 * 1024 * 1024;
+    else if (unit == "T" || unit == "TB" || unit == "TIB") scale = 1024.0 * 1024 * 1024 * 1024;
+    else return bad();
+    double bytes = number * scale;
+    if (bytes > 9.0e18) return bad();
+    return static_cast<uint64_t>(bytes);
+}
+
+std::string FormatBytes(uint64_t bytes) {
+    const double b = double(bytes);
+    if (b >= 1024.0 * 1024 * 1024) return fmt::format("{:.2f} GiB", b / (1024.0 * 1024 * 1024));
+    if (b >= 1024.0 * 1024) return fmt::format("{:.1f} MiB", b / (1024.0 * 1024));
+    if (b >= 1024.0) return fmt::format("{:.1f} KiB", b / 1024.0);
+    return fmt::format("{} B", bytes);
+}
+
+namespace {
+uint64_t ReadProcStatusKiB(const char* key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    const std::string prefix = std::string(key) + ":";
+    while (std::getline(in, line)) {
+        if (line.rfind(prefix, 0) == 0) return std::stoull(line.substr(prefix.size())) * 1024;
+    }
+    return 0;
+}
+}  // namespace
+
+uint64_t PeakRssBytes() { return ReadProcStatusKiB("VmHWM"); }
+uint64_t CurrentRssBytes() { return ReadProcStatusKiB("VmRSS"); }
+
+uint64_t PhysicalMemoryBytes() {
+    long pages = sysconf(_SC_PHYS_PAGES);
+    long page_size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
+}
+
+}  // namespace nave

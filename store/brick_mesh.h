@@ -1,0 +1,33 @@
+#pragma once
+// The geometry of one brick, decoded: what preprocess hands to the store writer and what the renderer gets
+// back from the store. Plain data, no dependency on Draco or Embree.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/vecmath.h"
+
+namespace nave::store {
+
+/// An indexed triangle mesh. Invariants (checked by Validate in store_writer): indices.size() == 3 * T,
+/// material_ids.size() == T, every index < positions.size(), normals and uvs empty or one per position.
+struct BrickMesh {
+    std::vector<Vec3f> positions;              ///< world coordinates (metres in nave's own models)
+    std::vector<Vec3f> normals;                ///< optional shading normals, unit length
+    std::vector<std::array<float, 2>> uvs;     ///< optional texture coordinates
+    std::vector<uint32_t> indices;             ///< 3 per triangle, counter-clockwise seen from the front
+    std::vector<uint32_t> material_ids;        ///< per triangle, an index into the store's material table
+
+    size_t TriangleCount() const { return indices.size() / 3; }
+    size_t VertexCount() const { return positions.size(); }
+    bool HasNormals() const { return !normals.empty(); }
+    bool HasUvs() const { return !uvs.empty(); }
+    /// Bytes held by the vectors (for memory budgets).
+    size_t MemoryBytes() const {
+        return positions.capacity() * sizeof(Vec3f) + normals.capacity() * sizeof(Vec3f) +
+               uvs.capacity() * sizeof(uvs[0]) + indices.capacity() * 4 + material_ids.capacity() * 4;
+    }
+};
+
+}  // namespace nave::store

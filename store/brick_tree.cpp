@@ -1,0 +1,129 @@
+#include "store/brick_tree.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace nave::store {
+
+BrickTree::BrickTree(Bounds3f bounds, std::vector<BrickTreeNode> nodes)
+    : bounds_(bounds), nodes_(std::move(nodes)) {}
+
+Status BrickTree::Validate(uint32_t brick_count) const {
+    if (nodes_.empty()) return DataLossError("brick tree has no nodes");
+    std::vector<uint8_t> seen_brick(brick_count, 0);
+    std::vector<uint8_t> seen_node(nodes_.size(), 0);
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+        uint32_t n = stack.back();
+        stack.pop_back();
+        if (seen_node[n]) return DataLossError("brick tree node {} is reached twice (a cycle or shared child)", n);
+        seen_node[n] = 1;
+        const BrickTreeNode& node = nodes_[n];
+        if (node.IsLeaf()) {
+            if (node.brick == kNoBrick) continue;
+            if (node.brick >= brick_count) {
+                return DataLossError("brick tree leaf {} names brick {} but the store has {} bricks", n,
+                                     node.brick, brick_count);
+            }
+            if (seen_brick[node.brick]) return DataLossError("brick {} appears in two brick tree leaves", node.brick);
+            seen_brick[node.brick] = 1;
+            continue;
+        }
+        if (node.axis > 3) return DataLossError("brick tree node {} has axis {} (expected 0..3)", n, node.axis);
+        for (uint32_t c : node.child) {
+            if (c == 0 || c >= nodes_.size()) {
+                return DataLossError("brick tree node {} has child {} out of range [1, {})", n, c, nodes_.size());
+            }
+            stack.push_back(c);
+        }
+    }
+    return Status::Ok();
+}
+
+uint32_t BrickTree::Locate(const Vec3f& p) const {
+    if (nodes_.empty() || !bounds_.Contains(p)) return kNoBrick;
+    uint32_t n = 0;
+    while (!nodes_[n].IsLeaf()) {
+        const BrickTreeNode& node = nodes_[n];
+        n = node.child[p[node.axis] >= node.split ? 1 : 0];
+    }
+    return nodes_[n].brick;
+}
+
+std::vector<Bounds3f> BrickTree::BrickCells(uint32_t brick_count) const {
+    std::vector<Bounds3f> cells(brick_count);
+    if (nodes_.empty()) return cells;
+    std::vector<std::pair<uint32_t, Bounds3f>> stack{{0, bounds_}};
+    while (!stack.empty()) {
+        auto [n, box] = stack.back();
+        stack.pop_back();
+        const BrickTreeNode& node = nodes_[n];
+        if (node.IsLeaf()) {
+            if (node.brick != kNoBrick && node.brick < brick_count) cells[node.brick] = box;
+            continue;
+        }
+        Bounds3f below = box, above = box;
+        below.max[node.axis] = node.split;
+        above.min[node.axis] = node.split;
+        stack.push_back({node.child[0], below});
+        stack.push_back({node.child[1], above});
+    }
+    return cells;
+}
+
+void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, float t_max,
+                         const std::function<bool(uint32_t, float, float)>& visit) const {
+    if (nodes_.empty()) return;
+    // Clip the ray to the root box (slab test), then walk the kd-tree front to back with an explicit stack.
+    float t0 = t_min, t1 = t_max;
+    for (int a = 0; a < 3; ++a) {
+        float inv = 1.0f / dir[a];
+        float near = (bounds_.min[a] - origin[a]) * inv;
+        float far = (bounds_.max[a] - origin[a]) * inv;
+        if (near > far) std::swap(near, far);
+        if (!(near <= far)) {  // NaN: the ray is parallel to and on a slab plane; keep it
+            continue;
+        }
+        t0 = std::max(t0, near);
+        t1 = std::min(t1, far);
+        if (t0 > t1) return;
+    }
+    struct Item {
+        uint32_t node;
+        float t0, t1;
+    };
+    Item stack[64];
+    int top = 0;
+    stack[top++] = {0, t0, t1};
+    while (top > 0) {
+        Item item = stack[--top];
+        uint32_t n = item.node;
+        float a = item.t0, b = item.t1;
+        while (!nodes_[n].IsLeaf()) {
+            const BrickTreeNode& node = nodes_[n];
+            const int axis = node.axis;
+            const float o = origin[axis];
+            const float d = dir[axis];
+            // The child that holds the ray's start (ties go to the upper cell, as in Locate, unless the ray
+            // moves downward from the plane).
+            const bool start_above = o > node.split || (o == node.split && d >= 0);
+            uint32_t first = node.child[start_above ? 1 : 0];
+            uint32_t second = node.child[start_above ? 0 : 1];
+            float t_split = d != 0 ? (node.split - o) / d : std::numeric_limits<float>::infinity();
+            if (t_split > b || t_split <= 0) {
+                n = first;
+            } else if (t_split < a) {
+                n = second;
+            } else {
+                NAVE_CHECK_LT(top, 64) << "brick tree deeper than 64 levels";
+                stack[top++] = {second, t_split, b};
+                n = first;
+                b = t_split;
+            }
+        }
+        uint32_t brick = nodes_[n].brick;
+        if (brick != kNoBrick && !visit(brick, a, b)) return;
+    }
+}
+
+}  // namespace nave::store

@@ -1,0 +1,54 @@
+#pragma once
+// What a store says about itself: header fields and the brick directory. See docs/store-format.md.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/vecmath.h"
+#include "store/grid.h"
+
+namespace nave::store {
+
+/// Current format version. Readers refuse another major version; a newer minor version only adds fields.
+inline constexpr uint16_t kFormatMajor = 1;
+inline constexpr uint16_t kFormatMinor = 0;
+
+/// Header fields that the writer's caller provides: how the store was made and from what.
+struct StoreProvenance {
+    std::vector<std::string> source_files;  ///< inputs, as given on the command line
+    std::string tool_version;               ///< "nave 0.1.0"
+    std::string options;                    ///< the creation options, as text ("brick-triangles=1000000 ...")
+};
+
+/// One section of a brick (the Draco mesh, a side section): where it is in the file and its checksum.
+struct SectionInfo {
+    uint64_t offset = 0;     ///< byte offset from the start of the file
+    uint64_t length = 0;     ///< bytes on disk
+    uint64_t checksum = 0;   ///< XXH64 of those bytes
+};
+
+/// A brick as the directory describes it. Reading the directory never touches brick payloads.
+struct BrickInfo {
+    uint32_t id = 0;
+    Bounds3f cell;             ///< the brick's cell in the brick tree (disjoint from every other cell)
+    Bounds3f geometry_bounds;  ///< box of the brick's triangles (may exceed `cell` for triangles that cross it)
+    uint64_t triangle_count = 0;
+    uint64_t vertex_count = 0;
+    uint64_t decoded_bytes = 0;    ///< BrickMesh::MemoryBytes() once decoded (for memory budgets)
+    SectionInfo mesh;              ///< Draco-encoded mesh
+    SectionInfo side;              ///< LZ4-compressed side section (see docs/store-format.md); length 0 if none
+    uint64_t BytesOnDisk() const { return mesh.length + side.length; }
+};
+
+struct StoreHeader {
+    uint16_t major = kFormatMajor;
+    uint16_t minor = kFormatMinor;
+    GlobalGrid grid;
+    Bounds3f bounds;              ///< box of all geometry
+    uint64_t triangle_count = 0;  ///< sum over bricks (triangles crossing cells counted once per brick)
+    uint64_t source_triangle_count = 0;  ///< triangles in the input before duplication across bricks
+    StoreProvenance provenance;
+};
+
+}  // namespace nave::store

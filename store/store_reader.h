@@ -1,0 +1,45 @@
+#pragma once
+// Reading a store. Open() reads the header, the directory, the brick tree and the material table only;
+// bricks are read on demand, their checksums verified, then decoded. Every error names the file, the brick
+// and the byte offset, with the expected and found values. Store is immutable after Open and thread-safe:
+// many threads may read bricks at once (positional reads, no shared file offset).
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "core/status.h"
+#include "store/brick_mesh.h"
+#include "store/brick_tree.h"
+#include "store/material_record.h"
+#include "store/store_info.h"
+
+namespace nave::store {
+
+class Store {
+  public:
+    /// Opens and checks header, tables and their checksums. Refuses another major version (naming both).
+    static StatusOr<std::unique_ptr<Store>> Open(const std::filesystem::path& path);
+    ~Store();
+
+    const std::filesystem::path& path() const;
+    const StoreHeader& header() const;
+    const std::vector<BrickInfo>& bricks() const;
+    const BrickTree& tree() const;
+    const std::vector<MaterialRecord>& materials() const;
+    uint64_t file_size() const;
+
+    /// Reads, verifies and decodes brick `id`. Thread-safe. Adds the bytes read to bytes_read().
+    StatusOr<BrickMesh> ReadBrick(uint32_t id) const;
+    /// Reads brick `id` and checks its checksums and that it decodes to the directory's counts.
+    Status VerifyBrick(uint32_t id) const;
+    /// Total payload bytes read from disk since Open (for statistics).
+    uint64_t bytes_read() const;
+
+  private:
+    struct Impl;
+    explicit Store(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace nave::store

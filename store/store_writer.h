@@ -1,0 +1,68 @@
+#pragma once
+// Writing a store. Encoding a brick (EncodeBrick) is thread-safe and independent of the writer, so that
+// preprocess encodes on many threads and appends the results as they finish. The file is written under a
+// temporary name; Finish() writes the tables last, then fsyncs and renames: an interrupted writer never
+// leaves a file that opens as a valid store.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/status.h"
+#include "store/brick_mesh.h"
+#include "store/brick_tree.h"
+#include "store/material_record.h"
+#include "store/store_info.h"
+
+namespace nave::store {
+
+/// Encoder settings. Defaults and why: docs/store-format.md.
+struct EncodeOptions {
+    int draco_speed = 5;        ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
+    int normal_bits = 10;       ///< octahedral quantization of normals
+    int uv_bits = 14;           ///< quantization of texture coordinates
+};
+
+/// A brick ready to be appended: encoded bytes and the directory fields known before writing.
+struct EncodedBrick {
+    std::string mesh_bytes;       ///< Draco bitstream
+    std::string side_bytes;       ///< LZ4 side section (may be empty)
+    Bounds3f cell;
+    Bounds3f geometry_bounds;
+    uint64_t triangle_count = 0;
+    uint64_t vertex_count = 0;
+    uint64_t decoded_bytes = 0;
+};
+
+/// Checks BrickMesh invariants; errors say which index or count is wrong.
+Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count);
+
+/// Snaps positions to `grid` and encodes. Thread-safe. Fails (InvalidArgument) on a mesh that breaks the
+/// invariants or a position outside the grid's int32 range.
+StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell, const GlobalGrid& grid,
+                                   const EncodeOptions& options);
+
+class StoreWriter {
+  public:
+    /// Starts writing `path` (through a temporary file beside it).
+    static StatusOr<std::unique_ptr<StoreWriter>> Create(const std::filesystem::path& path, const GlobalGrid& grid,
+                                                         StoreProvenance provenance);
+    ~StoreWriter();  // abandons the temporary file unless Finish() succeeded
+
+    /// Appends a brick and returns its id (ids count from 0 in append order). Not thread-safe.
+    StatusOr<uint32_t> Append(const EncodedBrick& brick);
+    /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory and the
+    /// header, then commits the file. `source_triangle_count` is the input's count before duplication.
+    Status Finish(const std::vector<MaterialRecord>& materials, const BrickTree& tree,
+                  uint64_t source_triangle_count);
+
+    uint64_t bytes_written() const;
+
+  private:
+    struct Impl;
+    explicit StoreWriter(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace nave::store
