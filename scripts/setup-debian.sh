@@ -8,7 +8,7 @@ packages=(
   libembree-dev            # Embree 3: ray tracing inside a brick
   libdraco-dev             # Draco: brick mesh compression
   libopenvdb-dev libboost-iostreams-dev  # OpenVDB (participating media); it needs boost-iostreams but does not pull it in
-  libopenimageio-dev       # OpenImageIO: EXR/PNG output, textures
+  libopenimageio-dev openimageio-tools  # OpenImageIO: EXR/PNG output, textures (its CMake config requires the tools)
   liblz4-dev               # LZ4: side sections and temporary bins
   libxxhash-dev            # xxHash: checksums of every stored section
   libtbb-dev               # TBB: thread pools
