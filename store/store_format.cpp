@@ -2,6 +2,7 @@
 
 #include <fmt/ostream.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/hash.h"
@@ -125,6 +126,10 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
         if (n < sizeof(kMagic) && std::memcmp(bytes.data(), kMagic, n) == 0) {
             return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)", name,
                                  file_bytes, kHeaderBytes);
+        }
+        if (n == sizeof(kMagic) && std::all_of(bytes.begin(), bytes.begin() + n, [](char c) { return c == 0; })) {
+            // The writer's placeholder: the header is written last, so this store was never finished.
+            return DataLossError("{}: the header is all zeros: the store's writing never finished", name);
         }
         std::string found;
         for (size_t i = 0; i < n; ++i) {
