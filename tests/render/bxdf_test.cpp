@@ -76,8 +76,9 @@ TEST(IorTest, Bk7Sellmeier) {
     EXPECT_NEAR(Bk7Index().Evaluate(587.56f), 1.51680f, 2e-5f);
     EXPECT_NEAR(Bk7Index().Evaluate(486.13f), 1.52238f, 3e-5f);
     EXPECT_NEAR(Bk7Index().Evaluate(656.27f), 1.51432f, 3e-5f);
-    // Rubin (1985): clear soda-lime glass n ≈ 1.52 in the visible.
-    EXPECT_NEAR(SodaLimeIndex().Evaluate(550.f), 1.52f, 5e-3f);
+    // Rubin (1985): clear float glass n_D ≈ 1.52-1.53; Rubin's fit gives 1.5233 at 589.3 nm.
+    EXPECT_NEAR(SodaLimeIndex().Evaluate(589.3f), 1.5233f, 2e-4f);
+    EXPECT_GT(SodaLimeIndex().Evaluate(450.f), SodaLimeIndex().Evaluate(650.f));
 }
 
 TEST(FrameTest, Orthonormal) {
