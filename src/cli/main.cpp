@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
 
     nave::cli::CommandRun run;
     nave::cli::RegisterVersionCommand(app, run);
+    nave::cli::RegisterSunCommand(app, run);
+    nave::cli::RegisterSpectrumCommand(app, run);
 
     try {
         app.parse(argc, argv);
