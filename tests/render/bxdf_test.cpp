@@ -106,7 +106,7 @@ void ExpectChi2(const Bxdf& bxdf, const Vec3f& wo, uint64_t seed, const std::str
     auto pdf = [&](const Vec3f& wi) { return bxdf.Pdf(wo, wi, kLambda); };
     // Significance 0.01 shared by the ~20 χ² tests of this file (Šidák correction, as pbrt-v4 does):
     // 1 - 0.99^(1/20) ≈ 5e-4.
-    testing::Chi2Result r = Chi2Test(sample, pdf, seed, 200000, 10, 5e-4);
+    testing::Chi2Result r = Chi2Test(sample, pdf, seed, 100000, 10, 5e-4);
     EXPECT_TRUE(r.passed) << what << ": " << r.message;
 }
 
@@ -118,17 +118,20 @@ TEST(BxdfChi2Test, Diffuse) {
     ExpectChi2(b, Dir(120.f, 10.f), seed++, "diffuse from below");
 }
 
-TEST(BxdfChi2Test, RoughConductor) {
+void ExpectConductorChi2(float ax, float ay, uint64_t seed) {
     SampledSpectrum eta(0.2f), k(3.f);
-    int seed = 10;
-    for (auto [ax, ay] : {std::pair{0.5f, 0.5f}, {0.2f, 0.2f}, {0.1f, 0.4f}, {0.05f, 0.05f}})
-        for (float theta : {10.f, 50.f, 80.f}) {
-            Bxdf b = ConductorBxdf(TrowbridgeReitz(ax, ay), eta, k);
-            ExpectChi2(b, Dir(theta, 20.f), uint64_t(seed++),
-                       "conductor ax=" + std::to_string(ax) + " ay=" + std::to_string(ay) +
-                           " theta=" + std::to_string(theta));
-        }
+    for (float theta : {10.f, 50.f, 80.f}) {
+        Bxdf b = ConductorBxdf(TrowbridgeReitz(ax, ay), eta, k);
+        ExpectChi2(b, Dir(theta, 20.f), seed++,
+                   "conductor ax=" + std::to_string(ax) + " ay=" + std::to_string(ay) +
+                       " theta=" + std::to_string(theta));
+    }
 }
+
+TEST(BxdfChi2Test, RoughConductorAlpha05) { ExpectConductorChi2(0.5f, 0.5f, 10); }
+TEST(BxdfChi2Test, RoughConductorAlpha02) { ExpectConductorChi2(0.2f, 0.2f, 20); }
+TEST(BxdfChi2Test, RoughConductorAnisotropic) { ExpectConductorChi2(0.1f, 0.4f, 30); }
+TEST(BxdfChi2Test, RoughConductorAlpha005) { ExpectConductorChi2(0.05f, 0.05f, 40); }
 
 // A sampled direction's f and pdf equal Eval and Pdf for the same pair (non-specular lobes).
 TEST(BxdfTest, SampleAgreesWithEvalAndPdf) {

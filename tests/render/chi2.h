@@ -89,7 +89,7 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
         observed[size_t(ti * phi_res + pi)] += 1;
     }
     // Integrate the pdf over each cell (midpoint rule on a fine sub-grid), in solid angle sinθ dθ dφ.
-    const int sub = 24;
+    const int sub = 16;
     const double dt = M_PI / theta_res, dp = 2 * M_PI / phi_res;
     for (int ti = 0; ti < theta_res; ++ti)
         for (int pi = 0; pi < phi_res; ++pi) {
