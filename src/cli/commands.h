@@ -17,5 +17,7 @@ using CommandRun = std::function<Status()>;
 void RegisterVersionCommand(CLI::App& app, CommandRun& run);
 void RegisterInspectCommand(CLI::App& app, CommandRun& run);
 void RegisterVerifyCommand(CLI::App& app, CommandRun& run);
+void RegisterSunCommand(CLI::App& app, CommandRun& run);
+void RegisterSpectrumCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

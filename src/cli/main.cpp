@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
     nave::cli::RegisterVersionCommand(app, run);
     nave::cli::RegisterInspectCommand(app, run);
     nave::cli::RegisterVerifyCommand(app, run);
+    nave::cli::RegisterSunCommand(app, run);
+    nave::cli::RegisterSpectrumCommand(app, run);
 
     try {
         app.parse(argc, argv);
