@@ -1,11 +1,12 @@
-// Damaged stores: every kind of damage gives the right StatusCode and a message naming the file, the part
-// (header, table, brick) and the byte offset; never a crash. Also the crash-safety of the writer.
+// Damaged stores: every kind of damage gives the right StatusCode and a message naming the file,
+// the part (header, table, brick) and the byte offset; never a crash. Also the crash-safety of the
+// writer.
+
+#include <gtest/gtest.h>
 
 #include <cstring>
 #include <fstream>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "core/file.h"
 #include "core/hash.h"
@@ -61,9 +62,12 @@ class StoreCorruption : public ::testing::Test {
         return b;
     }
     // Expects `status` to have `code` and a message containing every one of `parts`.
-    static void ExpectError(const Status& status, StatusCode code, std::initializer_list<std::string> parts) {
+    static void ExpectError(const Status& status, StatusCode code,
+                            std::initializer_list<std::string> parts) {
         EXPECT_EQ(status.code(), code) << status.ToString();
-        for (const std::string& p : parts) EXPECT_NE(status.message().find(p), std::string::npos) << status.message() << "\n  lacks: " << p;
+        for (const std::string& p : parts)
+            EXPECT_NE(status.message().find(p), std::string::npos)
+                << status.message() << "\n  lacks: " << p;
     }
 
     ScratchDir dir_;
@@ -76,9 +80,10 @@ class StoreCorruption : public ::testing::Test {
 
 TEST_F(StoreCorruption, TruncatedFileIsDataLoss) {
     const uint64_t n = bytes_.size();
-    for (uint64_t length : {uint64_t(3), uint64_t(12), uint64_t(100), uint64_t(format::kHeaderBytes),
-                            uint64_t(format::kHeaderBytes + 7), bricks_[2].mesh.offset + 5, header_.directory.offset,
-                            header_.materials.offset + 3, n - 1}) {
+    for (uint64_t length :
+         {uint64_t(3), uint64_t(12), uint64_t(100), uint64_t(format::kHeaderBytes),
+          uint64_t(format::kHeaderBytes + 7), bricks_[2].mesh.offset + 5, header_.directory.offset,
+          header_.materials.offset + 3, n - 1}) {
         SCOPED_TRACE("length " + std::to_string(length));
         auto store = OpenBytes(bytes_.substr(0, length));
         ASSERT_FALSE(store.ok());
@@ -95,7 +100,8 @@ TEST_F(StoreCorruption, FlippedHeaderByteIsDataLoss) {
     for (uint64_t offset : {20, 60, 100, 150, 250}) {
         SCOPED_TRACE("offset " + std::to_string(offset));
         auto store = OpenBytes(Flipped(offset));
-        ExpectError(store.status(), StatusCode::kDataLoss, {bad_.string(), "header @0x0: checksum", "!= stored"});
+        ExpectError(store.status(), StatusCode::kDataLoss,
+                    {bad_.string(), "header @0x0: checksum", "!= stored"});
     }
 }
 
@@ -104,14 +110,17 @@ TEST_F(StoreCorruption, FlippedTableByteNamesTheTableAndItsOffset) {
         const char* table;
         format::TableRef ref;
     };
-    for (const Case& c : {Case{"provenance", header_.provenance}, Case{"directory", header_.directory},
-                          Case{"tree", header_.tree}, Case{"materials", header_.materials}}) {
+    for (const Case& c :
+         {Case{"provenance", header_.provenance}, Case{"directory", header_.directory},
+          Case{"tree", header_.tree}, Case{"materials", header_.materials}}) {
         SCOPED_TRACE(c.table);
-        for (uint64_t at : {c.ref.offset, c.ref.offset + c.ref.length / 2, c.ref.offset + c.ref.length - 1}) {
+        for (uint64_t at :
+             {c.ref.offset, c.ref.offset + c.ref.length / 2, c.ref.offset + c.ref.length - 1}) {
             auto store = OpenBytes(Flipped(at));
             ASSERT_FALSE(store.ok());
             ExpectError(store.status(), StatusCode::kDataLoss,
-                        {bad_.string(), std::string(c.table) + " table @" + Hex(c.ref.offset) + ": checksum"});
+                        {bad_.string(),
+                         std::string(c.table) + " table @" + Hex(c.ref.offset) + ": checksum"});
         }
     }
 }
@@ -123,20 +132,22 @@ TEST_F(StoreCorruption, FlippedBrickByteIsReportedWithBrickAndOffset) {
     for (uint32_t id : {0u, 1u, 3u}) EXPECT_TRUE((*store)->VerifyBrick(id).ok());
     const Status s = (*store)->ReadBrick(2).status();
     ExpectError(s, StatusCode::kDataLoss,
-                {bad_.string() + " brick 2 @" + Hex(b.mesh.offset) + ": mesh checksum", "!= stored " + ChecksumHex(b.mesh.checksum)});
+                {bad_.string() + " brick 2 @" + Hex(b.mesh.offset) + ": mesh checksum",
+                 "!= stored " + ChecksumHex(b.mesh.checksum)});
     EXPECT_EQ((*store)->VerifyBrick(2).code(), StatusCode::kDataLoss);
 }
 
-// The checksums catch damage; this checks what is behind them. A payload changed and re-checksummed (as a
-// buggy writer would produce) must still give an error or a mesh consistent with the directory, never a
-// crash (run it under the asan preset).
+// The checksums catch damage; this checks what is behind them. A payload changed and re-checksummed
+// (as a buggy writer would produce) must still give an error or a mesh consistent with the
+// directory, never a crash (run it under the asan preset).
 TEST_F(StoreCorruption, DamagedPayloadBehindValidChecksumsNeverCrashes) {
     std::mt19937 rng(99);
     const BrickInfo& b = bricks_[1];
     int errors = 0;
     for (int trial = 0; trial < 60; ++trial) {
         std::string bytes = bytes_;
-        std::uniform_int_distribution<uint64_t> pos(b.mesh.offset, b.mesh.offset + b.mesh.length - 1);
+        std::uniform_int_distribution<uint64_t> pos(b.mesh.offset,
+                                                    b.mesh.offset + b.mesh.length - 1);
         for (int k = 0; k < 1 + trial % 3; ++k) bytes[pos(rng)] ^= char(1 << (trial % 8));
         // Re-checksum the mesh section, the directory and the header.
         const uint64_t mesh_sum = Checksum64(bytes.data() + b.mesh.offset, b.mesh.length);
@@ -151,7 +162,8 @@ TEST_F(StoreCorruption, DamagedPayloadBehindValidChecksumsNeverCrashes) {
         auto read = (*store)->ReadBrick(1);
         if (!read.ok()) {
             ++errors;
-            ExpectError(read.status(), StatusCode::kDataLoss, {bad_.string() + " brick 1 @" + Hex(b.mesh.offset)});
+            ExpectError(read.status(), StatusCode::kDataLoss,
+                        {bad_.string() + " brick 1 @" + Hex(b.mesh.offset)});
         } else {
             EXPECT_EQ(read->TriangleCount(), b.triangle_count);
         }
@@ -191,7 +203,8 @@ TEST_F(StoreCorruption, EmptyFileIsDataLoss) {
 
 TEST_F(StoreCorruption, OtherFileIsNotAStore) {
     auto store = OpenBytes("ply\nformat ascii 1.0\nelement vertex 8\n");
-    ExpectError(store.status(), StatusCode::kUnsupported, {bad_.string(), "not a nave store", "magic \"ply\\x0aform\""});
+    ExpectError(store.status(), StatusCode::kUnsupported,
+                {bad_.string(), "not a nave store", "magic \"ply\\x0aform\""});
     store = OpenBytes(Flipped(2));  // the magic itself damaged
     ExpectError(store.status(), StatusCode::kUnsupported, {"not a nave store"});
 }
@@ -204,7 +217,8 @@ TEST_F(StoreCorruption, MissingFileIsNotFound) {
 TEST_F(StoreCorruption, BrickIdOutOfRangeIsNotFound) {
     auto store = Store::Open(good_);
     ASSERT_TRUE(store.ok());
-    ExpectError((*store)->ReadBrick(4).status(), StatusCode::kNotFound, {"brick 4 does not exist", "4 bricks"});
+    ExpectError((*store)->ReadBrick(4).status(), StatusCode::kNotFound,
+                {"brick 4 does not exist", "4 bricks"});
 }
 
 TEST(StoreWriterCrashSafety, WriterDestroyedBeforeFinishLeavesNoFile) {
