@@ -175,7 +175,9 @@ TEST(BxdfTest, WhiteFurnace) {
             double rho = albedo(mirror, Dir(t, 0));
             EXPECT_LE(rho, 1.0 + 0.01) << "alpha " << a << " theta " << t;
             // Little roughness loses little energy away from grazing angles.
-            if (a <= 0.05f && t <= 45.f) EXPECT_GT(rho, 0.97) << "alpha " << a << " theta " << t;
+            if (a <= 0.05f && t <= 45.f) {
+                EXPECT_GT(rho, 0.97) << "alpha " << a << " theta " << t;
+            }
         }
     // Smooth mirror: exactly F.
     Bxdf smooth = ConductorBxdf(TrowbridgeReitz(0, 0), SampledSpectrum(1.38f), SampledSpectrum(1.914f));
@@ -211,8 +213,9 @@ TEST(BxdfTest, SmoothDielectricConservesEnergy) {
                     EXPECT_NEAR(eta_i * sin_i, eta_t * sin_t, 1e-4f);
                     // Radiance transport carries the 1/η² factor instead.
                     std::optional<BsdfSample> sr = b.Sample(wo, 0.9999f, Point2f(), kLambda);
-                    if (sr && sr->IsTransmission())
+                    if (sr && sr->IsTransmission()) {
                         EXPECT_NEAR(sr->f[0] * AbsCosTheta(sr->wi) / sr->pdf, 1.f / (sr->eta * sr->eta), 1e-4f);
+                    }
                 }
             }
             EXPECT_NEAR(double(reflected) / n, r, 4.0 * std::sqrt(r * (1 - r) / n) + 1e-3)
@@ -249,7 +252,9 @@ TEST(BxdfTest, ThinDielectricSumsInterreflections) {
     for (int i = 0; i < n; ++i) {
         std::optional<BsdfSample> s = tinted.Sample(wo, rng.NextFloat(), Point2f(), kLambda);
         ASSERT_TRUE(s.has_value());
-        if (s->IsTransmission()) EXPECT_NEAR(Length(s->wi + wo), 0.f, 1e-6f);
+        if (s->IsTransmission()) {
+            EXPECT_NEAR(Length(s->wi + wo), 0.f, 1e-6f);
+        }
         sum += s->f * (AbsCosTheta(s->wi) / s->pdf);
     }
     for (int i = 0; i < kNumWavelengths; ++i) EXPECT_NEAR(sum[i] / n, rr[i] + tt[i], 0.01f);
