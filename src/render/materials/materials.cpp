@@ -58,7 +58,7 @@ ConductorMaterial Metal(std::string_view symbol, float alpha) {
 std::vector<std::string> BuiltinMaterialNames() { return {std::begin(kNames), std::end(kNames)}; }
 
 StatusOr<Material> BuiltinMaterial(std::string_view name) {
-    const SpectraTable& building = EmbeddedSpectraTable("building_approx.csv");
+    const SpectraTable& building = EmbeddedSpectraTable("stone_approx.csv");
     for (std::string_view n : {"limestone", "limestone_dark", "floor_tile_light", "floor_tile_dark",
                                "wood", "roof_slate"}) {
         if (name == n) {
