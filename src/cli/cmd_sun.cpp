@@ -14,7 +14,7 @@ namespace {
 struct SunOptions {
     double lat = 1000, lon = 1000;
     std::string time;
-    double elevation_m = 0, pressure_hpa = -1, temperature_c = 15, turbidity = 3, delta_t_s = 69;
+    double elevation_m = 0, pressure_hpa = -1, temperature_c = 15, turbidity = 3, delta_t_s = NAN;
     double ozone_atm_cm = 0.30, water_cm = 1.4;
     bool spectrum = false, json = false;
 };
@@ -35,7 +35,9 @@ Status RunSun(const SunOptions& o) {
     in.latitude_deg = o.lat;
     in.longitude_deg = o.lon;
     in.elevation_m = o.elevation_m;
-    in.delta_t_s = o.delta_t_s;
+    // Without --delta-t, estimate ΔT for the date (matters for historical dates: ~11 min in 1236).
+    double delta_t = std::isfinite(o.delta_t_s) ? o.delta_t_s : EstimateDeltaT(DecimalYear(t));
+    in.delta_t_s = delta_t;
     in.atmosphere.pressure_hpa = o.pressure_hpa >= 0 ? o.pressure_hpa : StandardPressureHpa(o.elevation_m);
     in.atmosphere.temperature_c = o.temperature_c;
     in.atmosphere.turbidity = o.turbidity;
@@ -67,7 +69,7 @@ Status RunSun(const SunOptions& o) {
         out += fmt::format("  \"pressure_hpa\": {},\n  \"temperature_c\": {},\n  \"turbidity\": {},\n",
                            JsonNumber(in.atmosphere.pressure_hpa), JsonNumber(o.temperature_c),
                            JsonNumber(o.turbidity));
-        out += fmt::format("  \"delta_t_s\": {},\n  \"julian_day\": {:.6f},\n", JsonNumber(o.delta_t_s), p.jd);
+        out += fmt::format("  \"delta_t_s\": {},\n  \"julian_day\": {:.6f},\n", JsonNumber(delta_t), p.jd);
         out += fmt::format("  \"azimuth_deg\": {:.5f},\n  \"zenith_deg\": {:.5f},\n  \"elevation_deg\": {:.5f},\n",
                            p.azimuth_deg, p.zenith_deg, p.elevation_deg);
         out += fmt::format("  \"refraction_deg\": {:.5f},\n  \"earth_sun_distance_au\": {:.8f},\n",
@@ -90,8 +92,8 @@ Status RunSun(const SunOptions& o) {
         return Status::Ok();
     }
     (void)nan;
-    std::printf("time                      %s (JD %.6f, delta T %.1f s)\n", FormatIso8601(t).c_str(), p.jd,
-                o.delta_t_s);
+    std::printf("time                      %s (JD %.6f, delta T %.1f s%s)\n", FormatIso8601(t).c_str(), p.jd,
+                delta_t, std::isfinite(o.delta_t_s) ? "" : ", estimated");
     std::printf("place                     %.6f° %s, %.6f° %s, %.1f m\n", std::abs(o.lat), o.lat >= 0 ? "N" : "S",
                 std::abs(o.lon), o.lon >= 0 ? "E" : "W", o.elevation_m);
     std::printf("azimuth                   %.5f° (from north, clockwise)\n", p.azimuth_deg);
@@ -129,7 +131,8 @@ void RegisterSunCommand(CLI::App& app, CommandRun& run) {
                     "Station pressure in hPa (default: standard atmosphere at the elevation)");
     cmd->add_option("--temperature", o->temperature_c, "Air temperature in °C, for refraction (default 15)");
     cmd->add_option("--turbidity", o->turbidity, "Preetham turbidity of the aerosols, 2 = very clear (default 3)");
-    cmd->add_option("--delta-t", o->delta_t_s, "ΔT = TT - UT1 in seconds (default 69, about 2020)");
+    cmd->add_option("--delta-t", o->delta_t_s,
+                    "ΔT = TT - UT1 in seconds (default: Espenak & Meeus estimate for the date)");
     cmd->add_option("--ozone", o->ozone_atm_cm, "Ozone column in atm-cm (default 0.30)");
     cmd->add_option("--water", o->water_cm, "Precipitable water in cm (default 1.4)");
     cmd->add_flag("--spectrum", o->spectrum, "Print the direct normal spectral irradiance (CSV, 360-830 nm)");

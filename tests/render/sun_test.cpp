@@ -54,6 +54,22 @@ TEST(SpaTest, JulianDayGregorianAndJulianCalendars) {
     EXPECT_DOUBLE_EQ(JulianDay(-1000, 7, 12.5), 1356001.0);
 }
 
+// Espenak & Meeus (2006) Table 2.1 (ΔT at the start of each century, from the same model) and the
+// observed value of 2000 (63.8 s, IERS).
+TEST(SpaTest, DeltaTEstimate) {
+    EXPECT_NEAR(EstimateDeltaT(2000.0), 63.8, 0.2);
+    EXPECT_NEAR(EstimateDeltaT(1900.0), -2.7, 0.5);
+    EXPECT_NEAR(EstimateDeltaT(1800.0), 13.7, 0.5);
+    EXPECT_NEAR(EstimateDeltaT(1700.0), 8.8, 0.5);
+    EXPECT_NEAR(EstimateDeltaT(1600.0), 120.0, 2.0);
+    EXPECT_NEAR(EstimateDeltaT(1500.0), 200.0, 10.0);
+    EXPECT_NEAR(EstimateDeltaT(1000.0), 1570.0, 10.0);
+    EXPECT_NEAR(EstimateDeltaT(0.0), 10580.0, 30.0);
+    // Continuous across the period boundaries (within a few seconds).
+    for (double y : {500.0, 1600.0, 1700.0, 1800.0, 1860.0, 1900.0, 1920.0, 1941.0, 1961.0, 1986.0, 2005.0})
+        EXPECT_NEAR(EstimateDeltaT(y - 1e-6), EstimateDeltaT(y), 5.0) << y;
+}
+
 TEST(SpaTest, RejectsOutOfRangeInput) {
     SpaInput in;
     in.time = {2003, 10, 17, 12, 30, 30.0, -7.0};

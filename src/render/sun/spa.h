@@ -28,6 +28,13 @@ StatusOr<CivilTime> ParseIso8601(std::string_view text);
 /// "2003-10-17T12:30:30-07:00".
 std::string FormatIso8601(const CivilTime& t);
 
+/// An estimate of ΔT = TT - UT (seconds) for a decimal year, from the polynomial expressions of Espenak &
+/// Meeus, "Five Millennium Canon of Solar Eclipses: -1999 to +3000", NASA/TP-2006-214141, §2.6 (after
+/// Morrison & Stephenson 2004). About 1570 s in 1000, 63.8 s in 2000; uncertain by minutes in antiquity.
+double EstimateDeltaT(double decimal_year);
+/// The decimal year of a civil date (mid-month convention of Espenak & Meeus: y = year + (month - 0.5)/12).
+inline double DecimalYear(const CivilTime& t) { return t.year + (t.month - 0.5) / 12.0; }
+
 /// Julian Day of a UT instant (Reda & Andreas eq. 4; Gregorian from 1582-10-15, Julian before).
 double JulianDay(int year, int month, double day_with_fraction);
 
