@@ -51,7 +51,8 @@ Status RunSun(const SunOptions& o) {
     for (int i = 0; i < Spectrum::kNumSamples; ++i) watts += sun.direct_normal_irradiance.sample(i);
     bool lit = lux > 0;
     Chromaticity xy = lit ? XYZToChromaticity(SpectrumToXYZ(sun.direct_normal_irradiance)) : Chromaticity{};
-    double cct = lit ? CctMcCamy(xy) : NAN;
+    double cct = lit ? CctRobertson(xy) : NAN;
+    double cct_mccamy = lit ? CctMcCamy(xy) : NAN;
     double nan = NAN;
 
     if (o.spectrum && !o.json) {
@@ -78,8 +79,10 @@ Status RunSun(const SunOptions& o) {
                            sun.angular_radius_rad * 180 / M_PI, lit ? JsonNumber(sun.air_mass) : "null");
         out += fmt::format("  \"direct_normal_illuminance_lux\": {},\n", JsonNumber(lux));
         out += fmt::format("  \"direct_normal_irradiance_360_830_w_m2\": {},\n", JsonNumber(watts));
-        out += fmt::format("  \"cct_kelvin\": {},\n  \"chromaticity\": {{\"x\": {}, \"y\": {}}}",
-                           JsonNumber(cct), lit ? JsonNumber(xy.x) : "null", lit ? JsonNumber(xy.y) : "null");
+        out += fmt::format("  \"cct_kelvin\": {},\n  \"cct_mccamy_kelvin\": {},\n", JsonNumber(cct),
+                           JsonNumber(cct_mccamy));
+        out += fmt::format("  \"chromaticity\": {{\"x\": {}, \"y\": {}}}", lit ? JsonNumber(xy.x) : "null",
+                           lit ? JsonNumber(xy.y) : "null");
         if (o.spectrum) {
             out += ",\n  \"spectrum\": {\"wavelength_nm_start\": 360, \"step_nm\": 1, "
                    "\"direct_normal_irradiance_w_m2_nm\": [";
@@ -111,7 +114,7 @@ Status RunSun(const SunOptions& o) {
     std::printf("direct normal irradiance  %.1f W/m² (360-830 nm; turbidity %.2g, ozone %.2f atm-cm)\n",
                 watts, o.turbidity, o.ozone_atm_cm);
     std::printf("chromaticity              x %.4f, y %.4f\n", xy.x, xy.y);
-    std::printf("correlated colour temp.   %.0f K (McCamy 1992)\n", cct);
+    std::printf("correlated colour temp.   %.0f K (Robertson 1968; McCamy 1992: %.0f K)\n", cct, cct_mccamy);
     return Status::Ok();
 }
 

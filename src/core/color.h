@@ -127,5 +127,9 @@ double DeltaE76(const Vec3d& lab1, const Vec3d& lab2);
 /// Correlated colour temperature by McCamy's cubic (McCamy 1992, Color Res. Appl. 17(2) 142-144,
 /// erratum 18(2) 150); accurate to ~2 K over 2856-6504 K near the Planckian locus.
 double CctMcCamy(const Chromaticity& xy);
+/// Correlated colour temperature by Robertson's method (Robertson 1968, JOSA 58(11) 1528-1535): linear
+/// interpolation between the 31 isotemperature lines of Wyszecki & Stiles (1982) Table 1(3.11) in the CIE
+/// 1960 (u, v) diagram; 1667 K to infinity. NaN outside the table's reach (far from the locus).
+double CctRobertson(const Chromaticity& xy);
 
 }  // namespace nave

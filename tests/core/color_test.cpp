@@ -96,6 +96,27 @@ TEST(ColorTest, McCamyCct) {
     EXPECT_NEAR(CctMcCamy(IlluminantChromaticity(Spectrum::Blackbody(4000.0))), 4000.0, 15.0);
 }
 
+// Robertson (1968) with the Wyszecki & Stiles isotemperature lines: black bodies give back their own
+// temperature (0.2 %), illuminant A 2856 K, D65 6504 K; and the table's (u, v) lie on the Planckian
+// locus computed from nave's CMFs (a check of both tables).
+TEST(ColorTest, RobertsonCct) {
+    for (double t : {2000.0, 2856.0, 4000.0, 5000.0, 6500.0, 9000.0, 15000.0})
+        EXPECT_NEAR(CctRobertson(IlluminantChromaticity(Spectrum::Blackbody(t))) / t, 1.0, 2e-3) << t;
+    EXPECT_NEAR(CctRobertson(IlluminantChromaticity(IlluminantA())), 2856.0, 4.0);
+    EXPECT_NEAR(CctRobertson(IlluminantChromaticity(IlluminantD65())), 6504.0, 10.0);
+    for (double mired : {100.0, 200.0, 300.0, 400.0, 500.0}) {
+        Chromaticity c = IlluminantChromaticity(Spectrum::Blackbody(1e6 / mired));
+        double den = -2 * c.x + 12 * c.y + 3;
+        double u = 4 * c.x / den, v = 6 * c.y / den;
+        double tu = mired == 100 ? 0.19032 : mired == 200 ? 0.21142 : mired == 300 ? 0.24010
+                  : mired == 400 ? 0.27218 : 0.30505;
+        double tv = mired == 100 ? 0.29326 : mired == 200 ? 0.32312 : mired == 300 ? 0.34308
+                  : mired == 400 ? 0.35407 : 0.35907;
+        EXPECT_NEAR(u, tu, 3e-4) << mired;
+        EXPECT_NEAR(v, tv, 3e-4) << mired;
+    }
+}
+
 // Lindbloom's Bradford D65 -> D50 matrix (brucelindbloom.com, "Chromatic Adaptation"), computed with
 // whites (0.95047, 1, 1.08883) and (0.96422, 1, 0.82521); our whites come from xy, hence 2e-3.
 TEST(ColorTest, BradfordD65ToD50) {
