@@ -268,6 +268,8 @@ bool ParseDouble(std::string_view s, double* out) {
 
 StatusOr<SpectraTable> ParseSpectraCsv(std::string_view text, std::string_view source_name) {
     SpectraTable table;
+    // Spreadsheet exports often start with a UTF-8 byte-order mark.
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     size_t num_columns = 0;  // value columns, fixed by the header or the first data row
     int line_number = 0;
     bool seen_data = false;

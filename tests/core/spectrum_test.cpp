@@ -150,6 +150,14 @@ TEST(SpectraCsvTest, ParsesHeaderCommentsAndColumns) {
     EXPECT_EQ(t->ToSpectrum("green").status().code(), StatusCode::kNotFound);
 }
 
+TEST(SpectraCsvTest, ByteOrderMarkAndCrLf) {
+    StatusOr<SpectraTable> t = ParseSpectraCsv("\xEF\xBB\xBF" "400,0.1\r\n500,0.2\r\n", "excel.csv");
+    ASSERT_TRUE(t.ok()) << t.status().ToString();
+    EXPECT_EQ(t->lambda_nm.size(), 2u);
+    EXPECT_DOUBLE_EQ(t->columns[0][1], 0.2);
+    EXPECT_FALSE(ParseSpectraCsv("400,nan\n", "n.csv").ok());
+}
+
 TEST(SpectraCsvTest, ErrorsNameFileAndLine) {
     auto msg = [](std::string_view text) {
         StatusOr<SpectraTable> t = ParseSpectraCsv(text, "bad.csv");
