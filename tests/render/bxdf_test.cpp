@@ -133,14 +133,29 @@ TEST(BxdfChi2Test, RoughConductorAlpha02) { ExpectConductorChi2(0.2f, 0.2f, 20);
 TEST(BxdfChi2Test, RoughConductorAnisotropic) { ExpectConductorChi2(0.1f, 0.4f, 30); }
 TEST(BxdfChi2Test, RoughConductorAlpha005) { ExpectConductorChi2(0.05f, 0.05f, 40); }
 
+void ExpectDielectricChi2(float eta, float alpha, uint64_t seed) {
+    for (float theta : {10.f, 60.f, 170.f, 120.f}) {  // from outside and from inside
+        Bxdf b = DielectricBxdf(eta, TrowbridgeReitz(alpha, alpha));
+        ExpectChi2(b, Dir(theta, 40.f), seed++,
+                   "rough dielectric eta=" + std::to_string(eta) + " alpha=" + std::to_string(alpha) +
+                       " theta=" + std::to_string(theta));
+    }
+}
+
+TEST(BxdfChi2Test, RoughDielectric) {
+    ExpectDielectricChi2(1.5f, 0.3f, 50);
+    ExpectDielectricChi2(1.33f, 0.15f, 60);
+}
+
 // A sampled direction's f and pdf equal Eval and Pdf for the same pair (non-specular lobes).
 TEST(BxdfTest, SampleAgreesWithEvalAndPdf) {
     Bxdf bxdfs[] = {DiffuseBxdf(SampledSpectrum(0.5f)),
-                    ConductorBxdf(TrowbridgeReitz(0.3f, 0.1f), SampledSpectrum(0.3f), SampledSpectrum(2.f))};
+                    ConductorBxdf(TrowbridgeReitz(0.3f, 0.1f), SampledSpectrum(0.3f), SampledSpectrum(2.f)),
+                    DielectricBxdf(1.5f, TrowbridgeReitz(0.25f, 0.25f))};
     Pcg32 rng(7);
     for (const Bxdf& b : bxdfs)
         for (int i = 0; i < 2000; ++i) {
-            Vec3f wo = Dir(89.f * rng.NextFloat(), 360.f * rng.NextFloat());
+            Vec3f wo = Dir(179.f * rng.NextFloat() + 0.5f, 360.f * rng.NextFloat());
             std::optional<BsdfSample> s =
                 b.Sample(wo, rng.NextFloat(), Point2f(rng.NextFloat(), rng.NextFloat()), kLambda);
             if (!s) continue;
@@ -220,6 +235,29 @@ TEST(BxdfTest, SmoothDielectricConservesEnergy) {
             }
             EXPECT_NEAR(double(reflected) / n, r, 4.0 * std::sqrt(r * (1 - r) / n) + 1e-3)
                 << "eta " << eta << " theta " << theta;
+        }
+}
+
+// A rough dielectric loses energy only to single-scattering masking: the average weight is at most 1 and
+// close to 1 for a slightly rough surface away from grazing angles (Walter et al. 2007 §5.3).
+TEST(BxdfTest, RoughDielectricWhiteFurnace) {
+    Pcg32 rng(13);
+    for (float alpha : {0.05f, 0.3f, 0.7f})
+        for (float theta : {0.f, 45.f, 80.f, 135.f}) {
+            DielectricBxdf b(1.5f, TrowbridgeReitz(alpha, alpha));
+            Vec3f wo = Dir(theta, 0.f);
+            const int n = 20000;
+            double sum = 0;
+            for (int i = 0; i < n; ++i) {
+                std::optional<BsdfSample> s = b.Sample(wo, rng.NextFloat(), Point2f(rng.NextFloat(), rng.NextFloat()),
+                                                       kLambda, TransportMode::kImportance);
+                if (s && s->pdf > 0) sum += s->f[0] * AbsCosTheta(s->wi) / s->pdf;
+            }
+            double rho = sum / n;
+            EXPECT_LE(rho, 1.0 + 0.01) << "alpha " << alpha << " theta " << theta;
+            if (alpha <= 0.05f && (theta <= 45.f || theta >= 135.f)) {
+                EXPECT_GT(rho, 0.97) << "alpha " << alpha << " theta " << theta;
+            }
         }
 }
 

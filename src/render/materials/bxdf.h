@@ -182,15 +182,19 @@ class ConductorBxdf {
     SampledSpectrum eta_, k_;
 };
 
-/// A smooth interface between dielectrics of relative index eta (inside over outside; the normal points
-/// outside). Fresnel reflection and refraction, chosen in proportion to R and T = 1 - R, so that
-/// R + T = 1 exactly. Dispersion: the material passes the index at the hero wavelength and terminates
-/// the secondary wavelengths (see DielectricMaterial). Absorption inside (Beer-Lambert) is a property
-/// of the volume the refracted path crosses, not of the interface: see DielectricMaterial.
+/// An interface between dielectrics of relative index eta (inside over outside; the normal points
+/// outside). Smooth (a delta lobe pair) when the distribution is effectively smooth: Fresnel reflection and
+/// refraction chosen in proportion to R and T = 1 - R, so that R + T = 1 exactly. Rough otherwise: the
+/// Trowbridge-Reitz microfacet BTDF of Walter, Marschner, Li & Torrance 2007 ("Microfacet models for
+/// refraction through rough surfaces", eqs. 20-21) with visible-normal sampling (Heitz 2018), e.g. for
+/// uneven medieval glass. Dispersion: the material passes the index at the hero wavelength and terminates
+/// the secondary wavelengths (see DielectricMaterial). Absorption inside (Beer-Lambert) is a property of
+/// the volume the refracted path crosses, not of the interface: see DielectricMaterial.
 class DielectricBxdf {
   public:
     DielectricBxdf() = default;
-    explicit DielectricBxdf(float eta) : eta_(eta) {}
+    explicit DielectricBxdf(float eta, const TrowbridgeReitz& distrib = TrowbridgeReitz())
+        : eta_(eta), distrib_(distrib) {}
 
     SampledSpectrum Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda,
                          TransportMode mode = TransportMode::kRadiance) const;
@@ -200,13 +204,19 @@ class DielectricBxdf {
     float Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda,
               TransportMode mode = TransportMode::kRadiance) const;
     uint8_t Flags() const {
-        return eta_ == 1.f ? kBxdfTransmission | kBxdfSpecular
-                           : kBxdfReflection | kBxdfTransmission | kBxdfSpecular;
+        uint8_t kind = distrib_.EffectivelySmooth() ? kBxdfSpecular : kBxdfGlossy;
+        return eta_ == 1.f ? kBxdfTransmission | kind : kBxdfReflection | kBxdfTransmission | kind;
     }
     float eta() const { return eta_; }
+    const TrowbridgeReitz& distribution() const { return distrib_; }
 
   private:
+    /// The generalized half vector of (wo, wi) facing +z, the relative index across and whether it is a
+    /// reflection; false if the pair has no valid microfacet.
+    bool HalfVector(const Vec3f& wo, const Vec3f& wi, Vec3f* wm, float* etap, bool* reflect) const;
+
     float eta_ = 1.5f;
+    TrowbridgeReitz distrib_;
 };
 
 /// A thin pane of glass (window): two parallel interfaces of index eta(λ) with an absorbing interior of

@@ -43,11 +43,13 @@ struct DielectricMaterial {
     Spectrum eta = Spectrum::Constant(1.5f);
     /// Absorption coefficient α(λ) in m⁻¹ (0: clear).
     Spectrum absorption_per_m = Spectrum::Constant(0.f);
+    /// GGX roughness α of the surface (0: polished).
+    float alpha = 0.f;
 
     bool IsDispersive() const { return !eta.IsConstant(); }
     Bxdf GetBxdf(SampledWavelengths& lambda) const {
         if (IsDispersive()) lambda.TerminateSecondary();
-        return DielectricBxdf(eta.Evaluate(lambda.lambda_nm(0)));
+        return DielectricBxdf(eta.Evaluate(lambda.lambda_nm(0)), TrowbridgeReitz(alpha, alpha));
     }
     /// exp(-α(λ) d): Beer-Lambert transmittance of `distance_m` of the medium (Beer 1852).
     SampledSpectrum Transmittance(float distance_m, const SampledWavelengths& lambda) const {
