@@ -19,8 +19,8 @@ struct Cmfs {
         x = t.ToSpectrum(0);
         y = t.ToSpectrum(1);
         z = t.ToSpectrum(2);
-        // The table is at 1 nm over exactly nave's range, so the 1 nm sum is the integral (CIE 15:2004
-        // §7.1 recommends summation at the table's interval).
+        // The table is at 1 nm over exactly nave's range, so the 1 nm sum is the integral (CIE
+        // 15:2004 §7.1 recommends summation at the table's interval).
         for (int i = 0; i < Spectrum::kNumSamples; ++i) y_integral += y.sample(i);
     }
 };
@@ -37,7 +37,8 @@ const Spectrum& CieY() { return GetCmfs().y; }
 const Spectrum& CieZ() { return GetCmfs().z; }
 double CieYIntegral() { return GetCmfs().y_integral; }
 
-// ---- Mat3d ------------------------------------------------------------------------------------------
+// ---- Mat3d
+// ------------------------------------------------------------------------------------------
 
 Mat3d Mat3d::Identity() { return Diagonal({1, 1, 1}); }
 
@@ -102,7 +103,8 @@ std::ostream& operator<<(std::ostream& os, const Mat3d& m) {
     return os << "]";
 }
 
-// ---- XYZ --------------------------------------------------------------------------------------------
+// ---- XYZ
+// --------------------------------------------------------------------------------------------
 
 Chromaticity XYZToChromaticity(const Vec3d& xyz) {
     double sum = xyz.x + xyz.y + xyz.z;
@@ -152,7 +154,8 @@ Vec3d SampledToXYZ(const SampledSpectrum& L, const SampledWavelengths& lambda) {
     return xyz / (double(kNumWavelengths) * c.y_integral);
 }
 
-// ---- RGB colour spaces ------------------------------------------------------------------------------
+// ---- RGB colour spaces
+// ------------------------------------------------------------------------------
 
 RgbColorSpace::RgbColorSpace(std::string name, Chromaticity r, Chromaticity g, Chromaticity b,
                              Chromaticity white)
@@ -195,7 +198,8 @@ StatusOr<const RgbColorSpace*> RgbColorSpace::Named(std::string_view name) {
     return NotFoundError("unknown colour space '{}' (known: srgb, rec2020, acescg)", name);
 }
 
-// ---- Chromatic adaptation ---------------------------------------------------------------------------
+// ---- Chromatic adaptation
+// ---------------------------------------------------------------------------
 
 namespace {
 
@@ -204,12 +208,14 @@ Mat3d ConeMatrix(AdaptationMethod method) {
     switch (method) {
         case AdaptationMethod::kBradford:
             // Lam (1985); as in ICC.1:2010 Annex E and Lindbloom's tables.
-            m.m = {{{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}}};
+            m.m = {
+                {{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}}};
             break;
         case AdaptationMethod::kVonKries:
             // Hunt-Pointer-Estévez fundamentals normalised to D65 (Fairchild, Color Appearance
             // Models, 3rd ed., eq. 9.1).
-            m.m = {{{0.40024, 0.70760, -0.08081}, {-0.22630, 1.16532, 0.04570}, {0.0, 0.0, 0.91822}}};
+            m.m = {
+                {{0.40024, 0.70760, -0.08081}, {-0.22630, 1.16532, 0.04570}, {0.0, 0.0, 0.91822}}};
             break;
         case AdaptationMethod::kXyzScaling:
             m = Mat3d::Identity();
@@ -234,7 +240,8 @@ Mat3d WhiteBalancedXyzToRgb(const RgbColorSpace& space, const Chromaticity& scen
     return space.xyz_to_rgb() * ChromaticAdaptationMatrix(scene_white, space.white(), method);
 }
 
-// ---- Output -----------------------------------------------------------------------------------------
+// ---- Output
+// -----------------------------------------------------------------------------------------
 
 double SrgbEncode(double linear) {
     // IEC 61966-2-1:1999 §5.2, eq. (5).
@@ -304,8 +311,8 @@ double CctRobertson(const Chromaticity& xy) {
     double den = -2.0 * xy.x + 12.0 * xy.y + 3.0;
     if (den == 0.0) return NAN;
     double u = 4.0 * xy.x / den, v = 6.0 * xy.y / den;
-    // Signed distance of (u, v) from each isotemperature line; the CCT lies between the two lines where
-    // it changes sign (Robertson 1968 eq. 3).
+    // Signed distance of (u, v) from each isotemperature line; the CCT lies between the two lines
+    // where it changes sign (Robertson 1968 eq. 3).
     double prev_d = 0;
     for (size_t i = 0; i < std::size(kLines); ++i) {
         const Line& l = kLines[i];

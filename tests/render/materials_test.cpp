@@ -52,8 +52,10 @@ TEST(MaterialsTest, BeerAbsorption) {
 
 // A pane built from a measured total transmittance reproduces it at normal incidence.
 TEST(MaterialsTest, ThinGlassFromTotalTransmittanceRoundTrip) {
-    Spectrum measured = Spectrum::FromFunction([](double l) { return 0.05 + 0.8 * (l - 360) / 470; });
-    ThinGlassMaterial pane = ThinGlassMaterial::FromTotalTransmittance(Spectrum::Constant(1.5f), measured);
+    Spectrum measured =
+        Spectrum::FromFunction([](double l) { return 0.05 + 0.8 * (l - 360) / 470; });
+    ThinGlassMaterial pane =
+        ThinGlassMaterial::FromTotalTransmittance(Spectrum::Constant(1.5f), measured);
     for (float u : {0.05f, 0.3f, 0.6f, 0.95f}) {
         SampledWavelengths lambda = SampledWavelengths::SampleUniform(u);
         Bxdf b = pane.GetBxdf(lambda);

@@ -13,7 +13,8 @@ namespace {
 
 Vec3f FromAngles(double elevation_deg, double azimuth_deg) {
     double e = elevation_deg * M_PI / 180, a = azimuth_deg * M_PI / 180;
-    return Normalize(Vec3f(float(std::cos(e) * std::sin(a)), float(std::cos(e) * std::cos(a)), float(std::sin(e))));
+    return Normalize(Vec3f(float(std::cos(e) * std::sin(a)), float(std::cos(e) * std::cos(a)),
+                           float(std::sin(e))));
 }
 
 TEST(PreethamSkyTest, ZenithAndDistribution) {
@@ -22,15 +23,18 @@ TEST(PreethamSkyTest, ZenithAndDistribution) {
     Vec3d z = sky.xyY(Vec3f(0, 0, 1));
     EXPECT_NEAR(z.z, sky.zenith_luminance(), 1e-9 * sky.zenith_luminance());
     EXPECT_NEAR(z.x, sky.zenith_x(), 1e-12);
-    // Zenith luminance with the sun 45° high and turbidity 2.5 from Appendix A.2: 5.9 kcd/m², within the
-    // 3-10 kcd/m² measured under clear skies at that solar elevation (CIE 110-1994, Kittler et al. 1997).
+    // Zenith luminance with the sun 45° high and turbidity 2.5 from Appendix A.2: 5.9 kcd/m²,
+    // within the 3-10 kcd/m² measured under clear skies at that solar elevation (CIE 110-1994,
+    // Kittler et al. 1997).
     EXPECT_NEAR(sky.zenith_luminance(), 5917.0, 10.0);
     // Zenith chromaticity near the daylight locus, bluish (x < 0.31).
     EXPECT_GT(sky.zenith_x(), 0.22);
     EXPECT_LT(sky.zenith_x(), 0.31);
-    // Brighter around the sun than 90° away at the same elevation; symmetric about the sun's vertical.
+    // Brighter around the sun than 90° away at the same elevation; symmetric about the sun's
+    // vertical.
     EXPECT_GT(sky.xyY(FromAngles(45, 165)).z, sky.xyY(FromAngles(45, 90)).z);
-    EXPECT_NEAR(sky.xyY(FromAngles(30, 120)).z, sky.xyY(FromAngles(30, 240)).z, 1e-6 * sky.zenith_luminance());
+    EXPECT_NEAR(sky.xyY(FromAngles(30, 120)).z, sky.xyY(FromAngles(30, 240)).z,
+                1e-6 * sky.zenith_luminance());
     // Nothing from below the horizon.
     EXPECT_EQ(sky.xyY(Vec3f(0, 1, -0.1f)).z, 0.0);
     // A hazier sky is brighter at the zenith (more scattering).

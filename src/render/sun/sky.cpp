@@ -45,21 +45,35 @@ void DaylightWeights(double x, double y, double* m1, double* m2) {
 
 }  // namespace
 
-PreethamSky::PreethamSky(const Vec3f& sun_direction, float turbidity) : sun_(Normalize(sun_direction)) {
+PreethamSky::PreethamSky(const Vec3f& sun_direction, float turbidity)
+    : sun_(Normalize(sun_direction)) {
     double t = std::clamp(double(turbidity), 1.7, 10.0);
     theta_sun_ = std::acos(std::clamp(double(sun_.z), -1.0, 1.0));
     // Preetham et al. 1999, Appendix A.2: Perez coefficients as linear functions of turbidity.
     const double coef[3][5][2] = {
         // x
-        {{-0.0193, -0.2592}, {-0.0665, 0.0008}, {-0.0004, 0.2125}, {-0.0641, -0.8989}, {-0.0033, 0.0452}},
+        {{-0.0193, -0.2592},
+         {-0.0665, 0.0008},
+         {-0.0004, 0.2125},
+         {-0.0641, -0.8989},
+         {-0.0033, 0.0452}},
         // y
-        {{-0.0167, -0.2608}, {-0.0950, 0.0092}, {-0.0079, 0.2102}, {-0.0441, -1.6537}, {-0.0109, 0.0529}},
+        {{-0.0167, -0.2608},
+         {-0.0950, 0.0092},
+         {-0.0079, 0.2102},
+         {-0.0441, -1.6537},
+         {-0.0109, 0.0529}},
         // Y
-        {{0.1787, -1.4630}, {-0.3554, 0.4275}, {-0.0227, 5.3251}, {0.1206, -2.5771}, {-0.0670, 0.3703}},
+        {{0.1787, -1.4630},
+         {-0.3554, 0.4275},
+         {-0.0227, 5.3251},
+         {0.1206, -2.5771},
+         {-0.0670, 0.3703}},
     };
     for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 5; ++k) perez_[c][k] = coef[c][k][0] * t + coef[c][k][1];
-    // Zenith values (Appendix A.2). The sun is clamped at the horizon: the model is not defined below.
+    // Zenith values (Appendix A.2). The sun is clamped at the horizon: the model is not defined
+    // below.
     double ts = std::min(theta_sun_, kPiSky / 2);
     double chi = (4.0 / 9.0 - t / 120.0) * (kPiSky - 2.0 * ts);
     double yz_kcd = (4.0453 * t - 4.9710) * std::tan(chi) - 0.2155 * t + 2.4192;
@@ -87,7 +101,8 @@ double PreethamSky::Perez(int c, double theta, double gamma) const {
     const double* p = perez_[c];
     double cos_t = std::max(std::cos(theta), 1e-3);
     double cg = std::cos(gamma);
-    return (1.0 + p[0] * std::exp(p[1] / cos_t)) * (1.0 + p[2] * std::exp(p[3] * gamma) + p[4] * cg * cg);
+    return (1.0 + p[0] * std::exp(p[1] / cos_t)) *
+           (1.0 + p[2] * std::exp(p[3] * gamma) + p[4] * cg * cg);
 }
 
 Vec3d PreethamSky::xyY(const Vec3f& w_in) const {
@@ -125,7 +140,8 @@ SampledSpectrum PreethamSky::Radiance(const Vec3f& w, const SampledWavelengths& 
     SampledSpectrum s;
     for (int i = 0; i < kNumWavelengths; ++i) {
         float l = lambda.lambda_nm(i);
-        s[i] = std::max(0.f, (b.s0.Evaluate(l) + float(m1) * b.s1.Evaluate(l) + float(m2) * b.s2.Evaluate(l))) *
+        s[i] = std::max(0.f, (b.s0.Evaluate(l) + float(m1) * b.s1.Evaluate(l) +
+                              float(m2) * b.s2.Evaluate(l))) *
                scale;
     }
     return s;
