@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Builds data/stained_glass_approx.csv and data/building_approx.csv: APPROXIMATE spectra (no public measured
+"""Builds data/stained_glass_approx.csv and data/stone_approx.csv: APPROXIMATE spectra (no public measured
 data of these materials was available to nave). Run from data/: python3 tools/make_approx_spectra.py.
 Band positions (see data/SOURCES.md):
   Fe3+ UV charge-transfer edge (< 400 nm) and Fe2+ band at ~1050 nm in forest/clear glass (Bamford,
@@ -61,7 +61,7 @@ with open("stained_glass_approx.csv", "w") as f:
             tau = 10 ** (-m(l))
             vals.append((1 - R) ** 2 * tau / (1 - R * R * tau * tau))
         f.write(f"{l}," + ",".join(f"{v:.4f}" for v in vals) + "\n")
-with open("building_approx.csv", "w") as f:
+with open("stone_approx.csv", "w") as f:
     f.write("# APPROXIMATIONS, not measurements: diffuse spectral reflectance of building materials, built by\n")
     f.write("# tools/make_approx_spectra.py after the shape of published stone, terracotta and wood spectra (ECOSTRESS/ASTER library,\n")
     f.write("# Baldridge et al. 2009; USGS splib07, Kokaly et al. 2017). See SOURCES.md.\n")

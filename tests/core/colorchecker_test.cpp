@@ -11,15 +11,16 @@
 namespace nave {
 namespace {
 
-// BabelColor's average CIELAB of the ColorChecker (D50, 2°), computed by D. Pascale from the same 30-chart
-// average spectra nave embeds ("RGB coordinates of the Macbeth ColorChecker", BabelColor 2006; the
-// "ColorChecker 2005" / "before Nov 2014" reference values of Imatest, colour-science and OpenCV's
-// mcc module). And the 8-bit sRGB triples usually printed next to them (BabelColor table; Wikipedia
-// "ColorChecker"). Those sRGB triples are NOT the sRGB of the Lab beside them for the saturated patches
-// (blue: Lab (28.8, 14.2, -50.3) is sRGB (35, 63, 147) by IEC 61966-2-1 with Bradford D50->D65, the table
-// says (56, 61, 150)): they come from older chart data. So nave is tested against the Lab, and against
-// the sRGB that follows from the Lab by the standard transforms; the printed sRGB is checked on the
-// patches where it is consistent with its Lab (the neutrals and dark skin), within ±2.
+// BabelColor's average CIELAB of the ColorChecker (D50, 2°), computed by D. Pascale from the same
+// 30-chart average spectra nave embeds ("RGB coordinates of the Macbeth ColorChecker", BabelColor
+// 2006; the "ColorChecker 2005" / "before Nov 2014" reference values of Imatest, colour-science and
+// OpenCV's mcc module). And the 8-bit sRGB triples usually printed next to them (BabelColor table;
+// Wikipedia "ColorChecker"). Those sRGB triples are NOT the sRGB of the Lab beside them for the
+// saturated patches (blue: Lab (28.8, 14.2, -50.3) is sRGB (35, 63, 147) by IEC 61966-2-1 with
+// Bradford D50->D65, the table says (56, 61, 150)): they come from older chart data. So nave is
+// tested against the Lab, and against the sRGB that follows from the Lab by the standard
+// transforms; the printed sRGB is checked on the patches where it is consistent with its Lab (the
+// neutrals and dark skin), within ±2.
 struct Patch {
     const char* name;
     double l, a, b;
@@ -73,14 +74,16 @@ TEST(ColorCheckerTest, BabelColorSpectraGivePublishedColorimetry) {
         StatusOr<Spectrum> refl = cc.ToSpectrum(p.name);
         ASSERT_TRUE(refl.ok()) << refl.status().ToString();
         Vec3d xyz = ReflectanceToXYZ(*refl, d50);
-        // Our 1 nm linear interpolation of the 10 nm data vs BabelColor's weighting: ΔE*ab < 3 each,
-        // < 1 on average.
+        // Our 1 nm linear interpolation of the 10 nm data vs BabelColor's weighting: ΔE*ab < 3
+        // each, < 1 on average.
         double de = DeltaE76(XYZToLab(xyz, white), {p.l, p.a, p.b});
         EXPECT_LT(de, 3.0) << p.name;
         sum_de += de;
         std::array<uint8_t, 3> ours = LinearSrgbTo8Bit(to_srgb * xyz);
-        std::array<uint8_t, 3> from_lab = LinearSrgbTo8Bit(to_srgb * LabToXyz({p.l, p.a, p.b}, white));
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(ours[c], from_lab[c], 3) << p.name << " channel " << c;
+        std::array<uint8_t, 3> from_lab =
+            LinearSrgbTo8Bit(to_srgb * LabToXyz({p.l, p.a, p.b}, white));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(ours[c], from_lab[c], 3) << p.name << " channel " << c;
         std::string n = p.name;
         if (n == "dark_skin" || n.rfind("neutral", 0) == 0 || n == "black") {
             EXPECT_NEAR(ours[0], p.r, 2) << p.name;

@@ -22,8 +22,9 @@ Vec3f Dir(float theta_deg, float phi_deg) {
     return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
 }
 
-// Fresnel equations for η = 1.5 (Born & Wolf §1.5.3; Hecht, Optics, Fig. 4.49): R(0°) = ((η-1)/(η+1))² =
-// 0.04; R(45°) = 0.0502 (Rs = 0.0920, Rp = 0.0085); Rp = 0 at Brewster's angle atan(1.5) = 56.31°.
+// Fresnel equations for η = 1.5 (Born & Wolf §1.5.3; Hecht, Optics, Fig. 4.49): R(0°) =
+// ((η-1)/(η+1))² = 0.04; R(45°) = 0.0502 (Rs = 0.0920, Rp = 0.0085); Rp = 0 at Brewster's angle
+// atan(1.5) = 56.31°.
 TEST(FresnelTest, DielectricPublishedValues) {
     EXPECT_NEAR(FrDielectric(1.f, 1.5f), 0.04f, 1e-6f);
     EXPECT_NEAR(FrDielectric(std::cos(45.f * kPi / 180.f), 1.5f), 0.0502f, 1e-4f);
@@ -43,18 +44,20 @@ TEST(FresnelTest, DielectricPublishedValues) {
     EXPECT_NEAR(FrDielectric(ci, 1.5f), FrDielectric(-ct, 1.5f), 1e-6f);
 }
 
-// With κ = 0 the conductor equations reduce to the dielectric ones; at normal incidence the exact result
-// is ((n-1)² + κ²)/((n+1)² + κ²) (Born & Wolf eq. 14.2.(21)).
+// With κ = 0 the conductor equations reduce to the dielectric ones; at normal incidence the exact
+// result is ((n-1)² + κ²)/((n+1)² + κ²) (Born & Wolf eq. 14.2.(21)).
 TEST(FresnelTest, ConductorReducesToKnownForms) {
-    for (float c : {1.f, 0.8f, 0.5f, 0.2f, 0.05f}) EXPECT_NEAR(FrComplex(c, 1.5f, 0.f), FrDielectric(c, 1.5f), 1e-6f);
+    for (float c : {1.f, 0.8f, 0.5f, 0.2f, 0.05f})
+        EXPECT_NEAR(FrComplex(c, 1.5f, 0.f), FrDielectric(c, 1.5f), 1e-6f);
     for (auto [n, k] : {std::pair{0.2f, 3.f}, {1.38f, 1.914f}, {2.4f, 7.3f}})
-        EXPECT_NEAR(FrComplex(1.f, n, k), ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k), 1e-6f);
+        EXPECT_NEAR(FrComplex(1.f, n, k), ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k),
+                    1e-6f);
     EXPECT_NEAR(FrComplex(0.f, 0.2f, 3.f), 1.f, 1e-6f);
 }
 
 // Gold from Johnson & Christy (1972) n, κ: R(451 nm) = 0.408, R(551 nm) = 0.795 at normal incidence
-// (computed from the tabulated n, κ; the "about 0.39 / 0.85" are from other data sets and the
-// first agrees within 0.02). The steep rise between them is gold's colour.
+// (computed from the tabulated n, κ; the "about 0.39 / 0.85" are from other data sets and
+// the first agrees within 0.02). The steep rise between them is gold's colour.
 TEST(FresnelTest, GoldFromJohnsonChristy) {
     StatusOr<ComplexIndex> au = NamedMetal("Au");
     ASSERT_TRUE(au.ok()) << au.status().ToString();
@@ -82,7 +85,8 @@ TEST(IorTest, Bk7Sellmeier) {
 }
 
 TEST(FrameTest, Orthonormal) {
-    for (Vec3f n : {Vec3f(0, 0, 1), Vec3f(0, 0, -1), Normalize(Vec3f(1, 2, 3)), Normalize(Vec3f(-1, 0.001f, -2))}) {
+    for (Vec3f n : {Vec3f(0, 0, 1), Vec3f(0, 0, -1), Normalize(Vec3f(1, 2, 3)),
+                    Normalize(Vec3f(-1, 0.001f, -2))}) {
         Frame f = Frame::FromZ(n);
         EXPECT_NEAR(Dot(f.x, f.y), 0.f, 1e-6f);
         EXPECT_NEAR(Dot(f.x, f.z), 0.f, 1e-6f);
@@ -104,8 +108,8 @@ void ExpectChi2(const Bxdf& bxdf, const Vec3f& wo, uint64_t seed, const std::str
         return s->wi;
     };
     auto pdf = [&](const Vec3f& wi) { return bxdf.Pdf(wo, wi, kLambda); };
-    // Significance 0.01 shared by the ~20 χ² tests of this file (Šidák correction, as pbrt-v4 does):
-    // 1 - 0.99^(1/20) ≈ 5e-4.
+    // Significance 0.01 shared by the ~20 χ² tests of this file (Šidák correction, as pbrt-v4
+    // does): 1 - 0.99^(1/20) ≈ 5e-4.
     testing::Chi2Result r = Chi2Test(sample, pdf, seed, 100000, 10, 5e-4);
     EXPECT_TRUE(r.passed) << what << ": " << r.message;
 }
@@ -133,14 +137,30 @@ TEST(BxdfChi2Test, RoughConductorAlpha02) { ExpectConductorChi2(0.2f, 0.2f, 20);
 TEST(BxdfChi2Test, RoughConductorAnisotropic) { ExpectConductorChi2(0.1f, 0.4f, 30); }
 TEST(BxdfChi2Test, RoughConductorAlpha005) { ExpectConductorChi2(0.05f, 0.05f, 40); }
 
+void ExpectDielectricChi2(float eta, float alpha, uint64_t seed) {
+    for (float theta : {10.f, 60.f, 170.f, 120.f}) {  // from outside and from inside
+        Bxdf b = DielectricBxdf(eta, TrowbridgeReitz(alpha, alpha));
+        ExpectChi2(b, Dir(theta, 40.f), seed++,
+                   "rough dielectric eta=" + std::to_string(eta) +
+                       " alpha=" + std::to_string(alpha) + " theta=" + std::to_string(theta));
+    }
+}
+
+TEST(BxdfChi2Test, RoughDielectric) {
+    ExpectDielectricChi2(1.5f, 0.3f, 50);
+    ExpectDielectricChi2(1.33f, 0.15f, 60);
+}
+
 // A sampled direction's f and pdf equal Eval and Pdf for the same pair (non-specular lobes).
 TEST(BxdfTest, SampleAgreesWithEvalAndPdf) {
-    Bxdf bxdfs[] = {DiffuseBxdf(SampledSpectrum(0.5f)),
-                    ConductorBxdf(TrowbridgeReitz(0.3f, 0.1f), SampledSpectrum(0.3f), SampledSpectrum(2.f))};
+    Bxdf bxdfs[] = {
+        DiffuseBxdf(SampledSpectrum(0.5f)),
+        ConductorBxdf(TrowbridgeReitz(0.3f, 0.1f), SampledSpectrum(0.3f), SampledSpectrum(2.f)),
+        DielectricBxdf(1.5f, TrowbridgeReitz(0.25f, 0.25f))};
     Pcg32 rng(7);
     for (const Bxdf& b : bxdfs)
         for (int i = 0; i < 2000; ++i) {
-            Vec3f wo = Dir(89.f * rng.NextFloat(), 360.f * rng.NextFloat());
+            Vec3f wo = Dir(179.f * rng.NextFloat() + 0.5f, 360.f * rng.NextFloat());
             std::optional<BsdfSample> s =
                 b.Sample(wo, rng.NextFloat(), Point2f(rng.NextFloat(), rng.NextFloat()), kLambda);
             if (!s) continue;
@@ -151,9 +171,9 @@ TEST(BxdfTest, SampleAgreesWithEvalAndPdf) {
         }
 }
 
-// White furnace: the directional albedo ∫ f cosθi dωi of an albedo-1 Lambertian is exactly 1; a perfect
-// (R = 1) rough mirror reflects at most 1 (single-scattering microfacets lose energy to masking,
-// more at high roughness and grazing angles: Heitz 2016, Kulla & Conty 2017).
+// White furnace: the directional albedo ∫ f cosθi dωi of an albedo-1 Lambertian is exactly 1; a
+// perfect (R = 1) rough mirror reflects at most 1 (single-scattering microfacets lose energy to
+// masking, more at high roughness and grazing angles: Heitz 2016, Kulla & Conty 2017).
 TEST(BxdfTest, WhiteFurnace) {
     Pcg32 rng(11);
     auto albedo = [&](const Bxdf& b, const Vec3f& wo) {
@@ -171,7 +191,8 @@ TEST(BxdfTest, WhiteFurnace) {
     // A perfect reflector: κ huge, so F = 1 at all angles.
     for (float a : {0.05f, 0.3f, 0.8f})
         for (float t : {0.f, 45.f, 80.f}) {
-            Bxdf mirror = ConductorBxdf(TrowbridgeReitz(a, a), SampledSpectrum(0.f), SampledSpectrum(1e4f));
+            Bxdf mirror =
+                ConductorBxdf(TrowbridgeReitz(a, a), SampledSpectrum(0.f), SampledSpectrum(1e4f));
             double rho = albedo(mirror, Dir(t, 0));
             EXPECT_LE(rho, 1.0 + 0.01) << "alpha " << a << " theta " << t;
             // Little roughness loses little energy away from grazing angles.
@@ -180,14 +201,17 @@ TEST(BxdfTest, WhiteFurnace) {
             }
         }
     // Smooth mirror: exactly F.
-    Bxdf smooth = ConductorBxdf(TrowbridgeReitz(0, 0), SampledSpectrum(1.38f), SampledSpectrum(1.914f));
+    Bxdf smooth =
+        ConductorBxdf(TrowbridgeReitz(0, 0), SampledSpectrum(1.38f), SampledSpectrum(1.914f));
     std::optional<BsdfSample> s = smooth.Sample(Dir(30, 0), 0.5f, Point2f(0.5f, 0.5f), kLambda);
     ASSERT_TRUE(s && s->IsSpecular());
-    EXPECT_NEAR(s->f[0] * AbsCosTheta(s->wi) / s->pdf, FrComplex(std::cos(30.f * kPi / 180), 1.38f, 1.914f), 1e-5f);
+    EXPECT_NEAR(s->f[0] * AbsCosTheta(s->wi) / s->pdf,
+                FrComplex(std::cos(30.f * kPi / 180), 1.38f, 1.914f), 1e-5f);
 }
 
 // A smooth dielectric conserves energy exactly: R + T = 1. The estimator f|cosθ|/pdf is 1 for every
-// sample (importance transport); the frequency of reflection is the Fresnel R; refraction obeys Snell.
+// sample (importance transport); the frequency of reflection is the Fresnel R; refraction obeys
+// Snell.
 TEST(BxdfTest, SmoothDielectricConservesEnergy) {
     for (float eta : {1.33f, 1.5f, 2.4f})
         for (float theta : {0.f, 30.f, 60.f, 85.f, 150.f, 120.f}) {
@@ -198,8 +222,8 @@ TEST(BxdfTest, SmoothDielectricConservesEnergy) {
             int reflected = 0;
             Pcg32 rng(3);
             for (int i = 0; i < n; ++i) {
-                std::optional<BsdfSample> s =
-                    b.Sample(wo, rng.NextFloat(), Point2f(0.5f, 0.5f), kLambda, TransportMode::kImportance);
+                std::optional<BsdfSample> s = b.Sample(wo, rng.NextFloat(), Point2f(0.5f, 0.5f),
+                                                       kLambda, TransportMode::kImportance);
                 ASSERT_TRUE(s.has_value());
                 EXPECT_NEAR(s->f[0] * AbsCosTheta(s->wi) / s->pdf, 1.f, 1e-4f);
                 if (s->IsReflection()) {
@@ -214,12 +238,37 @@ TEST(BxdfTest, SmoothDielectricConservesEnergy) {
                     // Radiance transport carries the 1/η² factor instead.
                     std::optional<BsdfSample> sr = b.Sample(wo, 0.9999f, Point2f(), kLambda);
                     if (sr && sr->IsTransmission()) {
-                        EXPECT_NEAR(sr->f[0] * AbsCosTheta(sr->wi) / sr->pdf, 1.f / (sr->eta * sr->eta), 1e-4f);
+                        EXPECT_NEAR(sr->f[0] * AbsCosTheta(sr->wi) / sr->pdf,
+                                    1.f / (sr->eta * sr->eta), 1e-4f);
                     }
                 }
             }
             EXPECT_NEAR(double(reflected) / n, r, 4.0 * std::sqrt(r * (1 - r) / n) + 1e-3)
                 << "eta " << eta << " theta " << theta;
+        }
+}
+
+// A rough dielectric loses energy only to single-scattering masking: the average weight is at most
+// 1 and close to 1 for a slightly rough surface away from grazing angles (Walter et al. 2007 §5.3).
+TEST(BxdfTest, RoughDielectricWhiteFurnace) {
+    Pcg32 rng(13);
+    for (float alpha : {0.05f, 0.3f, 0.7f})
+        for (float theta : {0.f, 45.f, 80.f, 135.f}) {
+            DielectricBxdf b(1.5f, TrowbridgeReitz(alpha, alpha));
+            Vec3f wo = Dir(theta, 0.f);
+            const int n = 20000;
+            double sum = 0;
+            for (int i = 0; i < n; ++i) {
+                std::optional<BsdfSample> s =
+                    b.Sample(wo, rng.NextFloat(), Point2f(rng.NextFloat(), rng.NextFloat()),
+                             kLambda, TransportMode::kImportance);
+                if (s && s->pdf > 0) sum += s->f[0] * AbsCosTheta(s->wi) / s->pdf;
+            }
+            double rho = sum / n;
+            EXPECT_LE(rho, 1.0 + 0.01) << "alpha " << alpha << " theta " << theta;
+            if (alpha <= 0.05f && (theta <= 45.f || theta >= 135.f)) {
+                EXPECT_GT(rho, 0.97) << "alpha " << alpha << " theta " << theta;
+            }
         }
 }
 
@@ -242,7 +291,8 @@ TEST(BxdfTest, ThinDielectricSumsInterreflections) {
     EXPECT_NEAR(t[3], 0.f, 1e-7f);
     EXPECT_NEAR(r[3], 0.04f, 1e-6f);
     EXPECT_NEAR(t[0], 0.96f * 0.96f * 0.5f / (1 - 0.04f * 0.04f * 0.25f), 1e-6f);
-    // Sampling: weight = R_tot or T_tot per wavelength over the lobe probability; averages to R + T.
+    // Sampling: weight = R_tot or T_tot per wavelength over the lobe probability; averages to R +
+    // T.
     Pcg32 rng(5);
     Vec3f wo = Dir(40, 10);
     SampledSpectrum rr, tt;

@@ -1,6 +1,7 @@
 #pragma once
-// Statistical test of a direction sampler against its pdf (Pearson's χ², as in pbrt-v4's bsdfs_test.cpp):
-// histogram of sampled directions over a (θ, φ) grid vs. the pdf integrated over each cell. Test helper.
+// Statistical test of a direction sampler against its pdf (Pearson's χ², as in pbrt-v4's
+// bsdfs_test.cpp): histogram of sampled directions over a (θ, φ) grid vs. the pdf integrated over
+// each cell. Test helper.
 
 #include <algorithm>
 #include <cmath>
@@ -14,10 +15,13 @@
 
 namespace nave::testing {
 
-/// Deterministic PCG32 (O'Neill 2014) so that the tests do not depend on the standard library's engines.
+/// Deterministic PCG32 (O'Neill 2014) so that the tests do not depend on the standard library's
+/// engines.
 class Pcg32 {
   public:
-    explicit Pcg32(uint64_t seed) { state_ = seed * 6364136223846793005ULL + 1442695040888963407ULL; }
+    explicit Pcg32(uint64_t seed) {
+        state_ = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    }
     uint32_t NextU32() {
         uint64_t old = state_;
         state_ = old * 6364136223846793005ULL + 1442695040888963407ULL;
@@ -73,7 +77,8 @@ struct Chi2Result {
 /// `sample(u1, u2, u3)` returns a unit direction or nothing; `pdf(w)` its solid-angle density.
 inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float, float)>& sample,
                            const std::function<float(const Vec3f&)>& pdf, uint64_t seed,
-                           int num_samples = 200000, int theta_res = 10, double significance = 0.01) {
+                           int num_samples = 200000, int theta_res = 10,
+                           double significance = 0.01) {
     const int phi_res = 2 * theta_res;
     std::vector<double> observed(size_t(theta_res * phi_res), 0.0), expected(observed.size(), 0.0);
     Pcg32 rng(seed);
@@ -88,7 +93,8 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
         int pi = std::clamp(int(phi / (2 * M_PI) * phi_res), 0, phi_res - 1);
         observed[size_t(ti * phi_res + pi)] += 1;
     }
-    // Integrate the pdf over each cell (midpoint rule on a fine sub-grid), in solid angle sinθ dθ dφ.
+    // Integrate the pdf over each cell (midpoint rule on a fine sub-grid), in solid angle sinθ dθ
+    // dφ.
     const int sub = 16;
     const double dt = M_PI / theta_res, dp = 2 * M_PI / phi_res;
     for (int ti = 0; ti < theta_res; ++ti)
@@ -97,8 +103,8 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
             for (int a = 0; a < sub; ++a)
                 for (int b = 0; b < sub; ++b) {
                     double theta = (ti + (a + 0.5) / sub) * dt, phi = (pi + (b + 0.5) / sub) * dp;
-                    Vec3f w(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                            float(std::cos(theta)));
+                    Vec3f w(float(std::sin(theta) * std::cos(phi)),
+                            float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
                     sum += pdf(w) * std::sin(theta);
                 }
             expected[size_t(ti * phi_res + pi)] = sum * (dt / sub) * (dp / sub) * num_samples;
@@ -106,13 +112,15 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
     // Pool cells with small expected counts (Pearson's test needs >= 5 per cell).
     std::vector<size_t> order(observed.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return expected[a] < expected[b]; });
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return expected[a] < expected[b]; });
     double pooled_obs = 0, pooled_exp = 0, chi2 = 0;
     int dof = 0;
     Chi2Result result;
     for (size_t idx : order) {
         if (expected[idx] == 0 && observed[idx] > 0) {
-            result.message = "samples in a cell where the pdf is zero (cell " + std::to_string(idx) + ")";
+            result.message =
+                "samples in a cell where the pdf is zero (cell " + std::to_string(idx) + ")";
             return result;
         }
         if (expected[idx] < 5) {

@@ -41,9 +41,8 @@ const Spectrum& SodaLimeAbsorptionPerMetre() {
     static const Spectrum s = [] {
         Spectrum k = EmbeddedSpectraTable("glass_soda_lime_rubin1985.csv").ToSpectrum(0);
         // Beer-Lambert absorption coefficient of a medium of extinction coefficient κ: α = 4πκ/λ.
-        return Spectrum::FromFunction([&](double l_nm) {
-            return 4.0 * M_PI * k.Evaluate(float(l_nm)) / (l_nm * 1e-9);
-        });
+        return Spectrum::FromFunction(
+            [&](double l_nm) { return 4.0 * M_PI * k.Evaluate(float(l_nm)) / (l_nm * 1e-9); });
     }();
     return s;
 }
@@ -57,7 +56,9 @@ StatusOr<ComplexIndex> NamedMetal(std::string_view name) {
     if (n == "cu" || n == "copper") file = "metal_cu_johnson_christy_1972.csv";
     if (n == "al" || n == "aluminium" || n == "aluminum") file = "metal_al_mcpeak_2015.csv";
     if (n == "pb" || n == "lead") file = "metal_pb_werner_2009.csv";
-    if (!file) return NotFoundError("no optical constants for metal '{}' (known: Au, Ag, Cu, Al, Pb)", name);
+    if (!file)
+        return NotFoundError("no optical constants for metal '{}' (known: Au, Ag, Cu, Al, Pb)",
+                             name);
     const SpectraTable& t = EmbeddedSpectraTable(file);
     return ComplexIndex{t.ToSpectrum(0), t.ToSpectrum(1)};
 }

@@ -38,10 +38,24 @@ ThinGlassMaterial ThinGlassMaterial::FromTotalTransmittance(const Spectrum& eta,
 
 namespace {
 
-const char* const kNames[] = {"limestone", "limestone_dark", "floor_tile_light", "floor_tile_dark",
-                              "glass_clear", "glass_blue", "glass_red", "glass_yellow", "glass_green",
-                              "lead", "wood", "roof_slate", "gold", "silver", "copper", "aluminium",
-                              "bk7", "window_glass"};
+const char* const kNames[] = {"limestone",
+                              "limestone_dark",
+                              "floor_tile_light",
+                              "floor_tile_dark",
+                              "glass_clear",
+                              "glass_blue",
+                              "glass_red",
+                              "glass_yellow",
+                              "glass_green",
+                              "lead",
+                              "wood",
+                              "roof_slate",
+                              "gold",
+                              "silver",
+                              "copper",
+                              "aluminium",
+                              "bk7",
+                              "window_glass"};
 
 ConductorMaterial Metal(std::string_view symbol, float alpha) {
     StatusOr<ComplexIndex> ci = NamedMetal(symbol);
@@ -58,7 +72,7 @@ ConductorMaterial Metal(std::string_view symbol, float alpha) {
 std::vector<std::string> BuiltinMaterialNames() { return {std::begin(kNames), std::end(kNames)}; }
 
 StatusOr<Material> BuiltinMaterial(std::string_view name) {
-    const SpectraTable& building = EmbeddedSpectraTable("building_approx.csv");
+    const SpectraTable& building = EmbeddedSpectraTable("stone_approx.csv");
     for (std::string_view n : {"limestone", "limestone_dark", "floor_tile_light", "floor_tile_dark",
                                "wood", "roof_slate"}) {
         if (name == n) {
