@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
 
     nave::cli::CommandRun run;
     nave::cli::RegisterVersionCommand(app, run);
+    nave::cli::RegisterInspectCommand(app, run);
+    nave::cli::RegisterVerifyCommand(app, run);
     nave::cli::RegisterPreprocessCommand(app, run);
     nave::cli::RegisterGenerateCommand(app, run);
 
