@@ -1,5 +1,7 @@
 #include "preprocess/abbey/emitter.h"
 
+#include <cmath>
+
 namespace nave::preprocess::abbey {
 
 void Emitter::Push(Triangle& t) {
@@ -42,10 +44,11 @@ void Emitter::TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& 
     Vec3f nf = Cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
     if (Dot(nf, nf) == 0.f) return;
     // Shading normals face the same side as the geometric normal.
+    Vec3d face = Normalize(Vec3d(nf));
     auto orient = [&](const Vec3d& v) {
-        Vec3d u = Dot(v, outward) < 0 ? -v : v;
+        Vec3d u = Dot(v, face) < 0 ? -v : v;
         double len = Length(u);
-        return len > 0 ? Vec3f(u / len) : Vec3f(Normalize(outward));
+        return len > 0 && std::isfinite(len) ? Vec3f(u / len) : Vec3f(face);
     };
     t.n[0] = orient(na);
     t.n[1] = orient(flip ? nc : nb);
