@@ -59,6 +59,7 @@ struct LocalLeaf {
     std::vector<Vec3f> points;
     double estimate = 0;
     int node = 0;
+    int depth = 0;  // below the bin's node
     bool splittable = true;
 };
 
@@ -160,7 +161,7 @@ Status Partitioner::Split(const Bounds3f& root, double margin, ProgressBar& prog
 Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     NAVE_RETURN_IF_ERROR(CheckCancelled());
     const uint64_t leaf_max = config_.brick_triangles + config_.brick_triangles / 4;
-    if (task.triangles <= leaf_max || task.depth >= int(store::BrickTree::kMaxDepth) - 8) {
+    if (task.triangles <= leaf_max || task.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
         std::lock_guard<std::mutex> lock(mutex_);
         leaves_.push_back({task.file, task.cell, task.triangles, task.node, task.triangles > leaf_max});
         return Status::Ok();
@@ -187,7 +188,8 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         LocalLeaf& leaf = lleaves[best];
         int axis = leaf.cell.MaxAxis();
         float lo = leaf.cell.min[axis], hi = leaf.cell.max[axis];
-        if (double(hi) - double(lo) < 8 * margin_) {
+        if (double(hi) - double(lo) < 8 * margin_ ||
+            task.depth + leaf.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
             leaf.splittable = false;
             continue;
         }
@@ -204,6 +206,7 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         if (!(split > lo + guard && split < hi - guard)) split = 0.5f * (lo + hi);
         LocalLeaf below, above;
         below.cell = above.cell = leaf.cell;
+        below.depth = above.depth = leaf.depth + 1;
         below.cell.max[axis] = split;
         above.cell.min[axis] = split;
         for (const Vec3f& p : pts) (p[axis] < split ? below.points : above.points).push_back(p);
@@ -329,7 +332,7 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         child.cell = lleaves[i].cell;
         child.triangles = count;
         child.node = global[lleaves[i].node];
-        child.depth = task.depth + 1;
+        child.depth = task.depth + lleaves[i].depth;
         child.sample = std::move(samples[i].points());
         // No progress (most triangles span the whole cell): stop splitting this one.
         if (count > task.triangles * 98 / 100) {
