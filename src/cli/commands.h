@@ -19,5 +19,7 @@ void RegisterInspectCommand(CLI::App& app, CommandRun& run);
 void RegisterVerifyCommand(CLI::App& app, CommandRun& run);
 void RegisterSunCommand(CLI::App& app, CommandRun& run);
 void RegisterSpectrumCommand(CLI::App& app, CommandRun& run);
+void RegisterPreprocessCommand(CLI::App& app, CommandRun& run);
+void RegisterGenerateCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

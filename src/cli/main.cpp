@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
     nave::cli::RegisterVerifyCommand(app, run);
     nave::cli::RegisterSunCommand(app, run);
     nave::cli::RegisterSpectrumCommand(app, run);
+    nave::cli::RegisterPreprocessCommand(app, run);
+    nave::cli::RegisterGenerateCommand(app, run);
 
     try {
         app.parse(argc, argv);
