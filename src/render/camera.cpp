@@ -1,5 +1,7 @@
 #include "render/camera.h"
 
+#include "core/sampling.h"
+
 namespace nave::render {
 
 Camera::Camera(const CameraConfig& c)
@@ -26,9 +28,8 @@ void Camera::GenerateRay(float x, float y, float u_lens0, float u_lens1, Vec3f* 
     }
     // Thin lens: every ray through the lens point meets the pinhole ray on the plane of focus.
     Vec3f focus = position_ + d * (focus_distance_ / Dot(d, forward_));
-    float lx, ly;
-    ConcentricSampleDisk(u_lens0, u_lens1, &lx, &ly);
-    *origin = position_ + right_ * (lx * lens_radius_) + up_ * (ly * lens_radius_);
+    Point2f l = SampleUniformDiskConcentric(Point2f(u_lens0, u_lens1));
+    *origin = position_ + right_ * (l.x * lens_radius_) + up_ * (l.y * lens_radius_);
     *dir = Normalize(focus - *origin);
 }
 

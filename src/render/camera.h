@@ -28,25 +28,4 @@ class Camera {
     float lens_radius_, focus_distance_;
 };
 
-/// Maps [0,1)^2 to the unit disc preserving area (Shirley & Chiu, "A low distortion map between disk and
-/// square", JGT 1997, concentric mapping).
-inline void ConcentricSampleDisk(float u0, float u1, float* x, float* y) {
-    float a = 2 * u0 - 1, b = 2 * u1 - 1;
-    if (a == 0 && b == 0) {
-        *x = *y = 0;
-        return;
-    }
-    constexpr float kPiOver4 = 0.78539816339f, kPiOver2 = 1.57079632679f;
-    float r, theta;
-    if (std::abs(a) > std::abs(b)) {
-        r = a;
-        theta = kPiOver4 * (b / a);
-    } else {
-        r = b;
-        theta = kPiOver2 - kPiOver4 * (a / b);
-    }
-    *x = r * std::cos(theta);
-    *y = r * std::sin(theta);
-}
-
 }  // namespace nave::render

@@ -1,0 +1,67 @@
+#pragma once
+// Sampling of directions and discs for Monte Carlo rendering. Header-only; every warp lists its pdf.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/vecmath.h"
+
+namespace nave {
+
+/// A pair of uniform random numbers in [0, 1)² (or a 2D point in general).
+struct Point2f {
+    float x = 0, y = 0;
+    constexpr Point2f() = default;
+    constexpr Point2f(float x_, float y_) : x(x_), y(y_) {}
+    constexpr float operator[](int i) const { return i == 0 ? x : y; }
+    constexpr bool operator==(const Point2f&) const = default;
+};
+
+inline constexpr float kPi = std::numbers::pi_v<float>;
+inline constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+
+/// Concentric map of the square to the unit disc (Shirley & Chiu 1997, "A low distortion map between
+/// disk and square"), area-preserving.
+inline Point2f SampleUniformDiskConcentric(Point2f u) {
+    float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;
+    if (ox == 0.f && oy == 0.f) return {0.f, 0.f};
+    float r, theta;
+    if (std::abs(ox) > std::abs(oy)) {
+        r = ox;
+        theta = (kPi / 4.f) * (oy / ox);
+    } else {
+        r = oy;
+        theta = kPi / 2.f - (kPi / 4.f) * (ox / oy);
+    }
+    return {r * std::cos(theta), r * std::sin(theta)};
+}
+
+/// Cosine-weighted direction on the hemisphere z > 0 (Malley's method); pdf cosθ/π.
+inline Vec3f SampleCosineHemisphere(Point2f u) {
+    Point2f d = SampleUniformDiskConcentric(u);
+    float z = std::sqrt(std::max(0.f, 1.f - d.x * d.x - d.y * d.y));
+    return {d.x, d.y, z};
+}
+inline float CosineHemispherePdf(float cos_theta) { return cos_theta * kInvPi; }
+
+/// Uniform direction on the unit sphere; pdf 1/(4π).
+inline Vec3f SampleUniformSphere(Point2f u) {
+    float z = 1.f - 2.f * u.x;
+    float r = std::sqrt(std::max(0.f, 1.f - z * z));
+    float phi = 2.f * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline constexpr float UniformSpherePdf() { return 1.f / (4.f * kPi); }
+
+/// Uniform direction in the cone of half-angle acos(cos_theta_max) around +z; pdf 1/(2π(1 - cosθmax)).
+/// Used for the sun's disc.
+inline Vec3f SampleUniformCone(Point2f u, float cos_theta_max) {
+    float cos_theta = (1.f - u.x) + u.x * cos_theta_max;
+    float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
+    float phi = u.y * 2.f * kPi;
+    return {std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta};
+}
+inline float UniformConePdf(float cos_theta_max) { return 1.f / (2.f * kPi * (1.f - cos_theta_max)); }
+
+}  // namespace nave
