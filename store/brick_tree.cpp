@@ -1,6 +1,7 @@
 #include "store/brick_tree.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace nave::store {
@@ -12,12 +13,20 @@ Status BrickTree::Validate(uint32_t brick_count) const {
     if (nodes_.empty()) return DataLossError("brick tree has no nodes");
     std::vector<uint8_t> seen_brick(brick_count, 0);
     std::vector<uint8_t> seen_node(nodes_.size(), 0);
-    std::vector<uint32_t> stack{0};
+    struct Item {
+        uint32_t node;
+        uint32_t depth;
+    };
+    std::vector<Item> stack{{0, 0}};
     while (!stack.empty()) {
-        uint32_t n = stack.back();
+        const auto [n, depth] = stack.back();
         stack.pop_back();
         if (seen_node[n]) return DataLossError("brick tree node {} is reached twice (a cycle or shared child)", n);
         seen_node[n] = 1;
+        // Traverse keeps at most one pending node per level on a fixed stack.
+        if (depth >= kMaxDepth) {
+            return DataLossError("brick tree node {} is at depth {}, deeper than the limit {}", n, depth, kMaxDepth);
+        }
         const BrickTreeNode& node = nodes_[n];
         if (node.IsLeaf()) {
             if (node.brick == kNoBrick) continue;
@@ -30,11 +39,14 @@ Status BrickTree::Validate(uint32_t brick_count) const {
             continue;
         }
         if (node.axis > 3) return DataLossError("brick tree node {} has axis {} (expected 0..3)", n, node.axis);
+        if (!std::isfinite(node.split)) {
+            return DataLossError("brick tree node {} has a split plane at {}", n, node.split);
+        }
         for (uint32_t c : node.child) {
             if (c == 0 || c >= nodes_.size()) {
                 return DataLossError("brick tree node {} has child {} out of range [1, {})", n, c, nodes_.size());
             }
-            stack.push_back(c);
+            stack.push_back({c, depth + 1});
         }
     }
     return Status::Ok();
@@ -92,7 +104,7 @@ void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, flo
         uint32_t node;
         float t0, t1;
     };
-    Item stack[64];
+    Item stack[kMaxDepth];
     int top = 0;
     stack[top++] = {0, t0, t1};
     while (top > 0) {
@@ -115,7 +127,7 @@ void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, flo
             } else if (t_split < a) {
                 n = second;
             } else {
-                NAVE_CHECK_LT(top, 64) << "brick tree deeper than 64 levels";
+                NAVE_CHECK_LT(top, int(kMaxDepth)) << "brick tree deeper than Validate allows";
                 stack[top++] = {second, t_split, b};
                 n = first;
                 b = t_split;

@@ -31,7 +31,11 @@ class BrickTree {
     /// `nodes[0]` is the root; `bounds` is the box the root covers.
     BrickTree(Bounds3f bounds, std::vector<BrickTreeNode> nodes);
 
-    /// Checks the structure: child indices in range, no cycles, each brick id in [0, brick_count) at most once.
+    /// Deepest tree Validate accepts (Traverse walks with a fixed stack of this many entries).
+    static constexpr uint32_t kMaxDepth = 64;
+
+    /// Checks the structure: child indices in range, no cycles, finite splits, depth < kMaxDepth, each brick
+    /// id in [0, brick_count) at most once. Errors are DataLoss naming the node.
     Status Validate(uint32_t brick_count) const;
 
     const Bounds3f& bounds() const { return bounds_; }

@@ -36,7 +36,9 @@ struct BrickInfo {
     uint64_t triangle_count = 0;
     uint64_t vertex_count = 0;
     uint64_t decoded_bytes = 0;    ///< BrickMesh::MemoryBytes() once decoded (for memory budgets)
-    SectionInfo mesh;              ///< Draco-encoded mesh
+    bool has_normals = false;      ///< the decoded mesh has shading normals
+    bool has_uvs = false;          ///< the decoded mesh has texture coordinates
+    SectionInfo mesh;              ///< position base + Draco-encoded mesh (docs/store-format.md)
     SectionInfo side;              ///< LZ4-compressed side section (see docs/store-format.md); length 0 if none
     uint64_t BytesOnDisk() const { return mesh.length + side.length; }
 };

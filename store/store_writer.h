@@ -26,20 +26,26 @@ struct EncodeOptions {
 
 /// A brick ready to be appended: encoded bytes and the directory fields known before writing.
 struct EncodedBrick {
-    std::string mesh_bytes;       ///< Draco bitstream
-    std::string side_bytes;       ///< LZ4 side section (may be empty)
+    std::string mesh_bytes;       ///< mesh section: 16-byte position base, then the Draco bitstream
+    std::string side_bytes;       ///< LZ4 side section (empty in format 1.0; see docs/store-format.md)
     Bounds3f cell;
-    Bounds3f geometry_bounds;
-    uint64_t triangle_count = 0;
-    uint64_t vertex_count = 0;
+    Bounds3f geometry_bounds;     ///< box of the grid-snapped positions, exactly as they decode
+    uint64_t triangle_count = 0;  ///< stored triangles (input minus dropped_triangle_count)
+    uint64_t vertex_count = 0;    ///< vertices once decoded (Draco splits vertices at material borders)
     uint64_t decoded_bytes = 0;
+    bool has_normals = false;
+    bool has_uvs = false;
+    uint32_t max_material_id = 0;          ///< largest material id used (Finish checks it against the table)
+    uint64_t dropped_triangle_count = 0;   ///< input triangles whose corners collapsed onto <= 2 grid points
 };
 
 /// Checks BrickMesh invariants; errors say which index or count is wrong.
 Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count);
 
-/// Snaps positions to `grid` and encodes. Thread-safe. Fails (InvalidArgument) on a mesh that breaks the
-/// invariants or a position outside the grid's int32 range.
+/// Snaps positions to `grid` and encodes, then decodes the result once to check it. Thread-safe. Triangles
+/// that collapse on the grid (two corners on one grid point: zero area) are dropped and counted. Fails
+/// (InvalidArgument) on a mesh that breaks the invariants, a position outside the grid's int32 range or a
+/// brick spanning more than 2^29 grid steps.
 StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell, const GlobalGrid& grid,
                                    const EncodeOptions& options);
 

@@ -1,0 +1,446 @@
+#include "store/store_format.h"
+
+#include <fmt/ostream.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/hash.h"
+
+namespace nave::store::format {
+namespace {
+
+// Upper bounds that keep a corrupt count from turning into a huge allocation before a checksum or size
+// check can catch it.
+constexpr uint32_t kMaxStringBytes = 1u << 24;
+constexpr uint32_t kMaxHeaderBytes = 1u << 16;
+
+void PutTableRef(ByteWriter& w, const TableRef& t) {
+    w.Put(t.offset);
+    w.Put(t.length);
+    w.Put(t.checksum);
+}
+
+Status GetTableRef(ByteReader& r, TableRef* t) {
+    NAVE_RETURN_IF_ERROR(r.Get(&t->offset));
+    NAVE_RETURN_IF_ERROR(r.Get(&t->length));
+    return r.Get(&t->checksum);
+}
+
+void PutSection(ByteWriter& w, const SectionInfo& s) {
+    w.Put(s.offset);
+    w.Put(s.length);
+    w.Put(s.checksum);
+}
+
+Status GetSection(ByteReader& r, SectionInfo* s) {
+    NAVE_RETURN_IF_ERROR(r.Get(&s->offset));
+    NAVE_RETURN_IF_ERROR(r.Get(&s->length));
+    return r.Get(&s->checksum);
+}
+
+bool FiniteBounds(const Bounds3f& b) { return IsFinite(b.min) && IsFinite(b.max); }
+
+}  // namespace
+
+void ByteWriter::PutBounds(const Bounds3f& b) {
+    Put(b.min.x), Put(b.min.y), Put(b.min.z);
+    Put(b.max.x), Put(b.max.y), Put(b.max.z);
+}
+
+void ByteWriter::PutString(std::string_view s) {
+    NAVE_CHECK_LT(s.size(), size_t(kMaxStringBytes)) << "string too long for the store format";
+    Put(uint32_t(s.size()));
+    bytes_.append(s);
+}
+
+Status ByteReader::Need(size_t n) const {
+    if (n > bytes_.size() - pos_) {
+        return DataLossError("{} @0x{:x}: need {} bytes but only {} remain in the table", what_, file_pos(), n,
+                             bytes_.size() - pos_);
+    }
+    return Status::Ok();
+}
+
+Status ByteReader::GetBounds(Bounds3f* b) {
+    for (int a = 0; a < 3; ++a) NAVE_RETURN_IF_ERROR(Get(&b->min[a]));
+    for (int a = 0; a < 3; ++a) NAVE_RETURN_IF_ERROR(Get(&b->max[a]));
+    return Status::Ok();
+}
+
+Status ByteReader::GetString(std::string* s) {
+    uint32_t n = 0;
+    const uint64_t at = file_pos();
+    NAVE_RETURN_IF_ERROR(Get(&n));
+    if (n > kMaxStringBytes) {
+        return DataLossError("{} @0x{:x}: string length {} exceeds the limit {}", what_, at, n, kMaxStringBytes);
+    }
+    NAVE_RETURN_IF_ERROR(Need(n));
+    s->assign(bytes_.data() + pos_, n);
+    pos_ += n;
+    return Status::Ok();
+}
+
+Status ByteReader::Skip(size_t n) {
+    NAVE_RETURN_IF_ERROR(Need(n));
+    pos_ += n;
+    return Status::Ok();
+}
+
+// ---- header -------------------------------------------------------------------------------------------
+
+std::string EncodeHeader(const RawHeader& h) {
+    ByteWriter w;
+    w.bytes().append(kMagic, sizeof(kMagic));
+    w.Put(h.major);
+    w.Put(h.minor);
+    w.Put(kHeaderBytes);
+    w.Put(h.file_bytes);
+    w.Put(h.grid.origin.x), w.Put(h.grid.origin.y), w.Put(h.grid.origin.z);
+    w.Put(h.grid.step);
+    w.PutBounds(h.bounds);
+    w.Put(h.triangle_count);
+    w.Put(h.source_triangle_count);
+    w.Put(h.brick_count);
+    w.Put(h.material_count);
+    w.Put(h.tree_node_count);
+    w.Put(h.directory_entry_bytes);
+    w.Put(h.tree_node_bytes);
+    w.Put(uint32_t(0));  // reserved flags
+    PutTableRef(w, h.provenance);
+    PutTableRef(w, h.directory);
+    PutTableRef(w, h.tree);
+    PutTableRef(w, h.materials);
+    NAVE_CHECK_LE(w.size(), size_t(kHeaderBytes - 8));
+    w.PutZeros(kHeaderBytes - 8 - w.size());
+    w.Put(Checksum64(w.bytes().data(), w.size()));
+    NAVE_CHECK_EQ(w.size(), size_t(kHeaderBytes));
+    return std::move(w.bytes());
+}
+
+StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name, uint64_t file_bytes) {
+    // Magic and version come first and are checked before anything else is trusted: a future major version
+    // may lay out everything after the 16-byte prefix differently.
+    if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+        const size_t n = std::min(bytes.size(), sizeof(kMagic));
+        if (n < sizeof(kMagic) && std::memcmp(bytes.data(), kMagic, n) == 0) {
+            return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)", name,
+                                 file_bytes, kHeaderBytes);
+        }
+        if (n == sizeof(kMagic) && std::all_of(bytes.begin(), bytes.begin() + n, [](char c) { return c == 0; })) {
+            // The writer's placeholder: the header is written last, so this store was never finished.
+            return DataLossError("{}: the header is all zeros: the store's writing never finished", name);
+        }
+        std::string found;
+        for (size_t i = 0; i < n; ++i) {
+            const unsigned char c = static_cast<unsigned char>(bytes[i]);
+            found += (c >= 32 && c < 127) ? fmt::format("{}", char(c)) : fmt::format("\\x{:02x}", c);
+        }
+        return UnsupportedError("{}: not a nave store: magic \"{}\" != \"NAVESTOR\"", name, found);
+    }
+    if (bytes.size() < kHeaderPrefixBytes) {
+        return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)", name, file_bytes,
+                             kHeaderBytes);
+    }
+    ByteReader r(bytes, name + " header", 0);
+    NAVE_RETURN_IF_ERROR(r.Skip(sizeof(kMagic)));
+    RawHeader h;
+    NAVE_RETURN_IF_ERROR(r.Get(&h.major));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.minor));
+    if (h.major != kFormatMajor) {
+        return UnsupportedError(
+            "{}: store format version {}.{} cannot be read by this nave, which reads version {}.x (up to {}.{}); "
+            "{}",
+            name, h.major, h.minor, kFormatMajor, kFormatMajor, kFormatMinor,
+            h.major > kFormatMajor ? "use a newer nave" : "re-create the store with `nave preprocess`");
+    }
+    NAVE_RETURN_IF_ERROR(r.Get(&h.header_bytes));
+    if (h.header_bytes < kHeaderBytes || h.header_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} @0x{:x}: header size {} out of range [{}, {}]", name, 12, h.header_bytes,
+                             kHeaderBytes, kMaxHeaderBytes);
+    }
+    if (bytes.size() < h.header_bytes) {
+        return DataLossError("{}: truncated: {} bytes, too short for its {}-byte header", name, file_bytes,
+                             h.header_bytes);
+    }
+    uint64_t stored_checksum = 0;
+    std::memcpy(&stored_checksum, bytes.data() + h.header_bytes - 8, 8);
+    const uint64_t checksum = Checksum64(bytes.data(), h.header_bytes - 8);
+    if (checksum != stored_checksum) {
+        return DataLossError("{} header @0x0: checksum {} != stored {} (the header is corrupt, or the file was "
+                             "not completely written)",
+                             name, ChecksumHex(checksum), ChecksumHex(stored_checksum));
+    }
+    NAVE_RETURN_IF_ERROR(r.Get(&h.file_bytes));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.grid.origin.x));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.grid.origin.y));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.grid.origin.z));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.grid.step));
+    NAVE_RETURN_IF_ERROR(r.GetBounds(&h.bounds));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.triangle_count));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.source_triangle_count));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.brick_count));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.material_count));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.tree_node_count));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.directory_entry_bytes));
+    NAVE_RETURN_IF_ERROR(r.Get(&h.tree_node_bytes));
+    uint32_t reserved = 0;
+    NAVE_RETURN_IF_ERROR(r.Get(&reserved));
+    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.provenance));
+    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.directory));
+    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.tree));
+    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.materials));
+
+    // The checksum matched, so what follows catches writer bugs and files cut or extended after writing.
+    if (h.file_bytes != file_bytes) {
+        return DataLossError("{}: the file has {} bytes but its header says {} ({})", name, file_bytes,
+                             h.file_bytes, file_bytes < h.file_bytes ? "truncated" : "extra bytes appended");
+    }
+    if (!(h.grid.step > 0) || !std::isfinite(h.grid.step) || !IsFinite(h.grid.origin)) {
+        return DataLossError("{} header: invalid grid (origin {}, step {})", name, fmt::streamed(h.grid.origin), h.grid.step);
+    }
+    if (h.directory_entry_bytes < kDirectoryEntryBytes || h.directory_entry_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} header: directory entry size {} < {} (the minimum for version {}.x)", name,
+                             h.directory_entry_bytes, kDirectoryEntryBytes, kFormatMajor);
+    }
+    if (h.tree_node_bytes < kTreeNodeBytes || h.tree_node_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} header: tree node size {} < {} (the minimum for version {}.x)", name,
+                             h.tree_node_bytes, kTreeNodeBytes, kFormatMajor);
+    }
+    struct Named {
+        const char* what;
+        const TableRef* ref;
+    };
+    for (const Named& t : {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
+                           Named{"tree", &h.tree}, Named{"materials", &h.materials}}) {
+        if (t.ref->offset < h.header_bytes || t.ref->offset > file_bytes ||
+            t.ref->length > file_bytes - t.ref->offset) {
+            return DataLossError("{} header: {} table [0x{:x}, +{}) lies outside the file's data [0x{:x}, 0x{:x})",
+                                 name, t.what, t.ref->offset, t.ref->length, h.header_bytes, file_bytes);
+        }
+    }
+    const uint64_t expected_dir = uint64_t(h.brick_count) * h.directory_entry_bytes;
+    if (h.directory.length != expected_dir) {
+        return DataLossError("{} header: directory is {} bytes, expected {} bricks x {} = {}", name,
+                             h.directory.length, h.brick_count, h.directory_entry_bytes, expected_dir);
+    }
+    const uint64_t expected_tree = 24 + uint64_t(h.tree_node_count) * h.tree_node_bytes;
+    if (h.tree.length != expected_tree) {
+        return DataLossError("{} header: tree table is {} bytes, expected 24 + {} nodes x {} = {}", name,
+                             h.tree.length, h.tree_node_count, h.tree_node_bytes, expected_tree);
+    }
+    return h;
+}
+
+// ---- provenance ---------------------------------------------------------------------------------------
+
+std::string EncodeProvenance(const StoreProvenance& p) {
+    ByteWriter w;
+    w.Put(uint32_t(p.source_files.size()));
+    for (const std::string& f : p.source_files) w.PutString(f);
+    w.PutString(p.tool_version);
+    w.PutString(p.options);
+    return std::move(w.bytes());
+}
+
+StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::string& name, uint64_t offset) {
+    ByteReader r(bytes, name + " provenance", offset);
+    StoreProvenance p;
+    uint32_t n = 0;
+    NAVE_RETURN_IF_ERROR(r.Get(&n));
+    // Each name takes at least its 4-byte length: a count beyond that is corrupt, whatever the checksum said.
+    if (n > r.remaining() / 4) {
+        return DataLossError("{} @0x{:x}: {} source files cannot fit in {} bytes", r.what(), offset, n,
+                             bytes.size());
+    }
+    p.source_files.resize(n);
+    for (std::string& f : p.source_files) NAVE_RETURN_IF_ERROR(r.GetString(&f));
+    NAVE_RETURN_IF_ERROR(r.GetString(&p.tool_version));
+    NAVE_RETURN_IF_ERROR(r.GetString(&p.options));
+    // Bytes beyond these fields belong to a newer minor version and are ignored.
+    return p;
+}
+
+// ---- directory ----------------------------------------------------------------------------------------
+
+std::string EncodeDirectory(const std::vector<RawBrickEntry>& entries) {
+    ByteWriter w;
+    for (const RawBrickEntry& e : entries) {
+        const size_t start = w.size();
+        w.Put(e.info.id);
+        w.Put(e.flags);
+        w.PutBounds(e.info.cell);
+        w.PutBounds(e.info.geometry_bounds);
+        w.Put(e.info.triangle_count);
+        w.Put(e.info.vertex_count);
+        w.Put(e.info.decoded_bytes);
+        PutSection(w, e.info.mesh);
+        PutSection(w, e.info.side);
+        NAVE_CHECK_EQ(w.size() - start, size_t(kDirectoryEntryBytes));
+    }
+    return std::move(w.bytes());
+}
+
+StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, const RawHeader& h,
+                                                     const std::string& name) {
+    std::vector<RawBrickEntry> entries(h.brick_count);
+    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    for (uint32_t i = 0; i < h.brick_count; ++i) {
+        const uint64_t entry_offset = h.directory.offset + uint64_t(i) * h.directory_entry_bytes;
+        ByteReader r(bytes.substr(size_t(i) * h.directory_entry_bytes, h.directory_entry_bytes),
+                     fmt::format("{} directory entry {}", name, i), entry_offset);
+        RawBrickEntry& e = entries[i];
+        NAVE_RETURN_IF_ERROR(r.Get(&e.info.id));
+        NAVE_RETURN_IF_ERROR(r.Get(&e.flags));
+        NAVE_RETURN_IF_ERROR(r.GetBounds(&e.info.cell));
+        NAVE_RETURN_IF_ERROR(r.GetBounds(&e.info.geometry_bounds));
+        NAVE_RETURN_IF_ERROR(r.Get(&e.info.triangle_count));
+        NAVE_RETURN_IF_ERROR(r.Get(&e.info.vertex_count));
+        NAVE_RETURN_IF_ERROR(r.Get(&e.info.decoded_bytes));
+        NAVE_RETURN_IF_ERROR(GetSection(r, &e.info.mesh));
+        NAVE_RETURN_IF_ERROR(GetSection(r, &e.info.side));
+        e.info.has_normals = (e.flags & kBrickHasNormals) != 0;
+        e.info.has_uvs = (e.flags & kBrickHasUvs) != 0;
+        if (e.info.id != i) {
+            return DataLossError("{} brick {} @0x{:x}: directory entry says id {} (expected {})", name, i,
+                                 entry_offset, e.info.id, i);
+        }
+        for (const auto& [what, s] : {std::pair<const char*, const SectionInfo*>{"mesh", &e.info.mesh},
+                                      std::pair<const char*, const SectionInfo*>{"side", &e.info.side}}) {
+            if (s->length == 0) continue;
+            if (s->offset < h.header_bytes || s->offset > payload_end || s->length > payload_end - s->offset) {
+                return DataLossError(
+                    "{} brick {} @0x{:x}: {} section [0x{:x}, +{}) lies outside the payload area [0x{:x}, 0x{:x})",
+                    name, i, entry_offset, what, s->offset, s->length, h.header_bytes, payload_end);
+            }
+        }
+        if (e.info.mesh.length == 0 && e.info.triangle_count > 0) {
+            return DataLossError("{} brick {} @0x{:x}: {} triangles but no mesh section", name, i, entry_offset,
+                                 e.info.triangle_count);
+        }
+        if (!FiniteBounds(e.info.cell)) {
+            return DataLossError("{} brick {} @0x{:x}: cell {} is not finite", name, i, entry_offset, fmt::streamed(e.info.cell));
+        }
+    }
+    return entries;
+}
+
+// ---- tree ---------------------------------------------------------------------------------------------
+
+std::string EncodeTree(const BrickTree& tree) {
+    ByteWriter w;
+    w.PutBounds(tree.bounds());
+    for (const BrickTreeNode& n : tree.nodes()) {
+        w.Put(n.axis);
+        w.PutZeros(3);
+        w.Put(n.split);
+        w.Put(n.child[0]);
+        w.Put(n.child[1]);
+        w.Put(n.brick);
+    }
+    return std::move(w.bytes());
+}
+
+StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h, const std::string& name) {
+    ByteReader r(bytes, name + " tree", h.tree.offset);
+    Bounds3f bounds;
+    NAVE_RETURN_IF_ERROR(r.GetBounds(&bounds));
+    if (!FiniteBounds(bounds)) {
+        return DataLossError("{} tree @0x{:x}: root bounds {} are not finite", name, h.tree.offset, fmt::streamed(bounds));
+    }
+    std::vector<BrickTreeNode> nodes(h.tree_node_count);
+    for (uint32_t i = 0; i < h.tree_node_count; ++i) {
+        const size_t start = r.pos();
+        BrickTreeNode& n = nodes[i];
+        NAVE_RETURN_IF_ERROR(r.Get(&n.axis));
+        NAVE_RETURN_IF_ERROR(r.Skip(3));
+        NAVE_RETURN_IF_ERROR(r.Get(&n.split));
+        NAVE_RETURN_IF_ERROR(r.Get(&n.child[0]));
+        NAVE_RETURN_IF_ERROR(r.Get(&n.child[1]));
+        NAVE_RETURN_IF_ERROR(r.Get(&n.brick));
+        NAVE_RETURN_IF_ERROR(r.Skip(h.tree_node_bytes - (r.pos() - start)));
+    }
+    BrickTree tree(bounds, std::move(nodes));
+    Status valid = tree.Validate(h.brick_count);
+    if (!valid.ok()) return valid.WithContext(fmt::format("{} tree @0x{:x}", name, h.tree.offset));
+    return tree;
+}
+
+// ---- materials ----------------------------------------------------------------------------------------
+
+std::string EncodeMaterials(const std::vector<MaterialRecord>& materials) {
+    ByteWriter w;
+    for (const MaterialRecord& m : materials) {
+        ByteWriter rec;
+        rec.PutString(m.name);
+        for (float v : m.diffuse) rec.Put(v);
+        for (float v : m.specular) rec.Put(v);
+        for (float v : m.emission) rec.Put(v);
+        rec.Put(m.ior);
+        rec.Put(m.opacity);
+        rec.Put(m.shininess);
+        rec.Put(m.metallic);
+        rec.Put(m.roughness);
+        rec.Put(uint32_t(m.textures.size()));
+        for (const auto& [slot, path] : m.textures) {
+            rec.PutString(slot);
+            rec.PutString(path);
+        }
+        // Each record carries its length so that a newer minor version may append fields to it.
+        w.Put(uint32_t(rec.size()));
+        w.bytes().append(rec.bytes());
+    }
+    return std::move(w.bytes());
+}
+
+StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, const RawHeader& h,
+                                                      const std::string& name) {
+    ByteReader table(bytes, name + " materials", h.materials.offset);
+    // Each record takes at least its 4-byte length.
+    if (h.material_count > bytes.size() / 4) {
+        return DataLossError("{} materials @0x{:x}: {} materials cannot fit in {} bytes", name, h.materials.offset,
+                             h.material_count, bytes.size());
+    }
+    std::vector<MaterialRecord> materials(h.material_count);
+    for (uint32_t i = 0; i < h.material_count; ++i) {
+        uint32_t record_bytes = 0;
+        const uint64_t at = table.file_pos();
+        NAVE_RETURN_IF_ERROR(table.Get(&record_bytes));
+        if (record_bytes > table.remaining()) {
+            return DataLossError("{} material {} @0x{:x}: record of {} bytes overruns the table ({} bytes left)",
+                                 name, i, at, record_bytes, table.remaining());
+        }
+        ByteReader r(bytes.substr(table.pos(), record_bytes), fmt::format("{} material {}", name, i),
+                     table.file_pos());
+        NAVE_RETURN_IF_ERROR(table.Skip(record_bytes));
+        MaterialRecord& m = materials[i];
+        NAVE_RETURN_IF_ERROR(r.GetString(&m.name));
+        for (float& v : m.diffuse) NAVE_RETURN_IF_ERROR(r.Get(&v));
+        for (float& v : m.specular) NAVE_RETURN_IF_ERROR(r.Get(&v));
+        for (float& v : m.emission) NAVE_RETURN_IF_ERROR(r.Get(&v));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.ior));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.opacity));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.shininess));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.metallic));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.roughness));
+        uint32_t texture_count = 0;
+        NAVE_RETURN_IF_ERROR(r.Get(&texture_count));
+        if (texture_count > r.remaining() / 8) {
+            return DataLossError("{} material {} @0x{:x}: {} textures cannot fit in {} bytes", name, i, at,
+                                 texture_count, r.remaining());
+        }
+        for (uint32_t t = 0; t < texture_count; ++t) {
+            std::string slot, path;
+            NAVE_RETURN_IF_ERROR(r.GetString(&slot));
+            NAVE_RETURN_IF_ERROR(r.GetString(&path));
+            m.textures[slot] = path;
+        }
+    }
+    if (table.remaining() != 0) {
+        return DataLossError("{} materials @0x{:x}: {} bytes left after {} records", name, table.file_pos(),
+                             table.remaining(), h.material_count);
+    }
+    return materials;
+}
+
+}  // namespace nave::store::format

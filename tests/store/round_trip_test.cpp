@@ -1,0 +1,340 @@
+// Write -> read round trips of the brick store: exact topology and material ids, positions within the grid's
+// bound, normals and UVs within their quantization bounds, and no cracks between bricks.
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "store/brick_codec.h"
+#include "store/store_reader.h"
+#include "store/store_writer.h"
+#include "store/testing/store_testing.h"
+#include "test_util.h"
+
+namespace nave::store {
+namespace {
+
+using test::ScratchDir;
+using test::SortedKeys;
+
+// A grid whose origin is not on any round number, so that snapping really moves the vertices.
+GlobalGrid TestGrid(double step = 1e-3) { return GlobalGrid{{-1.2345, 2.3456, -0.3579}, step}; }
+
+// Bound on the angle-free error |n_decoded - n| of Draco's octahedral normal quantization with `bits` bits.
+// The octahedral parameters (u, v) in [-1, 1] are quantized with step d = 2 / (2^bits - 1), so each moves by
+// at most d/2. The unnormalized octahedron point (u, v, 1 - |u| - |v|) then moves by at most
+// sqrt((d/2)^2 + (d/2)^2 + d^2) = d sqrt(1.5), and normalizing a vector of length >= 1/sqrt(3) (the
+// octahedron's closest point to the origin) scales that by at most sqrt(3): |error| <= d sqrt(4.5).
+// Octahedral mapping: Meyer et al., "On Floating-Point Normal Vectors", EGSR 2010, section 3.
+double NormalErrorBound(int bits) { return 2.0 / ((1 << bits) - 1) * std::sqrt(4.5); }
+
+// Draco quantizes each UV component on a uniform grid spanning the brick's largest UV range with 2^bits - 1
+// steps, so the error is at most half a step.
+double UvErrorBound(int bits, double range) { return 0.5 * range / ((1 << bits) - 1); }
+
+TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
+    ScratchDir dir;
+    testing::SurfaceOptions surface;
+    surface.quads_x = 40;
+    surface.quads_y = 30;
+    const BrickMesh mesh = testing::MakeSurface(surface);
+    const auto materials = testing::MakeMaterials(3);
+    const GlobalGrid grid = TestGrid();
+    const EncodeOptions options;
+    auto written = testing::WriteGridStore(dir / "surface.nave", mesh, materials, {3, 2, 1}, grid, options);
+    ASSERT_TRUE(written.ok()) << written.status().ToString();
+    EXPECT_EQ(dir.Files(), std::vector<std::string>{"surface.nave"});
+
+    auto opened = Store::Open(dir / "surface.nave");
+    ASSERT_TRUE(opened.ok()) << opened.status().ToString();
+    const Store& store = **opened;
+    EXPECT_EQ(store.header().major, kFormatMajor);
+    EXPECT_EQ(store.header().minor, kFormatMinor);
+    EXPECT_EQ(store.header().grid.origin, grid.origin);
+    EXPECT_EQ(store.header().grid.step, grid.step);
+    EXPECT_EQ(store.header().triangle_count, mesh.TriangleCount());
+    EXPECT_EQ(store.header().source_triangle_count, mesh.TriangleCount());
+    EXPECT_EQ(store.header().provenance.source_files, std::vector<std::string>{"synthetic-surface"});
+    EXPECT_EQ(store.header().provenance.tool_version, "nave test");
+    EXPECT_EQ(store.header().provenance.options, "grid-split");
+    EXPECT_EQ(store.materials(), materials);
+    ASSERT_EQ(store.bricks().size(), written->bricks.size());
+    ASSERT_EQ(store.bricks().size(), 6u);
+    EXPECT_EQ(store.tree().nodes().size(), written->tree.nodes().size());
+
+    // Where each grid point decodes, over all bricks: a vertex shared by two bricks must decode bit for bit
+    // to the same coordinates in both.
+    std::map<std::array<int32_t, 3>, std::pair<Vec3f, int>> decoded_at;
+    Bounds3f all;
+    for (uint32_t b = 0; b < store.bricks().size(); ++b) {
+        SCOPED_TRACE("brick " + std::to_string(b));
+        const BrickMesh& in = written->bricks[b];
+        auto read = store.ReadBrick(b);
+        ASSERT_TRUE(read.ok()) << read.status().ToString();
+        const BrickMesh& out = *read;
+        const BrickInfo& info = store.bricks()[b];
+
+        // Topology and materials: the same oriented triangles on the grid, with the same materials.
+        EXPECT_EQ(SortedKeys(out, grid, false), SortedKeys(in, grid, false));
+        EXPECT_EQ(out.TriangleCount(), info.triangle_count);
+        EXPECT_EQ(out.VertexCount(), info.vertex_count);
+        EXPECT_EQ(out.MemoryBytes(), info.decoded_bytes);
+        EXPECT_TRUE(out.HasNormals() && info.has_normals);
+        EXPECT_TRUE(out.HasUvs() && info.has_uvs);
+
+        // Positions within step/2 per axis (plus the float rounding of the decoded value).
+        std::map<std::array<int32_t, 3>, uint32_t> input_vertex;  // the surface has one vertex per point
+        for (uint32_t v = 0; v < in.VertexCount(); ++v) input_vertex[test::GridKey(grid, in.positions[v])] = v;
+        float uv_lo = 1e30f, uv_hi = -1e30f;
+        for (const auto& uv : in.uvs) uv_lo = std::min({uv_lo, uv[0], uv[1]}), uv_hi = std::max({uv_hi, uv[0], uv[1]});
+        Bounds3f box;
+        for (uint32_t v = 0; v < out.VertexCount(); ++v) {
+            const auto key = test::GridKey(grid, out.positions[v]);
+            auto it = input_vertex.find(key);
+            ASSERT_NE(it, input_vertex.end()) << "decoded vertex " << v << " is on no input grid point";
+            const uint32_t src = it->second;
+            for (int a = 0; a < 3; ++a) {
+                const double err = std::fabs(double(out.positions[v][a]) - double(in.positions[src][a]));
+                // Half a float ulp of the decoded value, which lies within step/2 of the input.
+                const double round = (std::fabs(double(in.positions[src][a])) + grid.step) * 6e-8;
+                EXPECT_LE(err, grid.MaxAxisError() + round) << "vertex " << v << " axis " << a;
+            }
+            const Vec3f n = in.normals[src];
+            EXPECT_LE(Length(out.normals[v] - n), NormalErrorBound(options.normal_bits)) << "vertex " << v;
+            EXPECT_NEAR(Length(out.normals[v]), 1.f, 1e-5f);
+            for (int c = 0; c < 2; ++c) {
+                EXPECT_LE(std::fabs(out.uvs[v][c] - in.uvs[src][c]),
+                          UvErrorBound(options.uv_bits, uv_hi - uv_lo) + 1e-7)
+                    << "vertex " << v;
+            }
+            box.Extend(out.positions[v]);
+            auto [slot, inserted] = decoded_at.try_emplace(key, out.positions[v], 0);
+            EXPECT_EQ(slot->second.first, out.positions[v]) << "grid point decodes differently in two bricks";
+            slot->second.second += inserted ? 1 : 0;
+        }
+        EXPECT_EQ(box, info.geometry_bounds);
+        EXPECT_TRUE(store.VerifyBrick(b).ok());
+        all.Extend(box);
+    }
+    EXPECT_EQ(all, store.header().bounds);
+    // Shared border vertices exist (otherwise the crack check above proved nothing).
+    size_t shared = 0;
+    std::map<std::array<int32_t, 3>, int> bricks_per_point;
+    for (const BrickMesh& in : written->bricks) {
+        std::set<std::array<int32_t, 3>> mine;
+        for (const Vec3f& p : in.positions) mine.insert(test::GridKey(grid, p));
+        for (const auto& k : mine) ++bricks_per_point[k];
+    }
+    for (const auto& [k, count] : bricks_per_point) shared += count > 1 ? 1 : 0;
+    EXPECT_GT(shared, 50u);
+    EXPECT_GT(store.bytes_read(), 0u);
+}
+
+// A brick with everything Draco finds awkward: a random material per triangle (vertices split between
+// materials), an edge shared by three triangles, a duplicated triangle, vertices the input split for
+// seams, isolated vertices, and triangles that collapse on the grid.
+BrickMesh AwkwardMesh(std::mt19937& rng, uint32_t materials) {
+    BrickMesh m = testing::MakeSurface({.quads_x = 12, .quads_y = 9, .material_count = 1});
+    std::uniform_int_distribution<uint32_t> pick(0, materials - 1);
+    for (uint32_t& id : m.material_ids) id = pick(rng);
+    auto add_vertex = [&](Vec3f p) {
+        m.positions.push_back(p);
+        m.normals.push_back({0, 0, 1});
+        m.uvs.push_back({0.5f, 0.5f});
+        return uint32_t(m.positions.size() - 1);
+    };
+    auto add_triangle = [&](uint32_t a, uint32_t b, uint32_t c, uint32_t material) {
+        m.indices.insert(m.indices.end(), {a, b, c});
+        m.material_ids.push_back(material);
+    };
+    // A fin on the edge (0, 1): three triangles share it.
+    const uint32_t fin = add_vertex({0.4f, 0.f, 2.f});
+    add_triangle(0, 1, fin, pick(rng));
+    // The same triangle twice, with different materials.
+    add_triangle(14, 15, 28, 0);
+    add_triangle(14, 15, 28, materials - 1);
+    // A seam copy of vertex 20 (same position, other normal), used by a new triangle.
+    const uint32_t copy = add_vertex(m.positions[20]);
+    m.normals[copy] = {1, 0, 0};
+    add_triangle(copy, 21, fin, pick(rng));
+    // Isolated vertices and a triangle whose corners are 1e-5 apart (inside one 1 mm grid cell).
+    add_vertex({5, 5, 5});
+    const uint32_t a = add_vertex({3.f, 3.f, 3.f}), b = add_vertex({3.f, 3.00001f, 3.f});
+    add_triangle(a, b, 5, 1);
+    return m;
+}
+
+TEST(StoreRoundTrip, AwkwardMeshKeepsEveryTriangleAndMaterial) {
+    std::mt19937 rng(12345);
+    const GlobalGrid grid = TestGrid();
+    for (int speed : {0, 5, 10}) {
+        SCOPED_TRACE("speed " + std::to_string(speed));
+        const BrickMesh mesh = AwkwardMesh(rng, 7);
+        EncodeOptions options;
+        options.draco_speed = speed;
+        auto encoded = EncodeBrick(mesh, Bounds3f({0, 0, 0}, {10, 10, 10}), grid, options);
+        ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
+        EXPECT_EQ(encoded->dropped_triangle_count, 1u);
+        EXPECT_EQ(encoded->triangle_count, mesh.TriangleCount() - 1);
+        EXPECT_EQ(encoded->max_material_id, 6u);
+        auto decoded = codec::DecodeMeshSection(encoded->mesh_bytes, grid, 7, "test");
+        ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+        EXPECT_EQ(SortedKeys(*decoded, grid, false), SortedKeys(mesh, grid, true));
+        EXPECT_EQ(decoded->VertexCount(), encoded->vertex_count);
+        EXPECT_EQ(decoded->MemoryBytes(), encoded->decoded_bytes);
+    }
+}
+
+TEST(StoreRoundTrip, MeshWithoutNormalsOrUvs) {
+    const GlobalGrid grid = TestGrid(0.01);
+    const BrickMesh mesh = testing::MakeSurface({.quads_x = 8, .quads_y = 8, .normals = false, .uvs = false});
+    auto encoded = EncodeBrick(mesh, Bounds3f({0, 0, 0}, {10, 10, 1}), grid, {});
+    ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
+    EXPECT_FALSE(encoded->has_normals);
+    EXPECT_FALSE(encoded->has_uvs);
+    auto decoded = codec::DecodeMeshSection(encoded->mesh_bytes, grid, 3, "test");
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    EXPECT_FALSE(decoded->HasNormals());
+    EXPECT_FALSE(decoded->HasUvs());
+    EXPECT_EQ(SortedKeys(*decoded, grid, false), SortedKeys(mesh, grid, false));
+}
+
+TEST(StoreRoundTrip, BrickWhoseTrianglesAllCollapseIsEmpty) {
+    const GlobalGrid grid = TestGrid(1.0);
+    BrickMesh mesh;
+    mesh.positions = {{0, 0, 0}, {0.01f, 0, 0}, {0, 0.01f, 0}};
+    mesh.indices = {0, 1, 2};
+    mesh.material_ids = {0};
+    auto encoded = EncodeBrick(mesh, Bounds3f({0, 0, 0}, {1, 1, 1}), grid, {});
+    ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
+    EXPECT_EQ(encoded->triangle_count, 0u);
+    EXPECT_EQ(encoded->dropped_triangle_count, 1u);
+    auto decoded = codec::DecodeMeshSection(encoded->mesh_bytes, grid, 1, "test");
+    ASSERT_TRUE(decoded.ok());
+    EXPECT_EQ(decoded->TriangleCount(), 0u);
+}
+
+TEST(StoreRoundTrip, ConcurrentReadsGiveIdenticalBricks) {
+    ScratchDir dir;
+    const BrickMesh mesh = testing::MakeSurface({.quads_x = 24, .quads_y = 24});
+    auto written = testing::WriteGridStore(dir / "s.nave", mesh, testing::MakeMaterials(3), {2, 2, 1}, TestGrid());
+    ASSERT_TRUE(written.ok()) << written.status().ToString();
+    auto store = Store::Open(dir / "s.nave");
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    const uint32_t n = uint32_t((*store)->bricks().size());
+    std::vector<std::vector<BrickMesh>> results(4, std::vector<BrickMesh>(n));
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t) {
+        threads.emplace_back([&, t] {
+            for (uint32_t i = 0; i < 3 * n; ++i) {
+                const uint32_t b = (i + uint32_t(t)) % n;
+                auto read = (*store)->ReadBrick(b);
+                if (read.ok()) results[t][b] = std::move(read).value();
+            }
+        });
+    }
+    for (auto& th : threads) th.join();
+    for (uint32_t b = 0; b < n; ++b) {
+        for (int t = 1; t < 4; ++t) {
+            EXPECT_EQ(results[t][b].positions, results[0][b].positions);
+            EXPECT_EQ(results[t][b].indices, results[0][b].indices);
+            EXPECT_EQ(results[t][b].material_ids, results[0][b].material_ids);
+        }
+        EXPECT_EQ(results[0][b].TriangleCount(), (*store)->bricks()[b].triangle_count);
+    }
+}
+
+TEST(StoreRoundTrip, SideSectionIsVerifiedAndRoundTrips) {
+    const std::string raw = "original triangle ids would go here " + std::string(1000, 'x');
+    const std::string packed = codec::CompressSideSection(raw);
+    EXPECT_LT(packed.size(), raw.size());
+    auto unpacked = codec::DecompressSideSection(packed, "test");
+    ASSERT_TRUE(unpacked.ok()) << unpacked.status().ToString();
+    EXPECT_EQ(*unpacked, raw);
+
+    // A store whose brick carries a side section opens, reads and verifies.
+    ScratchDir dir;
+    const GlobalGrid grid = TestGrid();
+    const BrickMesh mesh = testing::MakeSurface({.quads_x = 4, .quads_y = 4});
+    testing::GridStore split = testing::SplitOnGrid(mesh, {1, 1, 1});
+    auto writer = StoreWriter::Create(dir / "side.nave", grid, {});
+    ASSERT_TRUE(writer.ok());
+    auto encoded = EncodeBrick(split.bricks[0], {}, grid, {});
+    ASSERT_TRUE(encoded.ok());
+    encoded->side_bytes = packed;
+    ASSERT_TRUE((*writer)->Append(*encoded).ok());
+    ASSERT_TRUE((*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
+    auto store = Store::Open(dir / "side.nave");
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    EXPECT_EQ((*store)->bricks()[0].side.length, packed.size());
+    EXPECT_EQ((*store)->bricks()[0].cell, split.tree.BrickCells(1)[0]);  // taken from the tree
+    EXPECT_TRUE((*store)->VerifyBrick(0).ok());
+}
+
+TEST(StoreWriter, RefusesBadMeshes) {
+    const GlobalGrid grid = TestGrid();
+    BrickMesh mesh = testing::MakeSurface({.quads_x = 2, .quads_y = 2});
+    BrickMesh bad = mesh;
+    bad.indices[4] = 99;
+    Status s = EncodeBrick(bad, {}, grid, {}).status();
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(s.message().find("triangle 1 corner 1: index 99 out of range [0, 9)"), std::string::npos) << s.message();
+
+    bad = mesh;
+    bad.material_ids.pop_back();
+    EXPECT_EQ(EncodeBrick(bad, {}, grid, {}).status().code(), StatusCode::kInvalidArgument);
+
+    bad = mesh;
+    bad.normals[3] = {0, 0, 0};
+    s = EncodeBrick(bad, {}, grid, {}).status();
+    EXPECT_NE(s.message().find("vertex 3: normal"), std::string::npos) << s.message();
+
+    bad = mesh;
+    bad.positions[2] = {1e9f, 0, 0};  // 1e12 grid steps: beyond int32
+    s = EncodeBrick(bad, {}, grid, {}).status();
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(s.message().find("vertex 2"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("int32 range"), std::string::npos) << s.message();
+
+    EXPECT_EQ(ValidateBrickMesh(mesh, 1).code(), StatusCode::kInvalidArgument);  // material 1 and 2 >= 1
+    EXPECT_TRUE(ValidateBrickMesh(mesh, 3).ok());
+}
+
+TEST(StoreWriter, FinishRefusesInconsistentTablesAndCanRetry) {
+    ScratchDir dir;
+    const GlobalGrid grid = TestGrid();
+    const BrickMesh mesh = testing::MakeSurface({.quads_x = 6, .quads_y = 6});
+    testing::GridStore split = testing::SplitOnGrid(mesh, {2, 1, 1});
+    auto writer = StoreWriter::Create(dir / "w.nave", grid, {});
+    ASSERT_TRUE(writer.ok());
+    for (const BrickMesh& b : split.bricks) {
+        auto e = EncodeBrick(b, {}, grid, {});
+        ASSERT_TRUE(e.ok());
+        ASSERT_TRUE((*writer)->Append(*e).ok());
+    }
+    // Too few materials for the ids in use.
+    Status s = (*writer)->Finish(testing::MakeMaterials(1), split.tree, 0);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(s.message().find("uses material"), std::string::npos) << s.message();
+    // Duplicate material names.
+    auto twice = testing::MakeMaterials(3);
+    twice[2].name = twice[0].name;
+    s = (*writer)->Finish(twice, split.tree, 0);
+    EXPECT_NE(s.message().find("used twice"), std::string::npos) << s.message();
+    // A tree that forgets brick 1.
+    std::vector<BrickTreeNode> one_leaf(1);
+    one_leaf[0].brick = 0;
+    s = (*writer)->Finish(testing::MakeMaterials(3), BrickTree(split.tree.bounds(), one_leaf), 0);
+    EXPECT_NE(s.message().find("brick 1 is in no leaf"), std::string::npos) << s.message();
+    EXPECT_FALSE(std::filesystem::exists(dir / "w.nave"));
+    // Fixed: it commits.
+    ASSERT_TRUE((*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
+    EXPECT_TRUE(Store::Open(dir / "w.nave").ok());
+}
+
+}  // namespace
+}  // namespace nave::store
