@@ -15,5 +15,6 @@ using CommandRun = std::function<Status()>;
 
 // One line per subcommand; main.cpp calls them in this order (the order of `nave --help`).
 void RegisterVersionCommand(CLI::App& app, CommandRun& run);
+void RegisterRenderCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

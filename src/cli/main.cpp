@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
 
     nave::cli::CommandRun run;
     nave::cli::RegisterVersionCommand(app, run);
+    nave::cli::RegisterRenderCommand(app, run);
 
     try {
         app.parse(argc, argv);
