@@ -439,14 +439,18 @@ Status Engine::RunPath() {
     ProgressBar progress("render", pixels * uint64_t(spp), "paths");
     auto start = std::chrono::steady_clock::now();
     int passes = 0;
-    for (int s = 0; s < spp; ++s) {
+    // Small images put several passes in one wave, so that the streams stay long enough to keep every thread
+    // busy; large images split a pass into waves to bound the memory of the queues.
+    const int passes_per_wave = int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
+    for (int s = 0; s < spp; s += passes_per_wave) {
+        const int s_end = std::min(spp, s + passes_per_wave);
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
-            GenerateCameraRays(first, last, uint32_t(s), nullptr);
+            for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
             NAVE_RETURN_IF_ERROR(Drain());
-            progress.Add(last - first);
+            progress.Add((last - first) * uint64_t(s_end - s));
         }
-        passes = s + 1;
+        passes = s_end;
         double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
     }
