@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/log.h"
+#include "render/sun/sun.h"
 
 namespace nave::render {
 
@@ -40,21 +41,40 @@ float SurfaceMaterial::AlbedoForAov() const {
     }
 }
 
-StatusOr<SunState> ComputeSun(const SunConfig& sun) {
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
     SunState s;
-    if (!sun.direction) {
-        return UnsupportedError(
-            "sun.datetime: the solar position model is not available in this build; give sun.direction");
-    }
-    s.to_sun = *sun.direction;
-    s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / 3.14159265358979;
-    s.azimuth_deg = std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / 3.14159265358979 + 360.0, 360.0);
-    if (sun.radiance) {
-        s.radiance = ToSpectrum(*sun.radiance);
+    if (sun.direction) {
+        s.to_sun = *sun.direction;
+        s.cos_max = std::cos(sun.angular_radius_deg * 3.14159265358979f / 180.f);
+        s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / 3.14159265358979;
+        s.azimuth_deg = std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / 3.14159265358979 + 360.0, 360.0);
+        if (sun.radiance) {
+            s.radiance = ToSpectrum(*sun.radiance);
+        } else {
+            // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for that
+            // zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490) spread over the
+            // disc, i.e. the sun without an atmosphere.
+            double omega = 2 * 3.14159265358979 * (1 - double(s.cos_max));
+            s.radiance = ExtraterrestrialSolarSpectrum() * float(1.0 / omega);
+        }
     } else {
-        // Without an atmosphere: the solar disc as a 5778 K black body (Planck's law; the effective
-        // temperature of the photosphere, IAU 2015 Resolution B3 nominal values), W m^-2 sr^-1 nm^-1.
-        s.radiance = Spectrum::FromFunction([](double l) { return PlanckRadiance(l, 5772.0); });
+        SunInput in;
+        in.time = CivilTime{sun.when.year, sun.when.month, sun.when.day, sun.when.hour, sun.when.minute,
+                            sun.when.second, sun.when.utc_offset_minutes / 60.0};
+        in.latitude_deg = sun.latitude_deg;
+        in.longitude_deg = sun.longitude_deg;
+        in.elevation_m = sun.elevation_m;
+        in.atmosphere.pressure_hpa = sun.pressure_mbar;  // 1 mbar = 1 hPa
+        in.atmosphere.temperature_c = sun.temperature_c;
+        in.atmosphere.turbidity = sun.turbidity;
+        StatusOr<Sun> model = ComputeSun(in);
+        if (!model.ok()) return model.status().WithContext(fmt::format("{}: [sun]", file));
+        s.to_sun = model->direction;
+        s.zenith_deg = model->position.zenith_deg;
+        s.azimuth_deg = model->position.azimuth_deg;
+        s.cos_max = model->CosThetaMax();
+        s.radiance = sun.radiance ? ToSpectrum(*sun.radiance) : model->radiance;
+        s.above_horizon = model->AboveHorizon();
     }
     s.radiance *= sun.scale;
     return s;
@@ -110,11 +130,12 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
     }
 
     if (config.sun.enabled) {
-        NAVE_ASSIGN_OR_RETURN(SunState sun, ComputeSun(config.sun));
+        NAVE_ASSIGN_OR_RETURN(SunState sun, ResolveSun(config.sun, file));
+        if (!sun.above_horizon) log::Warning("{}: the sun is below the horizon at that date and place", file);
         Light l;
         l.kind = Light::Kind::kSun;
         l.to_light = sun.to_sun;
-        l.cos_sun = std::cos(config.sun.angular_radius_deg * 3.14159265358979f / 180.f);
+        l.cos_sun = sun.cos_max;
         l.spectrum = sun.radiance;
         scene.sun = int(scene.lights.size());
         scene.lights.push_back(std::move(l));

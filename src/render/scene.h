@@ -68,13 +68,15 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
 /// The tabulated form of a config spectrum.
 Spectrum ToSpectrum(const SpectrumSpec& spec);
 
-/// The sun's position and spectrum for a place and time. Filled by the physics sun model (NREL SPA and
-/// atmospheric transmittance) when available.
+/// The sun's position and spectrum for a place and time: the physics sun model (NREL SPA, clear-sky
+/// transmittance, render/sun/sun.h), or the config's fixed direction and spectrum.
 struct SunState {
     Vec3f to_sun;            ///< unit vector, world frame (+X east, +Y north, +Z up)
     double zenith_deg = 0, azimuth_deg = 0;
+    float cos_max = 1;       ///< cosine of the disc's angular radius
     Spectrum radiance;       ///< disc radiance at the ground, W m^-2 sr^-1 nm^-1
+    bool above_horizon = true;
 };
-StatusOr<SunState> ComputeSun(const SunConfig& sun);
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file);
 
 }  // namespace nave::render

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/file.h"
+#include "render/sun/spa.h"
 
 namespace nave::render {
 
@@ -443,42 +444,13 @@ Status ParseOutput(TableReader& r, OutputConfig* o) {
 }  // namespace
 
 StatusOr<DateTime> ParseDateTime(std::string_view text) {
-    DateTime d;
-    int n = 0;
-    char sep = 0;
-    std::string s(text);
-    // YYYY-MM-DD[T ]HH:MM[:SS[.fff]](Z|+HH:MM|-HH:MM)
-    if (std::sscanf(s.c_str(), "%4d-%2d-%2d%c%2d:%2d%n", &d.year, &d.month, &d.day, &sep, &d.hour, &d.minute, &n) != 6 ||
-        (sep != 'T' && sep != ' ')) {
-        return InvalidArgumentError("'{}' is not a date-time (expected YYYY-MM-DDTHH:MM[:SS]+HH:MM)", text);
+    // The sun model's ISO 8601 parser (render/sun/spa.h) checks fields and requires a zone.
+    NAVE_ASSIGN_OR_RETURN(CivilTime t, ParseIso8601(text));
+    if (t.day > DaysInMonth(t.year, t.month)) {
+        return InvalidArgumentError("'{}': day {} is not in 1..{} for {:04d}-{:02d}", text, t.day,
+                                    DaysInMonth(t.year, t.month), t.year, t.month);
     }
-    size_t pos = size_t(n);
-    if (pos < s.size() && s[pos] == ':') {
-        char* end = nullptr;
-        d.second = std::strtod(s.c_str() + pos + 1, &end);
-        pos = size_t(end - s.c_str());
-    }
-    if (d.month < 1 || d.month > 12) return InvalidArgumentError("'{}': month {} is not in 1..12", text, d.month);
-    if (d.day < 1 || d.day > DaysInMonth(d.year, d.month)) {
-        return InvalidArgumentError("'{}': day {} is not in 1..{} for {:04d}-{:02d}", text, d.day,
-                                    DaysInMonth(d.year, d.month), d.year, d.month);
-    }
-    if (d.hour > 23 || d.minute > 59 || d.second < 0 || d.second >= 61) {
-        return InvalidArgumentError("'{}': time {:02d}:{:02d}:{} is not a valid time of day", text, d.hour, d.minute,
-                                    d.second);
-    }
-    std::string zone = s.substr(pos);
-    if (zone == "Z") {
-        d.utc_offset_minutes = 0;
-    } else {
-        int oh = 0, om = 0, m = 0;
-        if (zone.size() != 6 || (zone[0] != '+' && zone[0] != '-') ||
-            std::sscanf(zone.c_str() + 1, "%2d:%2d%n", &oh, &om, &m) != 2 || m != 5 || oh > 14 || om > 59) {
-            return InvalidArgumentError("'{}': time zone '{}' (expected Z or +HH:MM / -HH:MM)", text, zone);
-        }
-        d.utc_offset_minutes = (zone[0] == '-' ? -1 : 1) * (oh * 60 + om);
-    }
-    return d;
+    return DateTime{t.year, t.month, t.day, t.hour, t.minute, t.second, int(std::lround(t.utc_offset_hours * 60))};
 }
 
 StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string& name) {

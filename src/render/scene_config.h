@@ -57,7 +57,7 @@ struct SunConfig {
     double turbidity = 3.0;          ///< Linke/Angstrom-style haze factor handed to the sun model
     float scale = 1.f;               ///< multiplies the sun's radiance
     std::optional<Vec3f> direction; ///< toward the sun; overrides date/place (tests, studios)
-    float angular_radius_deg = 0.2666f;  ///< apparent radius of the solar disc
+    float angular_radius_deg = 0.2666f;  ///< apparent radius of the disc with `direction` (the model computes its own)
     std::optional<SpectrumSpec> radiance;  ///< overrides the atmospheric model's spectrum (W m^-2 sr^-1 nm^-1)
 };
 
