@@ -65,16 +65,16 @@ Status RunRender(const RenderOptions& o) {
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats));
 
-    const uint64_t rays = stats.segments_traced + stats.shadow_segments;
+    const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);
     std::string settings = fmt::format(
         "mode={} spp={} iterations={} photons_per_iteration={} seed={} max_depth={} threads={}",
         ModeName(config.render.mode), stats.samples_per_pixel, stats.iterations, config.render.photons_per_iteration,
         config.render.seed, config.render.max_depth, config.render.threads);
     std::string statistics = fmt::format(
-        "wall={:.3f}s segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
+        "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
         "bytes_read={} peak_rss={}",
-        stats.wall_seconds, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
+        stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
         stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
@@ -90,11 +90,12 @@ Status RunRender(const RenderOptions& o) {
     png.replace_extension(".png");
     std::fprintf(stderr,
                  "nave render: wrote %s and %s\n"
-                 "  time %s, %s ray segments/s (%s segments, %s shadow), %s photons/s\n"
+                 "  time %s, %s rays/s (%s rays: %s segments traced, %s shadow segments), %s photons/s\n"
                  "  rays moved between bricks %s, brick visits %s, loads %s, read %s, peak memory %s, "
                  "peak queues %s\n",
                  out.string().c_str(), png.string().c_str(), FormatDuration(stats.wall_seconds).c_str(),
-                 FormatCount(double(rays) / secs).c_str(), FormatCount(double(stats.segments_traced)).c_str(),
+                 FormatCount(double(rays) / secs).c_str(), FormatCount(double(rays)).c_str(),
+                 FormatCount(double(stats.segments_traced)).c_str(),
                  FormatCount(double(stats.shadow_segments)).c_str(),
                  FormatCount(double(stats.photons) / secs).c_str(), FormatCount(double(stats.brick_moves)).c_str(),
                  FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),

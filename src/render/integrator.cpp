@@ -50,7 +50,7 @@ float PowerHeuristic(float a, float b) {
 }
 
 struct LocalCounters {
-    uint64_t segments = 0, shadow_segments = 0, moves = 0;
+    uint64_t segments = 0, shadow_segments = 0, moves = 0, rays = 0;
 };
 
 /// Rays spawned or moved by one task, flushed to the queues grouped by brick.
@@ -115,7 +115,7 @@ class Engine {
     RenderStats* stats_;
     const store::BrickTree& tree_;
     BrickQueues<RayRecord> queues_;
-    std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0};
+    std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
     std::unique_ptr<VisiblePoints> visible_;  // photon mode
 
@@ -179,6 +179,7 @@ void Engine::Escape(const RayRecord& r) {
 }
 
 void Engine::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c) {
+    ++c.rays;
     uint32_t next = Route(r, 0, store::kNoBrick);
     if (next == store::kNoBrick) {
         if (r.kind == kShadowRay) {
@@ -362,6 +363,7 @@ void Engine::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Out
         }
         bool go_on = r.kind == kPhotonRay ? ShadePhoton(r, b, brick, hit) : ShadePath(r, b, brick, hit, out, c);
         if (!go_on) return;
+        ++c.rays;
         uint32_t next = Route(r, 0, store::kNoBrick);
         if (next == store::kNoBrick) {
             Escape(r);
@@ -388,6 +390,7 @@ void Engine::Flush(Outbox& out, const LocalCounters& c) {
     segments_.fetch_add(c.segments, std::memory_order_relaxed);
     shadow_segments_.fetch_add(c.shadow_segments, std::memory_order_relaxed);
     moves_.fetch_add(c.moves, std::memory_order_relaxed);
+    rays_.fetch_add(c.rays, std::memory_order_relaxed);
 }
 
 Status Engine::Drain() {
@@ -681,6 +684,7 @@ Status Engine::Run() {
     stats_->segments_traced = segments_.load();
     stats_->shadow_segments = shadow_segments_.load();
     stats_->brick_moves = moves_.load();
+    stats_->rays = rays_.load();
     stats_->batches = batches_.load();
     stats_->brick_loads = after.loads - before.loads;
     stats_->bytes_read = after.bytes_read - before.bytes_read;

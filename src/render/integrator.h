@@ -25,6 +25,8 @@ namespace nave::render {
 struct RenderStats {
     double wall_seconds = 0;
     uint64_t camera_paths = 0;
+    uint64_t rays = 0;             ///< rays started: camera, continuation, shadow rays and photons
+
     uint64_t segments_traced = 0;  ///< ray segments traced inside a brick (closest-hit queries)
     uint64_t shadow_segments = 0;  ///< shadow-ray segments traced inside a brick (occlusion queries)
     uint64_t photons = 0;          ///< photons emitted
