@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/file.h"
+#include "core/spectrum.h"
 #include "render/sun/spa.h"
 
 namespace nave::render {
@@ -215,10 +216,32 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
                                             WhereIs(*n), Name(key), i, s.wavelengths_nm[i], s.wavelengths_nm[i - 1]);
             }
         }
+    } else if (t.Has("csv")) {
+        // A column of a CSV spectra file, looked up beside the config, then in nave's data directory.
+        s.kind = SpectrumSpec::Kind::kTable;
+        std::string csv, column;
+        NAVE_RETURN_IF_ERROR(t.String("csv", &csv));
+        NAVE_RETURN_IF_ERROR(t.String("column", &column));
+        std::filesystem::path path = std::filesystem::path(file_).parent_path() / csv;
+        if (!std::filesystem::exists(path)) path = std::filesystem::path(NAVE_DATA_DIR) / csv;
+        StatusOr<SpectraTable> table = LoadSpectraCsv(path);
+        if (!table.ok()) {
+            return InvalidArgumentError("{}: {}.csv: {}", WhereIs(*n), Name(key), table.status().message());
+        }
+        auto it = std::find(table->names.begin(), table->names.end(), column);
+        if (it == table->names.end()) {
+            return InvalidArgumentError("{}: {}.column: '{}' is not a column of {} (columns: {})", WhereIs(*n),
+                                        Name(key), column, path.string(), fmt::join(table->names, ", "));
+        }
+        const auto& values = table->columns[size_t(it - table->names.begin())];
+        for (size_t i = 0; i < values.size(); ++i) {
+            s.wavelengths_nm.push_back(float(table->lambda_nm[i]));
+            s.values.push_back(float(values[i]));
+        }
     } else if (t.Has("value")) {
         NAVE_RETURN_IF_ERROR(t.Float("value", &s.value));
     } else {
-        return InvalidArgumentError("{}: {}: a spectrum table needs value, wavelengths_nm + values, or blackbody_k",
+        return InvalidArgumentError("{}: {}: a spectrum table needs value, wavelengths_nm + values, csv + column, or blackbody_k",
                                     WhereIs(*n), Name(key));
     }
     NAVE_RETURN_IF_ERROR(t.Finish());

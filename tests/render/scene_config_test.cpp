@@ -130,6 +130,20 @@ TEST(SceneConfig, MissingCameraAndBadMode) {
     EXPECT_NE(c.status().message().find("bidir"), std::string::npos);
 }
 
+TEST(SceneConfig, SpectrumFromCsvColumnOfNavesData) {
+    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.glass_blue]\n"
+                              "type = \"thin_dielectric\"\ntransmittance = { csv = \"stained_glass_approx.csv\", "
+                              "column = \"glass_blue\" }\n", "g.toml");
+    ASSERT_TRUE(c.ok()) << c.status().ToString();
+    const SpectrumSpec& t = c->materials.at("glass_blue").transmittance;
+    EXPECT_EQ(t.kind, SpectrumSpec::Kind::kTable);
+    EXPECT_GT(t.Evaluate(450), 2 * t.Evaluate(620));  // blue glass passes blue, not red
+    auto bad = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.x]\n"
+                                "reflectance = { csv = \"stone_approx.csv\", column = \"marble\" }\n", "g.toml");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.status().message().find("limestone"), std::string::npos) << bad.status().message();
+}
+
 TEST(SpectrumSpec, BlackbodyPeaksAtWien) {
     SpectrumSpec s;
     s.kind = SpectrumSpec::Kind::kBlackbody;
