@@ -64,8 +64,9 @@ struct SurfaceHit {
 
 class Engine {
   public:
-    Engine(const RenderScene& scene, Film* film, RenderStats* stats)
-        : scene_(scene),
+    Engine(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker)
+        : picker_(picker ? std::move(picker) : BrickPicker(PickFullestBrick)),
+          scene_(scene),
           film_(film),
           stats_(stats),
           tree_(scene.source->tree()),
@@ -110,6 +111,7 @@ class Engine {
         return RngKey{scene_.settings.seed, r.pixel, r.sample, r.depth, iteration_, stream};
     }
 
+    BrickPicker picker_;
     const RenderScene& scene_;
     Film* film_;
     RenderStats* stats_;
@@ -395,7 +397,14 @@ void Engine::Flush(Outbox& out, const LocalCounters& c) {
 
 Status Engine::Drain() {
     std::vector<RayRecord> batch;
-    for (uint32_t b = queues_.Fullest(); b != store::kNoBrick; b = queues_.Fullest()) {
+    std::vector<size_t> waiting(queues_.brick_count());
+    for (;;) {
+        size_t total = 0;
+        for (uint32_t i = 0; i < queues_.brick_count(); ++i) total += waiting[i] = queues_.Waiting(i);
+        if (total == 0) break;
+        const uint32_t b = picker_(waiting, *scene_.source);
+        NAVE_CHECK(b < waiting.size() && waiting[b] > 0) << "the brick picker chose brick " << b
+                                                         << " which has no rays waiting";
         stats_->peak_queue_bytes = std::max<uint64_t>(stats_->peak_queue_bytes, queues_.MemoryBytes());
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, scene_.source->Acquire(b));
         queues_.Take(b, kMaxBatch, &batch);
@@ -694,13 +703,17 @@ Status Engine::Run() {
 
 }  // namespace
 
-Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats) {
+uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource&) {
+    return uint32_t(std::max_element(waiting.begin(), waiting.end()) - waiting.begin());
+}
+
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker) {
     NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
     int threads = scene.settings.threads > 0 ? scene.settings.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     Status status;
     arena.execute([&] {
-        Engine engine(scene, film, stats);
+        Engine engine(scene, film, stats, std::move(picker));
         status = engine.Run();
     });
     return status;

@@ -13,6 +13,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "core/spectrum.h"
 #include "core/status.h"
@@ -40,8 +42,17 @@ struct RenderStats {
     int iterations = 0;            ///< photon mode: SPPM iterations completed
 };
 
+/// The scheduling policy: which brick to process next, given the rays waiting in every brick's queue
+/// (indexed by brick id; never called with all queues empty). Return a brick with waiting rays. The default
+/// picks the brick with the most rays waiting (the paper's load balancing); the out-of-core pager replaces
+/// it to weigh residency and prefetching. Called from the scheduler thread only.
+using BrickPicker = std::function<uint32_t(const std::vector<size_t>& waiting, const BrickSource& source)>;
+
+/// The default policy: the most rays waiting, lowest id on ties.
+uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource& source);
+
 /// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's resolution.
-/// Thread count: scene.settings.threads (0: all cores).
-Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats);
+/// Thread count: scene.settings.threads (0: all cores). `picker` empty: PickFullestBrick.
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker = {});
 
 }  // namespace nave::render

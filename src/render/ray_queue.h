@@ -9,7 +9,6 @@
 #include <mutex>
 #include <vector>
 
-#include "store/brick_tree.h"
 
 namespace nave::render {
 
@@ -55,20 +54,6 @@ class BrickQueues {
         size_t n = 0;
         for (const auto& q : queues_) n += q->size.load(std::memory_order_relaxed);
         return n;
-    }
-    /// The brick with the most rays waiting (lowest id on ties), or kNoBrick when all queues are empty.
-    /// This is the scheduling policy of the paper's load balancing; the pager may weigh residency too.
-    uint32_t Fullest() const {
-        uint32_t best = store::kNoBrick;
-        size_t best_n = 0;
-        for (uint32_t b = 0; b < queues_.size(); ++b) {
-            size_t n = Waiting(b);
-            if (n > best_n) {
-                best_n = n;
-                best = b;
-            }
-        }
-        return best;
     }
     /// Bytes held by the queues (for statistics and budgets).
     size_t MemoryBytes() const {

@@ -151,6 +151,28 @@ TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePath) {
     EXPECT_LT(MaxRelativeDifference(*many->film, *many_more_threads->film), 1e-9);
 }
 
+TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
+    // Process bricks emptiest-first and highest-id-first instead of fullest-first: the same image.
+    std::string config = fmt::format(fmt::runtime(kClutter), "path");
+    auto fullest = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
+    ASSERT_TRUE(fullest);
+    for (int policy = 0; policy < 2; ++policy) {
+        Film film(fullest->film->width(), fullest->film->height(), fullest->config.output);
+        RenderStats stats;
+        BrickPicker picker = [policy](const std::vector<size_t>& waiting, const BrickSource&) {
+            uint32_t best = store::kNoBrick;
+            for (uint32_t b = 0; b < waiting.size(); ++b) {
+                if (waiting[b] == 0) continue;
+                if (best == store::kNoBrick || (policy == 0 ? waiting[b] < waiting[best] : true)) best = b;
+            }
+            return best;
+        };
+        ASSERT_TRUE(RenderStreams(fullest->scene, &film, &stats, picker).ok());
+        EXPECT_GT(stats.batches, fullest->stats.batches / 2);
+        EXPECT_LT(MaxRelativeDifference(*fullest->film, film), 1e-9) << "policy " << policy;
+    }
+}
+
 TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePhoton) {
     std::string config = fmt::format(fmt::runtime(kClutter), "photon");
     auto one = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 1, 1);
