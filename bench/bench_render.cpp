@@ -64,7 +64,10 @@ std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
     auto f = std::make_unique<Fixture>();
     auto device = EmbreeDevice::Create();
     GridBricks grid = SplitIntoGridBricks(mesh, split, split, split);
-    std::vector<store::MaterialRecord> materials = {{"floor"}, {"ball"}, {"chrome"}};
+    std::vector<store::MaterialRecord> materials(3);
+    materials[0].name = "floor";
+    materials[1].name = "ball";
+    materials[2].name = "chrome";
     f->source = std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
     f->config = ParseSceneConfig(fmt::format(fmt::runtime(kConfig), mode), "bench.toml").value();
     f->scene = BuildRenderScene(f->config, *f->source).value();

@@ -317,7 +317,7 @@ bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, c
     if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
         visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
     }
-    if (r.depth + 1 >= uint32_t(scene_.settings.max_depth)) return false;
+    if (uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth)) return false;
     VertexRng rng(Key(r, kStreamPhoton));
     std::optional<BsdfSample> bs =
         bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice), Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),

@@ -43,7 +43,11 @@ StatusOr<std::unique_ptr<MemoryBrickSource>> OpenProceduralSource(const std::str
     NAVE_ASSIGN_OR_RETURN(ProceduralModel model, MakeProceduralModel(name));
     GridBricks grid = SplitIntoGridBricks(model.mesh, bricks, bricks, bricks);
     std::vector<store::MaterialRecord> materials;
-    for (const auto& n : model.material_names) materials.push_back(store::MaterialRecord{n});
+    for (const auto& n : model.material_names) {
+        store::MaterialRecord r;
+        r.name = n;
+        materials.push_back(r);
+    }
     return std::make_unique<MemoryBrickSource>(std::move(device), grid.tree, std::move(grid.meshes),
                                                std::move(materials));
 }

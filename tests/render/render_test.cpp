@@ -221,7 +221,11 @@ Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh&
         NAVE_CHECK_EQ(id, uint32_t(b));
     }
     std::vector<store::MaterialRecord> materials;
-    for (const auto& name : names) materials.push_back(store::MaterialRecord{name});
+    for (const auto& name : names) {
+        store::MaterialRecord r;
+        r.name = name;
+        materials.push_back(r);
+    }
     return writer->Finish(materials, grid.tree, mesh.TriangleCount());
 }
 
