@@ -13,6 +13,7 @@
 #include "core/progress.h"
 #include "core/sampling.h"
 #include "render/brick_walk.h"
+#include "render/photon_portals.h"
 #include "render/ray_queue.h"
 #include "render/ray.h"
 #include "render/rng.h"
@@ -105,10 +106,18 @@ class Engine {
                      const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick, Outbox& out,
                      LocalCounters& c);
     void Escape(const RayRecord& r);
+    /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin glass
+    /// (windows) lets it through, scaled by the pane's transmittance at that angle: panes do not bend rays.
+    bool ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const;
+    /// A straight pass through thin glass: the path continues in the same direction, and this is not a
+    /// scattering event (depth, MIS state unchanged), as for shadow rays.
+    static bool IsPassThrough(const SurfaceMaterial& m, const BsdfSample& bs) {
+        return m.kind == MaterialConfig::Kind::kThinDielectric && bs.IsTransmission();
+    }
     void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
     SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
     RngKey Key(const RayRecord& r, uint32_t stream) const {
-        return RngKey{scene_.settings.seed, r.pixel, r.sample, r.depth, iteration_, stream};
+        return RngKey{scene_.settings.seed, r.pixel, r.sample, r.vertex, iteration_, stream};
     }
 
     BrickPicker picker_;
@@ -119,6 +128,9 @@ class Engine {
     BrickQueues<RayRecord> queues_;
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
+    bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
+        return m.kind == MaterialConfig::Kind::kThinDielectric;
+    });
     std::unique_ptr<VisiblePoints> visible_;  // photon mode
 
     struct Emitter {
@@ -128,7 +140,9 @@ class Engine {
         Vec3f v0, v1, v2, n;  // kTriangle
         float area = 0;
         const Spectrum* emission = nullptr;
+        int portal = -1;      // kLight (sun, directional): index in portals_ when aiming at windows
     };
+    std::vector<PortalProjection> portals_;
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     Vec3f scene_center_;
@@ -178,6 +192,25 @@ void Engine::Escape(const RayRecord& r) {
         }
     }
     if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda);
+}
+
+bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const {
+    float t0 = r.t_enter;
+    for (;;) {
+        ++c.shadow_segments;
+        if (!has_thin_glass_) return !brick.Occluded(r.origin, r.dir, t0, t1);
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
+        SurfaceHit h = MakeSurfaceHit(brick, hit);
+        const SurfaceMaterial& m = *h.material;
+        if (m.kind != MaterialConfig::Kind::kThinDielectric) return false;
+        SampledSpectrum reflected, transmitted;
+        ThinDielectricBxdf(m.eta.Sample(r.lambda), m.transmittance.Sample(r.lambda))
+            .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
+        r.beta *= transmitted;
+        if (r.beta.IsZero()) return false;
+        t0 = hit.t + 1e-5f * (1.f + std::abs(hit.t));  // past this pane
+    }
 }
 
 void Engine::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c) {
@@ -286,6 +319,13 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
                                                Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)), r.lambda);
     if (!bs) return false;
     r.beta *= bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        if (r.beta.IsZero()) return false;
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
     r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
     r.prev_pdf = bs->pdf;
     if (r.depth >= 2) {
@@ -324,6 +364,16 @@ bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, c
                     r.lambda, TransportMode::kImportance);
     if (!bs) return false;
     SampledSpectrum beta = r.beta * bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        // Through a window pane: not a bounce, so a photon that arrives next at a diffuse surface is still
+        // direct sunlight, which next-event estimation through glass already counts.
+        r.beta = beta;
+        if (r.beta.IsZero()) return false;
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
     // Russian roulette on the photon's change of power (pbrt-v4 SPPM photon pass).
     float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
     if (rng.Uniform(kDimRoulette) < q) return false;
@@ -340,8 +390,7 @@ void Engine::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Out
     for (;;) {
         const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
         if (r.kind == kShadowRay) {
-            ++c.shadow_segments;
-            if (brick.Occluded(r.origin, r.dir, r.t_enter, t1)) return;
+            if (!ShadowThroughBrick(r, brick, t1, c)) return;
             uint32_t next = Route(r, r.t_exit, b);
             if (next == store::kNoBrick) {
                 film_->AddSample(r.pixel, r.beta, r.lambda);  // unoccluded all the way
@@ -487,16 +536,71 @@ Status Engine::BuildEmitters() {
     scene_center_ = bounds.Center();
     scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
     const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
+    const float kPiF = 3.14159265358979f;
+
+    // One pass over the bricks that hold emissive or portal materials. A triangle stored in several bricks
+    // (it crosses cells) is kept only in the brick whose cell holds its centroid.
+    const bool want_portals = scene_.settings.photon_target == RenderSettings::PhotonTarget::kPortals;
+    bool any_emissive = false, any_portal = false;
+    for (const SurfaceMaterial& m : scene_.materials) {
+        any_emissive |= m.emissive;
+        any_portal |= m.portal;
+    }
+    if (want_portals && !any_portal) {
+        return InvalidArgumentError("render.photon_target = \"portals\" but no material has portal = true");
+    }
     std::vector<double> weights;
+    std::vector<Emitter> triangles;
+    std::vector<double> triangle_weights;
+    std::vector<std::array<Vec3f, 3>> portal_triangles;
+    if (any_emissive || (want_portals && any_portal)) {
+        for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
+            NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
+            const store::BrickMesh& m = h->mesh();
+            for (size_t t = 0; t < m.TriangleCount(); ++t) {
+                uint32_t mat = m.material_ids[t];
+                if (mat >= scene_.materials.size()) continue;
+                const SurfaceMaterial& sm = scene_.materials[mat];
+                if (!sm.emissive && !(want_portals && sm.portal)) continue;
+                Vec3f v0 = m.positions[m.indices[3 * t]], v1 = m.positions[m.indices[3 * t + 1]],
+                      v2 = m.positions[m.indices[3 * t + 2]];
+                if (tree_.Locate((v0 + v1 + v2) * (1.f / 3.f)) != b) continue;
+                if (want_portals && sm.portal) portal_triangles.push_back({v0, v1, v2});
+                if (!sm.emissive) continue;
+                Emitter e;
+                e.kind = Emitter::Kind::kTriangle;
+                e.v0 = v0;
+                e.v1 = v1;
+                e.v2 = v2;
+                Vec3f c = Cross(v1 - v0, v2 - v0);
+                e.area = 0.5f * Length(c);
+                if (e.area <= 0) continue;
+                e.n = Normalize(c);
+                e.emission = &sm.emission;
+                triangles.push_back(e);
+                // Two-sided Lambertian emitter: power = L pi A per side.
+                triangle_weights.push_back(MeanVisible(*e.emission) * 2 * kPiF * e.area);
+            }
+        }
+    }
     for (const Light& l : scene_.lights) {
         Emitter e;
         e.light = &l;
         float w = MeanVisible(l.spectrum);
+        float target_area = disk_area;
+        if (want_portals && (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional)) {
+            PortalProjection projection(portal_triangles, l.to_light);
+            if (!projection.empty()) {
+                e.portal = int(portals_.size());
+                target_area = float(projection.total_area());
+                portals_.push_back(std::move(projection));
+            }
+        }
         switch (l.kind) {
-            case Light::Kind::kSun: w *= l.SunSolidAngle() * disk_area; break;
-            case Light::Kind::kDirectional: w *= disk_area; break;
+            case Light::Kind::kSun: w *= l.SunSolidAngle() * target_area; break;
+            case Light::Kind::kDirectional: w *= target_area; break;
             case Light::Kind::kPoint:
-            case Light::Kind::kSpot: w *= 4 * 3.14159265358979f; break;
+            case Light::Kind::kSpot: w *= 4 * kPiF; break;
         }
         emitters_.push_back(e);
         weights.push_back(w);
@@ -505,36 +609,10 @@ Status Engine::BuildEmitters() {
         Emitter e;
         e.kind = Emitter::Kind::kSky;
         emitters_.push_back(e);
-        weights.push_back(MeanVisible(scene_.sky_radiance) * 4 * 3.14159265358979f * disk_area);
+        weights.push_back(MeanVisible(scene_.sky_radiance) * 4 * kPiF * disk_area);
     }
-    // Emissive triangles: one pass over the bricks that hold emissive materials. A triangle stored in several
-    // bricks (it crosses cells) is kept only in the brick whose cell holds its centroid.
-    bool any_emissive = std::any_of(scene_.materials.begin(), scene_.materials.end(),
-                                    [](const SurfaceMaterial& m) { return m.emissive; });
-    if (any_emissive) {
-        for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
-            NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
-            const store::BrickMesh& m = h->mesh();
-            for (size_t t = 0; t < m.TriangleCount(); ++t) {
-                uint32_t mat = m.material_ids[t];
-                if (mat >= scene_.materials.size() || !scene_.materials[mat].emissive) continue;
-                Emitter e;
-                e.kind = Emitter::Kind::kTriangle;
-                e.v0 = m.positions[m.indices[3 * t]];
-                e.v1 = m.positions[m.indices[3 * t + 1]];
-                e.v2 = m.positions[m.indices[3 * t + 2]];
-                if (tree_.Locate((e.v0 + e.v1 + e.v2) * (1.f / 3.f)) != b) continue;
-                Vec3f c = Cross(e.v1 - e.v0, e.v2 - e.v0);
-                e.area = 0.5f * Length(c);
-                if (e.area <= 0) continue;
-                e.n = Normalize(c);
-                e.emission = &scene_.materials[mat].emission;
-                emitters_.push_back(e);
-                // Two-sided Lambertian emitter: power = L pi A per side.
-                weights.push_back(MeanVisible(*e.emission) * 2 * 3.14159265358979f * e.area);
-            }
-        }
-    }
+    emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
+    weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
     double total = 0;
     for (double w : weights) total += w;
     if (emitters_.empty() || !(total > 0)) {
@@ -580,19 +658,29 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
             if (e.kind == Emitter::Kind::kLight) {
                 const Light& l = *e.light;
                 switch (l.kind) {
-                    case Light::Kind::kSun: {
-                        Vec3f to = Frame::FromZ(l.to_light).FromLocal(SampleUniformCone(u2, l.cos_sun));
-                        r.origin = disc_origin(l.to_light);
+                    case Light::Kind::kSun:
+                    case Light::Kind::kDirectional: {
+                        const bool sun = l.kind == Light::Kind::kSun;
+                        Vec3f to = sun ? Frame::FromZ(l.to_light).FromLocal(SampleUniformCone(u2, l.cos_sun))
+                                       : l.to_light;
+                        // Area density of the start point on the plane facing the light: 1/A on the disc,
+                        // count(x)/A_total on the portals' projections (photon_portals.h).
+                        float area = disk_area;
+                        if (e.portal >= 0) {
+                            const PortalProjection& portals = portals_[size_t(e.portal)];
+                            int coverage = 1;
+                            Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
+                            r.origin = p + to * (2 * scene_radius_);
+                            area = float(portals.total_area()) / float(coverage);
+                        } else {
+                            r.origin = disc_origin(l.to_light);
+                        }
                         r.dir = -to;
-                        // L cos / (p_area p_dir) with p_area = 1/A, p_dir = 1/Omega.
-                        r.beta = l.spectrum.Sample(lambda) * (Dot(to, l.to_light) * disk_area * l.SunSolidAngle());
+                        // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E / p_area.
+                        r.beta = sun ? l.spectrum.Sample(lambda) * (Dot(to, l.to_light) * area * l.SunSolidAngle())
+                                     : l.spectrum.Sample(lambda) * area;
                         break;
                     }
-                    case Light::Kind::kDirectional:
-                        r.origin = disc_origin(l.to_light);
-                        r.dir = -l.to_light;
-                        r.beta = l.spectrum.Sample(lambda) * disk_area;
-                        break;
                     case Light::Kind::kPoint:
                     case Light::Kind::kSpot: {
                         r.origin = l.position;

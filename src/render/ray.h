@@ -29,9 +29,10 @@ struct RayRecord {
     float t_exit = 0;      ///< end of the segment in the current brick's cell
     uint32_t pixel = 0;    ///< pixel index (y * width + x), or photon index
     uint32_t sample = 0;   ///< sample index within the pixel
-    uint16_t depth = 0;    ///< scatterings so far
+    uint16_t depth = 0;    ///< scatterings so far (straight passes through thin glass do not count)
     uint8_t kind = kPathRay;
     uint8_t flags = 0;
+    uint16_t vertex = 0;   ///< surfaces met so far, passes through thin glass included (keys the random numbers)
     float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun)
     SampledSpectrum beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;

@@ -395,7 +395,6 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
         NAVE_RETURN_IF_ERROR(r.Spectrum("eta", &m->eta));
         NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
-        m->portal = true;
     } else if (type == "black") {
         m->kind = MaterialConfig::Kind::kBlack;
     } else {
@@ -428,6 +427,16 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Int("seed", &s->seed, 0, INT64_MAX));
     NAVE_RETURN_IF_ERROR(r.Int("threads", &s->threads, 0, 4096));
     NAVE_RETURN_IF_ERROR(r.Int("wave_paths", &s->wave_paths, 1024, int64_t(1) << 30));
+    std::string target = "bounds";
+    NAVE_RETURN_IF_ERROR(r.String("photon_target", &target));
+    if (target == "bounds") {
+        s->photon_target = RenderSettings::PhotonTarget::kBounds;
+    } else if (target == "portals") {
+        s->photon_target = RenderSettings::PhotonTarget::kPortals;
+    } else {
+        return InvalidArgumentError("{}: render.photon_target: '{}' (expected \"bounds\" or \"portals\")",
+                                    r.WhereTable(), target);
+    }
     return r.Finish();
 }
 

@@ -86,7 +86,7 @@ struct MaterialConfig {
     SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< tint of thin glass per pass
     float roughness = 0.f;
     std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface
-    bool portal = false;             ///< photons from the sun are aimed at surfaces of this material
+    bool portal = false;             ///< with render.photon_target = "portals", sun photons aim at it
     std::string where;
 };
 
@@ -103,6 +103,10 @@ struct RenderSettings {
     uint64_t seed = 1;
     int threads = 0;                 ///< 0: all cores
     uint32_t wave_paths = 1u << 20;  ///< camera paths in flight at once
+    /// Where photons from the sun and directional lights are aimed: the model's bounds projected onto the
+    /// light's direction, or the triangles of materials marked `portal` (windows) only.
+    enum class PhotonTarget { kBounds, kPortals };
+    PhotonTarget photon_target = PhotonTarget::kBounds;
 };
 
 struct OutputConfig {

@@ -262,3 +262,59 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
 
 }  // namespace
 }  // namespace nave::render
+
+namespace nave::render {
+namespace {
+
+// A closed room (black walls and roof) with a thin glass window in the roof and the sun at the zenith: the
+// floor under the window receives E = L_sun Omega T_tot, T_tot = (1-r)^2 tau / (1 - r^2 tau^2) for a pane of
+// internal transmittance tau (Stokes; Hecht, Optics §9.7), r = ((n-1)/(n+1))^2 at normal incidence.
+// Shadow rays pass through thin glass, so path tracing gets this by next-event estimation; photon mode must
+// give the same (no double counting by photons that merely crossed the pane).
+TEST_F(RenderTest, SunThroughThinGlassWindow) {
+    constexpr const char* kRoom = R"(
+[camera]
+position = [0.3, 0.2, 2.0]
+look_at = [0.3, 0.2, 0]
+up = [0, 1, 0]
+fov_deg = 10
+resolution = [8, 8]
+[sun]
+direction = [0, 0, 1]
+radiance = 1000.0
+[materials.floor]
+reflectance = 0.5
+[materials.wall]
+type = "black"
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+transmittance = 0.8
+portal = true
+[render]
+mode = "{}"
+spp = 4
+iterations = 32
+photons_per_iteration = 1000
+photon_target = "{}"
+max_depth = 1
+)";
+    float cos_sun = std::cos(0.2666f * 3.14159265f / 180.f);
+    double omega = 2 * 3.14159265 * (1 - cos_sun);
+    double r = 0.04, tau = 0.8;
+    double t_tot = (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
+    double expected = 0.5 / 3.14159265 * 1000.0 * omega * t_tot;
+    std::vector<std::string> names = {"floor", "wall", "window"};
+    auto path = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "path", "bounds"), 2);
+    ASSERT_TRUE(path);
+    EXPECT_NEAR(MeanY(*path->film), expected, 0.01 * expected);
+    for (const char* target : {"bounds", "portals"}) {
+        auto photon = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "photon", target), 2);
+        ASSERT_TRUE(photon);
+        // One wavelength set per iteration: 32 sets give the flat spectrum's Y to about 0.5 %.
+        EXPECT_NEAR(MeanY(*photon->film), expected, 0.015 * expected) << target;
+    }
+}
+
+}  // namespace
+}  // namespace nave::render

@@ -9,6 +9,7 @@
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
+#include "render/procedural_meshes.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
 
@@ -55,6 +56,23 @@ inline double MeanY(const Film& film) {
     double sum = 0;
     for (size_t p = 0; p < film.pixel_count(); ++p) sum += film.PixelXYZ(uint32_t(p)).y;
     return sum / double(film.pixel_count());
+}
+
+/// A 4 x 4 x 3 m closed room (materials: 0 floor, 1 walls and roof) with a 2 x 2 m window (material 2) in
+/// the roof.
+inline store::BrickMesh RoomWithRoofWindow() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 4, 0);                  // floor, facing up
+    AppendQuad(&m, {2, 0, 1.5f}, {0, 2, 0}, {0, 0, 1.5f}, 1, 1);            // walls
+    AppendQuad(&m, {-2, 0, 1.5f}, {0, 0, 1.5f}, {0, 2, 0}, 1, 1);
+    AppendQuad(&m, {0, 2, 1.5f}, {0, 0, 1.5f}, {2, 0, 0}, 1, 1);
+    AppendQuad(&m, {0, -2, 1.5f}, {2, 0, 0}, {0, 0, 1.5f}, 1, 1);
+    AppendQuad(&m, {1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);             // roof around a 2 x 2 m hole
+    AppendQuad(&m, {-1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);
+    AppendQuad(&m, {0, 1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
+    AppendQuad(&m, {0, -1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
+    AppendQuad(&m, {0, 0, 3}, {1, 0, 0}, {0, 1, 0}, 2, 2);                   // the window
+    return m;
 }
 
 }  // namespace nave::render::testing

@@ -35,11 +35,13 @@ reflectance = { wavelengths_nm = [400, 700], values = [0.5, 0.7] }
 [materials.glass_clear]
 type = "dielectric"
 eta = 1.52
+portal = true
 
 [render]
 mode = "photon"
 iterations = 8
 seed = 42
+photon_target = "portals"
 
 [output]
 aovs = ["albedo", "depth"]
@@ -63,6 +65,7 @@ TEST(SceneConfig, ParsesEveryPart) {
     EXPECT_TRUE(c->materials.at("glass_clear").portal);
     EXPECT_EQ(c->render.mode, RenderSettings::Mode::kPhoton);
     EXPECT_EQ(c->render.seed, 42u);
+    EXPECT_EQ(c->render.photon_target, RenderSettings::PhotonTarget::kPortals);
     EXPECT_TRUE(c->output.aov_albedo && c->output.aov_depth && !c->output.aov_normal);
 }
 

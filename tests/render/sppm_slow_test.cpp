@@ -110,5 +110,48 @@ seed = 9
     EXPECT_NEAR(MeanY(*many->film), mean, 0.03 * mean);
 }
 
+// Indirect light through a window: photons aimed at the portals only must give the same image as photons
+// aimed at the model's bounds (the portal estimator is unbiased, also where two portals overlap as seen
+// from the sun: here a second pane hangs below the roof window).
+TEST(SppmSlow, PortalPhotonsMatchBoundsPhotons) {
+    ProgressBar::SetEnabled(false);
+    store::BrickMesh m = testing::RoomWithRoofWindow();
+    AppendQuad(&m, {0.4f, 0.3f, 1.8f}, {0.5f, 0, 0}, {0, 0.5f, 0}, 1, 2);  // a pane under the window
+    constexpr const char* kRoom = R"(
+[camera]
+position = [1.8, 1.8, 2.5]
+look_at = [0, 0, 0]
+fov_deg = 70
+resolution = [12, 12]
+[sun]
+direction = [0.1, 0.05, 1]
+radiance = 1000.0
+[materials.floor]
+reflectance = 0.6
+[materials.wall]
+reflectance = 0.6
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+transmittance = 0.9
+portal = true
+[render]
+mode = "photon"
+iterations = 8
+photons_per_iteration = {}
+photon_target = "{}"
+initial_radius_m = 0.1
+max_depth = 6
+seed = 4
+)";
+    std::vector<std::string> names = {"floor", "wall", "window"};
+    auto bounds = Render(m, names, fmt::format(fmt::runtime(kRoom), 400000, "bounds"), 2);
+    auto portals = Render(m, names, fmt::format(fmt::runtime(kRoom), 60000, "portals"), 2);
+    ASSERT_TRUE(bounds && portals);
+    double b = MeanY(*bounds->film), p = MeanY(*portals->film);
+    EXPECT_GT(b, 0);
+    EXPECT_NEAR(p, b, 0.03 * b) << "bounds " << b << " portals " << p;
+}
+
 }  // namespace
 }  // namespace nave::render
