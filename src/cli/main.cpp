@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
     nave::cli::RegisterSpectrumCommand(app, run);
     nave::cli::RegisterPreprocessCommand(app, run);
     nave::cli::RegisterGenerateCommand(app, run);
+    nave::cli::RegisterRenderCommand(app, run);
 
     try {
         app.parse(argc, argv);

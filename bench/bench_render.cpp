@@ -1,0 +1,115 @@
+// Ray streams over bricks: rays per second for the same scene cut into 1, 8 and 64 bricks, all resident
+// (the cost of the decomposition itself: queueing, moving rays between bricks, per-brick Embree scenes),
+// and photons per second of the SPPM photon pass.
+//   build/release/bench/bench_render --benchmark_counters_tabular=true
+
+#include <benchmark/benchmark.h>
+
+#include "core/progress.h"
+#include "render/brick_source.h"
+#include "render/film.h"
+#include "render/integrator.h"
+#include "render/procedural_meshes.h"
+#include "render/scene.h"
+#include "render/scene_config.h"
+
+namespace nave::render {
+namespace {
+
+/// About 1.1 M triangles: a tessellated floor, a grid of 16 spheres, boxes; lit by sun and sky.
+store::BrickMesh BenchMesh() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {8, 0, 0}, {0, 8, 0}, 200, 0);
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+            AppendSphere(&m, {-6 + 4.f * i, -6 + 4.f * j, 1.2f}, 1.0f, 96, 192, uint32_t((i + j) % 2 + 1));
+    for (int i = 0; i < 5; ++i) AppendBox(&m, Bounds3f({-7.5f + 3 * i, 6.5f, 0}, {-6.5f + 3 * i, 7.5f, 4.f}), 0);
+    return m;
+}
+
+constexpr const char* kConfig = R"(
+[camera]
+position = [10, -12, 7]
+look_at = [0, 0, 0.5]
+fov_deg = 50
+resolution = [256, 192]
+[sun]
+direction = [0.3, -0.4, 0.85]
+radiance = 10000.0
+[sky]
+radiance = 0.5
+[materials.floor]
+reflectance = 0.6
+[materials.ball]
+reflectance = 0.4
+[materials.chrome]
+type = "conductor"
+roughness = 0.3
+[render]
+mode = "{}"
+spp = 4
+iterations = 1
+photons_per_iteration = 1000000
+max_depth = 6
+)";
+
+struct Fixture {
+    std::unique_ptr<MemoryBrickSource> source;
+    SceneConfig config;
+    RenderScene scene;
+};
+
+std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
+    static const store::BrickMesh mesh = BenchMesh();
+    auto f = std::make_unique<Fixture>();
+    auto device = EmbreeDevice::Create();
+    GridBricks grid = SplitIntoGridBricks(mesh, split, split, split);
+    std::vector<store::MaterialRecord> materials(3);
+    materials[0].name = "floor";
+    materials[1].name = "ball";
+    materials[2].name = "chrome";
+    f->source = std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
+    f->config = ParseSceneConfig(fmt::format(fmt::runtime(kConfig), mode), "bench.toml").value();
+    f->scene = BuildRenderScene(f->config, *f->source).value();
+    for (uint32_t b = 0; b < f->source->brick_count(); ++b) (void)f->source->Acquire(b);  // all resident
+    return f;
+}
+
+void BM_PathRays(benchmark::State& state) {
+    ProgressBar::SetEnabled(false);
+    auto f = MakeFixture(int(state.range(0)), "path");
+    uint64_t rays = 0, moves = 0, segments = 0;
+    for (auto _ : state) {
+        Film film(f->config.camera.width, f->config.camera.height, f->config.output);
+        RenderStats stats;
+        if (!RenderStreams(f->scene, &film, &stats).ok()) state.SkipWithError("render failed");
+        rays += stats.rays;
+        segments += stats.segments_traced + stats.shadow_segments;
+        moves += stats.brick_moves;
+    }
+    state.counters["bricks"] = double(f->source->brick_count());
+    state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
+    state.counters["moves/ray"] = double(moves) / double(std::max<uint64_t>(1, rays));
+    state.counters["segments/ray"] = double(segments) / double(std::max<uint64_t>(1, rays));
+}
+BENCHMARK(BM_PathRays)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+void BM_Photons(benchmark::State& state) {
+    ProgressBar::SetEnabled(false);
+    auto f = MakeFixture(int(state.range(0)), "photon");
+    uint64_t photons = 0;
+    for (auto _ : state) {
+        Film film(f->config.camera.width, f->config.camera.height, f->config.output);
+        RenderStats stats;
+        if (!RenderStreams(f->scene, &film, &stats).ok()) state.SkipWithError("render failed");
+        photons += stats.photons;
+    }
+    state.counters["bricks"] = double(f->source->brick_count());
+    state.counters["photons/s"] = benchmark::Counter(double(photons), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Photons)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+}  // namespace
+}  // namespace nave::render
+
+BENCHMARK_MAIN();

@@ -1,0 +1,362 @@
+#include "render/brick_source.h"
+
+#include <embree3/rtcore.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+
+namespace nave::render {
+
+// ---------------------------------------------------------------------------------------------- Embree
+
+StatusOr<std::shared_ptr<EmbreeDevice>> EmbreeDevice::Create(const std::string& config) {
+    std::shared_ptr<EmbreeDevice> device(new EmbreeDevice());
+    RTCDevice handle = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+    if (handle == nullptr) {
+        return InternalError("Embree: cannot create a device with config '{}' (error {})", config,
+                             int(rtcGetDeviceError(nullptr)));
+    }
+    device->device_ = handle;
+    rtcSetDeviceErrorFunction(
+        handle,
+        [](void* user, RTCError code, const char* message) {
+            EmbreeDevice::ErrorCallback(user, int(code), message);
+        },
+        device.get());
+    return device;
+}
+
+EmbreeDevice::~EmbreeDevice() {
+    if (device_ != nullptr) rtcReleaseDevice(static_cast<RTCDevice>(device_));
+}
+
+void EmbreeDevice::ErrorCallback(void* user, int code, const char* message) {
+    auto* self = static_cast<EmbreeDevice*>(user);
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    if (self->error_.ok()) {
+        self->error_ = Status(code == RTC_ERROR_OUT_OF_MEMORY ? StatusCode::kResourceExhausted
+                                                              : StatusCode::kInternal,
+                              fmt::format("Embree error {}: {}", code, message ? message : "(no message)"));
+    }
+}
+
+Status EmbreeDevice::TakeError(const std::string& context) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Status s = error_;
+    error_ = Status::Ok();
+    return s.ok() ? s : s.WithContext(context);
+}
+
+// ---------------------------------------------------------------------------------------------- ResidentBrick
+
+ResidentBrick::ResidentBrick(uint32_t id, Bounds3f cell, store::BrickMesh mesh)
+    : id_(id), cell_(cell), mesh_(std::move(mesh)) {}
+
+ResidentBrick::~ResidentBrick() {
+    if (scene_ != nullptr) rtcReleaseScene(static_cast<RTCScene>(scene_));
+}
+
+StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
+                                                              Bounds3f cell, store::BrickMesh mesh) {
+    // Embree reads vertex buffers with 16-byte loads: the last vertex needs 4 readable bytes after it.
+    mesh.positions.reserve(mesh.positions.size() + 1);
+    std::unique_ptr<ResidentBrick> brick(new ResidentBrick(id, cell, std::move(mesh)));
+    const store::BrickMesh& m = brick->mesh_;
+    RTCDevice dev = static_cast<RTCDevice>(device.handle());
+    RTCScene scene = rtcNewScene(dev);
+    brick->scene_ = scene;
+    const std::string context = fmt::format("building the Embree scene of brick {}", id);
+    if (scene == nullptr) return device.TakeError(context);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    if (m.TriangleCount() > 0) {
+        RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0,
+                                   sizeof(Vec3f), m.positions.size());
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0,
+                                   3 * sizeof(uint32_t), m.TriangleCount());
+        rtcCommitGeometry(geom);
+        rtcAttachGeometry(scene, geom);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(scene);
+    NAVE_RETURN_IF_ERROR(device.TakeError(context));
+    // Embree's BVH takes roughly 40-60 bytes per triangle for a medium-quality build.
+    brick->memory_bytes_ = m.MemoryBytes() + 56 * uint64_t(m.TriangleCount());
+    return brick;
+}
+
+bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = origin.x;
+    rh.ray.org_y = origin.y;
+    rh.ray.org_z = origin.z;
+    rh.ray.dir_x = dir.x;
+    rh.ray.dir_y = dir.y;
+    rh.ray.dir_z = dir.z;
+    rh.ray.tnear = t0;
+    rh.ray.tfar = t1;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(static_cast<RTCScene>(scene_), &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->triangle = rh.hit.primID;
+    hit->ng = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+    return true;
+}
+
+bool ResidentBrick::Occluded(const Vec3f& origin, const Vec3f& dir, float t0, float t1) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.tnear = t0;
+    ray.tfar = t1;
+    ray.time = 0;
+    ray.mask = 0xffffffffu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(static_cast<RTCScene>(scene_), &context, &ray);
+    return ray.tfar == -std::numeric_limits<float>::infinity();
+}
+
+// ---------------------------------------------------------------------------------------------- handles
+
+BrickHandle& BrickHandle::operator=(BrickHandle&& o) noexcept {
+    if (this != &o) {
+        Reset();
+        source_ = o.source_;
+        brick_ = o.brick_;
+        o.source_ = nullptr;
+        o.brick_ = nullptr;
+    }
+    return *this;
+}
+
+void BrickHandle::Reset() {
+    if (source_ != nullptr && brick_ != nullptr) source_->Release(brick_->id());
+    source_ = nullptr;
+    brick_ = nullptr;
+}
+
+// ---------------------------------------------------------------------------------------------- BrickSource
+
+BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
+                         std::vector<store::MaterialRecord> materials, Bounds3f bounds)
+    : device_(std::move(device)),
+      tree_(std::move(tree)),
+      cells_(std::move(cells)),
+      materials_(std::move(materials)),
+      bounds_(bounds) {
+    slots_.reserve(cells_.size());
+    for (size_t i = 0; i < cells_.size(); ++i) slots_.push_back(std::make_unique<Slot>());
+}
+
+BrickSource::~BrickSource() = default;
+
+StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
+    if (id >= slots_.size()) {
+        return InvalidArgumentError("brick {} requested but the model has {} bricks", id, slots_.size());
+    }
+    acquires_.fetch_add(1, std::memory_order_relaxed);
+    Slot& slot = *slots_[id];
+    // Pin first, then check: an evictor takes the slot lock and refuses while pins > 0.
+    slot.pins.fetch_add(1, std::memory_order_acq_rel);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire)) return BrickHandle(this, b);
+    std::lock_guard<std::mutex> lock(slot.mutex);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire)) return BrickHandle(this, b);
+    if (!slot.error.ok()) {
+        slot.pins.fetch_sub(1, std::memory_order_acq_rel);
+        return slot.error;
+    }
+    auto start = std::chrono::steady_clock::now();
+    uint64_t bytes = 0;
+    StatusOr<store::BrickMesh> mesh = LoadMesh(id, &bytes);
+    StatusOr<std::unique_ptr<ResidentBrick>> built =
+        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value())
+                  : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!built.ok()) {
+        slot.error = built.status().WithContext(fmt::format("loading brick {}", id));
+        slot.pins.fetch_sub(1, std::memory_order_acq_rel);
+        return slot.error;
+    }
+    slot.brick = std::move(built).value();
+    {
+        std::lock_guard<std::mutex> stats_lock(stats_mutex_);
+        stats_.loads += 1;
+        stats_.bytes_read += bytes;
+        stats_.load_seconds += seconds;
+        stats_.resident_bytes += slot.brick->memory_bytes();
+        stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, stats_.resident_bytes);
+    }
+    slot.ready.store(slot.brick.get(), std::memory_order_release);
+    return BrickHandle(this, slot.brick.get());
+}
+
+void BrickSource::Release(uint32_t id) {
+    uint32_t before = slots_[id]->pins.fetch_sub(1, std::memory_order_acq_rel);
+    NAVE_CHECK_GT(before, 0u) << "brick " << id << " released more often than acquired";
+}
+
+bool BrickSource::IsResident(uint32_t id) const {
+    return id < slots_.size() && slots_[id]->ready.load(std::memory_order_acquire) != nullptr;
+}
+
+bool BrickSource::Evict(uint32_t id) {
+    if (id >= slots_.size()) return false;
+    Slot& slot = *slots_[id];
+    std::lock_guard<std::mutex> lock(slot.mutex);
+    if (slot.brick == nullptr || slot.pins.load(std::memory_order_acquire) != 0) return false;
+    slot.ready.store(nullptr, std::memory_order_release);
+    // A reader that pinned between our check and the store above would hold a dangling pointer; re-check.
+    if (slot.pins.load(std::memory_order_acquire) != 0) {
+        slot.ready.store(slot.brick.get(), std::memory_order_release);
+        return false;
+    }
+    uint64_t bytes = slot.brick->memory_bytes();
+    slot.brick.reset();
+    std::lock_guard<std::mutex> stats_lock(stats_mutex_);
+    stats_.evictions += 1;
+    stats_.resident_bytes -= bytes;
+    return true;
+}
+
+BrickSourceStats BrickSource::stats() const {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    BrickSourceStats s = stats_;
+    s.acquires = acquires_.load(std::memory_order_relaxed);
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------- memory source
+
+namespace {
+Bounds3f MeshesBounds(const std::vector<store::BrickMesh>& meshes) {
+    Bounds3f b;
+    for (const auto& m : meshes) {
+        for (const Vec3f& p : m.positions) b.Extend(p);
+    }
+    return b;
+}
+}  // namespace
+
+MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                                     std::vector<store::BrickMesh> meshes,
+                                     std::vector<store::MaterialRecord> materials)
+    : BrickSource(std::move(device), tree, tree.BrickCells(uint32_t(meshes.size())), std::move(materials),
+                  MeshesBounds(meshes)),
+      meshes_(std::move(meshes)) {}
+
+StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
+    *bytes_read += meshes_[id].MemoryBytes();
+    return meshes_[id];
+}
+
+// ---------------------------------------------------------------------------------------------- grid split
+
+GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int nz) {
+    Bounds3f box;
+    for (const Vec3f& p : mesh.positions) box.Extend(p);
+    // Enlarge a little so no vertex lies on the root box (the tree tiles exactly this box).
+    Vec3f pad = box.Diagonal() * 1e-3f + Vec3f(1e-4f, 1e-4f, 1e-4f);
+    box = Bounds3f(box.min - pad, box.max + pad);
+    const int n[3] = {nx, ny, nz};
+    std::vector<float> planes[3];
+    for (int a = 0; a < 3; ++a) {
+        for (int i = 0; i <= n[a]; ++i) {
+            planes[a].push_back(i == n[a] ? box.max[a] : box.min[a] + box.Diagonal()[a] * float(i) / float(n[a]));
+        }
+    }
+    auto cell_index = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
+    // Triangles to cells by box overlap (closed boxes: a triangle on a plane goes to both sides).
+    std::vector<std::vector<uint32_t>> cell_tris(size_t(nx) * ny * nz);
+    for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
+        Bounds3f tb;
+        for (int c = 0; c < 3; ++c) tb.Extend(mesh.positions[mesh.indices[3 * t + c]]);
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = 0;
+            while (lo[a] + 1 < n[a] && planes[a][lo[a] + 1] < tb.min[a]) ++lo[a];
+            hi[a] = lo[a];
+            while (hi[a] + 1 < n[a] && planes[a][hi[a] + 1] <= tb.max[a]) ++hi[a];
+        }
+        for (int k = lo[2]; k <= hi[2]; ++k)
+            for (int j = lo[1]; j <= hi[1]; ++j)
+                for (int i = lo[0]; i <= hi[0]; ++i) cell_tris[cell_index(i, j, k)].push_back(uint32_t(t));
+    }
+    GridBricks out;
+    std::vector<uint32_t> brick_of_cell(cell_tris.size(), store::kNoBrick);
+    for (size_t c = 0; c < cell_tris.size(); ++c) {
+        if (cell_tris[c].empty()) continue;
+        brick_of_cell[c] = uint32_t(out.meshes.size());
+        store::BrickMesh m;
+        std::unordered_map<uint32_t, uint32_t> remap;
+        for (uint32_t t : cell_tris[c]) {
+            for (int v = 0; v < 3; ++v) {
+                uint32_t src = mesh.indices[3 * t + v];
+                auto [it, inserted] = remap.try_emplace(src, uint32_t(m.positions.size()));
+                if (inserted) {
+                    m.positions.push_back(mesh.positions[src]);
+                    if (mesh.HasNormals()) m.normals.push_back(mesh.normals[src]);
+                    if (mesh.HasUvs()) m.uvs.push_back(mesh.uvs[src]);
+                }
+                m.indices.push_back(it->second);
+            }
+            m.material_ids.push_back(mesh.material_ids[t]);
+        }
+        out.meshes.push_back(std::move(m));
+    }
+    // A kd-tree over the grid: split the longest index range in the middle until one cell is left.
+    std::vector<store::BrickTreeNode> nodes;
+    struct Range {
+        int lo[3], hi[3];
+    };
+    std::function<uint32_t(Range)> build = [&](Range r) -> uint32_t {
+        uint32_t index = uint32_t(nodes.size());
+        nodes.emplace_back();
+        int axis = -1, longest = 1;
+        for (int a = 0; a < 3; ++a) {
+            if (r.hi[a] - r.lo[a] > longest) {
+                longest = r.hi[a] - r.lo[a];
+                axis = a;
+            }
+        }
+        if (axis < 0) {
+            nodes[index].brick = brick_of_cell[cell_index(r.lo[0], r.lo[1], r.lo[2])];
+            return index;
+        }
+        int mid = (r.lo[axis] + r.hi[axis]) / 2;
+        Range below = r, above = r;
+        below.hi[axis] = mid;
+        above.lo[axis] = mid;
+        uint32_t c0 = build(below);
+        uint32_t c1 = build(above);
+        nodes[index].axis = uint8_t(axis);
+        nodes[index].split = planes[axis][mid];
+        nodes[index].child[0] = c0;
+        nodes[index].child[1] = c1;
+        return index;
+    };
+    build(Range{{0, 0, 0}, {nx, ny, nz}});
+    out.tree = store::BrickTree(box, std::move(nodes));
+    return out;
+}
+
+}  // namespace nave::render

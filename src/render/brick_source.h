@@ -1,0 +1,218 @@
+#pragma once
+// Access to the bricks of a model through pinned handles. The renderer never holds a brick except through a
+// BrickHandle, and never assumes that a brick it does not hold is resident: which bricks stay in memory is
+// the source's policy (StoreBrickSource keeps every brick it has loaded; the out-of-core pager replaces that
+// policy under a memory budget). A resident brick carries its decoded mesh and its Embree scene, built when
+// the brick is loaded. Embree types stay in brick_source.cpp.
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "core/status.h"
+#include "core/vecmath.h"
+#include "store/brick_mesh.h"
+#include "store/brick_tree.h"
+#include "store/material_record.h"
+
+namespace nave::store {
+class Store;
+}
+
+namespace nave::render {
+
+class EmbreeDevice;
+
+/// The nearest hit of a ray inside one brick.
+struct BrickHit {
+    float t = 0;          ///< ray parameter of the hit
+    float u = 0, v = 0;   ///< barycentrics of vertices 1 and 2 (Embree's convention)
+    uint32_t triangle = 0;
+    Vec3f ng;             ///< geometric normal, unnormalised, (v1 - v0) x (v2 - v0): front side is CCW
+};
+
+/// A brick in memory: its cell, its mesh (shading data) and its Embree scene. Immutable once built, so any
+/// number of threads may trace it at once. Built and destroyed only by a BrickSource.
+class ResidentBrick {
+  public:
+    ~ResidentBrick();
+    ResidentBrick(const ResidentBrick&) = delete;
+    ResidentBrick& operator=(const ResidentBrick&) = delete;
+
+    /// Builds the Embree scene over `mesh` (shared buffers: the mesh is not copied). Embree errors (out of
+    /// memory, invalid geometry) come back as a Status naming the brick.
+    static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id, Bounds3f cell,
+                                                          store::BrickMesh mesh);
+
+    uint32_t id() const { return id_; }
+    const Bounds3f& cell() const { return cell_; }
+    const store::BrickMesh& mesh() const { return mesh_; }
+    /// Bytes of the mesh plus an estimate of Embree's BVH (for budgets and statistics).
+    uint64_t memory_bytes() const { return memory_bytes_; }
+
+    /// The nearest hit with t in [t0, t1], or false. Thread-safe.
+    bool Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const;
+    /// Whether any triangle is hit with t in [t0, t1]. Thread-safe.
+    bool Occluded(const Vec3f& origin, const Vec3f& dir, float t0, float t1) const;
+
+  private:
+    ResidentBrick(uint32_t id, Bounds3f cell, store::BrickMesh mesh);
+    uint32_t id_;
+    Bounds3f cell_;
+    store::BrickMesh mesh_;
+    void* scene_ = nullptr;  // RTCScene
+    uint64_t memory_bytes_ = 0;
+};
+
+class BrickSource;
+
+/// A pin on a resident brick: while a handle lives, its brick stays in memory. Move-only; releasing (or
+/// destroying) the handle unpins it.
+class BrickHandle {
+  public:
+    BrickHandle() = default;
+    BrickHandle(BrickSource* source, const ResidentBrick* brick) : source_(source), brick_(brick) {}
+    BrickHandle(BrickHandle&& o) noexcept : source_(o.source_), brick_(o.brick_) { o.source_ = nullptr; o.brick_ = nullptr; }
+    BrickHandle& operator=(BrickHandle&& o) noexcept;
+    BrickHandle(const BrickHandle&) = delete;
+    BrickHandle& operator=(const BrickHandle&) = delete;
+    ~BrickHandle() { Reset(); }
+
+    void Reset();
+    const ResidentBrick* get() const { return brick_; }
+    const ResidentBrick* operator->() const { return brick_; }
+    const ResidentBrick& operator*() const { return *brick_; }
+    explicit operator bool() const { return brick_ != nullptr; }
+
+  private:
+    BrickSource* source_ = nullptr;
+    const ResidentBrick* brick_ = nullptr;
+};
+
+/// Counters a source keeps for the final statistics (all since creation).
+struct BrickSourceStats {
+    uint64_t acquires = 0;        ///< Acquire calls (brick visits)
+    uint64_t loads = 0;           ///< bricks read and built
+    uint64_t evictions = 0;       ///< bricks dropped from memory
+    uint64_t bytes_read = 0;      ///< payload bytes read from disk
+    uint64_t resident_bytes = 0;  ///< bytes of the bricks in memory now
+    uint64_t peak_resident_bytes = 0;
+    double load_seconds = 0;      ///< time spent reading, decoding and building Embree scenes
+};
+
+/// Where bricks come from, and which stay resident. Thread-safe: many workers may acquire at once; loading
+/// one brick never blocks acquiring another that is already resident (one lock per brick, double-checked
+/// as in OpenVDB's LeafBuffer).
+class BrickSource {
+  public:
+    virtual ~BrickSource();
+
+    uint32_t brick_count() const { return uint32_t(slots_.size()); }
+    const store::BrickTree& tree() const { return tree_; }
+    /// The cell of every brick, by id.
+    const std::vector<Bounds3f>& cells() const { return cells_; }
+    const std::vector<store::MaterialRecord>& materials() const { return materials_; }
+    /// Box of all geometry.
+    const Bounds3f& bounds() const { return bounds_; }
+
+    /// Pins brick `id`, loading it first if it is not resident. Errors (corrupt brick, Embree failure) name
+    /// the brick and are returned to every caller that asks for it.
+    StatusOr<BrickHandle> Acquire(uint32_t id);
+    /// Whether brick `id` is in memory now (a hint: it may be evicted right after unless pinned).
+    bool IsResident(uint32_t id) const;
+    /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's tool;
+    /// the default policy never calls it.
+    bool Evict(uint32_t id);
+    BrickSourceStats stats() const;
+
+  protected:
+    BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
+                std::vector<store::MaterialRecord> materials, Bounds3f bounds);
+    /// Reads and decodes brick `id` (no caching: the base class caches). Adds to `bytes_read`.
+    virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
+
+  private:
+    friend class BrickHandle;
+    void Release(uint32_t id);
+
+    struct Slot {
+        std::mutex mutex;                       // held while loading this brick
+        std::atomic<const ResidentBrick*> ready{nullptr};
+        std::unique_ptr<ResidentBrick> brick;
+        std::atomic<uint32_t> pins{0};
+        Status error;                           // sticky load error
+    };
+    std::shared_ptr<EmbreeDevice> device_;
+    store::BrickTree tree_;
+    std::vector<Bounds3f> cells_;
+    std::vector<store::MaterialRecord> materials_;
+    Bounds3f bounds_;
+    std::vector<std::unique_ptr<Slot>> slots_;
+    mutable std::mutex stats_mutex_;
+    BrickSourceStats stats_;
+    std::atomic<uint64_t> acquires_{0};
+};
+
+/// Bricks read from a store file on first touch and kept resident.
+class StoreBrickSource final : public BrickSource {
+  public:
+    static StatusOr<std::unique_ptr<StoreBrickSource>> Open(const std::filesystem::path& path,
+                                                            std::shared_ptr<EmbreeDevice> device);
+    ~StoreBrickSource() override;
+    const store::Store& store() const { return *store_; }
+
+  protected:
+    StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+
+  private:
+    StoreBrickSource(std::unique_ptr<store::Store> store, std::shared_ptr<EmbreeDevice> device);
+    std::unique_ptr<store::Store> store_;
+};
+
+/// Bricks held in memory from the start (tests, benchmarks). "Loading" copies the mesh.
+class MemoryBrickSource final : public BrickSource {
+  public:
+    MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                      std::vector<store::BrickMesh> meshes, std::vector<store::MaterialRecord> materials);
+
+  protected:
+    StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+
+  private:
+    std::vector<store::BrickMesh> meshes_;
+};
+
+/// Cuts `mesh` into an nx * ny * nz grid of bricks over its bounds (slightly enlarged), as preprocess does:
+/// every triangle goes to every cell its box overlaps. For tests and benchmarks that compare brick counts.
+struct GridBricks {
+    store::BrickTree tree;
+    std::vector<store::BrickMesh> meshes;
+};
+GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int nz);
+
+/// The process's Embree device. Embree errors reported through its callback are kept and turned into a
+/// Status by the call that caused them.
+class EmbreeDevice {
+  public:
+    /// `config` is Embree's device configuration string ("threads=4"); empty for the defaults.
+    static StatusOr<std::shared_ptr<EmbreeDevice>> Create(const std::string& config = "");
+    ~EmbreeDevice();
+    EmbreeDevice(const EmbreeDevice&) = delete;
+    EmbreeDevice& operator=(const EmbreeDevice&) = delete;
+
+    void* handle() const { return device_; }  // RTCDevice
+    /// The last error reported by Embree's callback (and clears it), or Ok.
+    Status TakeError(const std::string& context);
+
+  private:
+    EmbreeDevice() = default;
+    static void ErrorCallback(void* user, int code, const char* message);
+    void* device_ = nullptr;
+    std::mutex mutex_;
+    Status error_;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,132 @@
+#include "render/film.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/image_io.h"
+
+namespace nave::render {
+namespace {
+
+template <typename T>
+void AtomicAdd(std::atomic<T>& a, T v) {
+    T old = a.load(std::memory_order_relaxed);
+    while (!a.compare_exchange_weak(old, old + v, std::memory_order_relaxed)) {
+    }
+}
+
+/// The white the image is balanced for: none keeps XYZ -> sRGB as is (equal-energy light looks slightly
+/// pink, as in pbrt-v4 without white balance); otherwise the named illuminant's chromaticity is mapped to
+/// the sRGB white (Bradford adaptation).
+Mat3d OutputMatrix(const std::string& white_balance) {
+    const RgbColorSpace& srgb = RgbColorSpace::Srgb();
+    if (white_balance == "none") return srgb.xyz_to_rgb();
+    double cct = white_balance == "D65" ? 6504.0 : white_balance == "D50" ? 5003.0
+                                                                          : std::stod(white_balance);
+    Chromaticity white = XYZToChromaticity(SpectrumToXYZ(Spectrum::CieIlluminantD(std::clamp(cct, 4000.0, 25000.0))));
+    return WhiteBalancedXyzToRgb(srgb, white);
+}
+
+}  // namespace
+
+Film::Film(int width, int height, const OutputConfig& output)
+    : width_(width), height_(height), output_(output) {
+    xyz_.reset(new std::atomic<double>[pixel_count() * 3]);
+    for (size_t i = 0; i < pixel_count() * 3; ++i) xyz_[i].store(0, std::memory_order_relaxed);
+    if (output_.aov_albedo || output_.aov_normal || output_.aov_depth) {
+        aov_.reset(new std::atomic<float>[pixel_count() * 7]);
+        aov_count_.reset(new std::atomic<uint32_t>[pixel_count()]);
+        for (size_t i = 0; i < pixel_count() * 7; ++i) aov_[i].store(0, std::memory_order_relaxed);
+        for (size_t i = 0; i < pixel_count(); ++i) aov_count_[i].store(0, std::memory_order_relaxed);
+    }
+}
+
+void Film::AddXYZ(uint32_t pixel, const Vec3d& xyz) {
+    if (!(std::isfinite(xyz.x) && std::isfinite(xyz.y) && std::isfinite(xyz.z))) return;
+    for (int c = 0; c < 3; ++c) AtomicAdd(xyz_[3 * size_t(pixel) + c], xyz[c]);
+}
+
+void Film::AddAov(uint32_t pixel, const Vec3f& albedo, const Vec3f& normal, float depth) {
+    if (!aov_) return;
+    const float v[7] = {albedo.x, albedo.y, albedo.z, normal.x, normal.y, normal.z, depth};
+    for (int c = 0; c < 7; ++c) AtomicAdd(aov_[7 * size_t(pixel) + c], v[c]);
+    aov_count_[pixel].fetch_add(1, std::memory_order_relaxed);
+}
+
+Vec3d Film::SumXYZ(uint32_t pixel) const {
+    return {xyz_[3 * size_t(pixel)].load(std::memory_order_relaxed),
+            xyz_[3 * size_t(pixel) + 1].load(std::memory_order_relaxed),
+            xyz_[3 * size_t(pixel) + 2].load(std::memory_order_relaxed)};
+}
+
+void Film::SetPixelXYZ(uint32_t pixel, const Vec3d& xyz) {
+    for (int c = 0; c < 3; ++c) xyz_[3 * size_t(pixel) + c].store(xyz[c] * spp_, std::memory_order_relaxed);
+}
+
+std::vector<float> Film::LinearRgb() const {
+    Mat3d m = OutputMatrix(output_.white_balance);
+    std::vector<float> rgb(pixel_count() * 3);
+    for (size_t p = 0; p < pixel_count(); ++p) {
+        Vec3d c = m * PixelXYZ(uint32_t(p));
+        for (int i = 0; i < 3; ++i) rgb[3 * p + i] = float(c[i]);
+    }
+    return rgb;
+}
+
+Status Film::Write(const std::filesystem::path& exr_path,
+                   const std::vector<std::pair<std::string, std::string>>& metadata) const {
+    std::vector<float> rgb = LinearRgb();
+    FloatImage image;
+    image.width = width_;
+    image.height = height_;
+    image.channels = {"R", "G", "B"};
+    if (aov_) {
+        if (output_.aov_albedo) image.channels.insert(image.channels.end(), {"albedo.R", "albedo.G", "albedo.B"});
+        if (output_.aov_normal) image.channels.insert(image.channels.end(), {"normal.X", "normal.Y", "normal.Z"});
+        if (output_.aov_depth) image.channels.push_back("Z");
+    }
+    const size_t nc = image.channels.size();
+    image.pixels.resize(pixel_count() * nc);
+    for (size_t p = 0; p < pixel_count(); ++p) {
+        float* out = &image.pixels[p * nc];
+        for (int i = 0; i < 3; ++i) out[i] = rgb[3 * p + i];
+        if (!aov_) continue;
+        size_t k = 3;
+        uint32_t n = std::max(1u, aov_count_[p].load(std::memory_order_relaxed));
+        auto aov = [&](int c) { return aov_[7 * p + c].load(std::memory_order_relaxed) / float(n); };
+        if (output_.aov_albedo) for (int c = 0; c < 3; ++c) out[k++] = aov(c);
+        if (output_.aov_normal) {
+            Vec3f nrm(aov(3), aov(4), aov(5));
+            float len = Length(nrm);
+            if (len > 0) nrm = nrm / len;
+            for (int c = 0; c < 3; ++c) out[k++] = nrm[c];
+        }
+        if (output_.aov_depth) out[k++] = aov_count_[p].load() ? aov(6) : INFINITY;
+    }
+    NAVE_RETURN_IF_ERROR(WriteExr(exr_path, image, metadata));
+
+    // PNG: exposure set so the log-average luminance maps to middle grey 0.18 (Reinhard et al. 2002,
+    // "Photographic tone reproduction", eq. 1-2), shifted by exposure_ev, then clamped and sRGB-encoded.
+    double log_sum = 0;
+    size_t count = 0;
+    for (size_t p = 0; p < pixel_count(); ++p) {
+        double y = 0.2126 * rgb[3 * p] + 0.7152 * rgb[3 * p + 1] + 0.0722 * rgb[3 * p + 2];
+        if (y > 0 && std::isfinite(y)) {
+            log_sum += std::log(1e-6 + y);
+            ++count;
+        }
+    }
+    double key = count ? std::exp(log_sum / double(count)) : 1.0;
+    double ev = std::log2(0.18 / key) + output_.exposure_ev;
+    std::vector<uint8_t> png(pixel_count() * 3);
+    for (size_t p = 0; p < pixel_count(); ++p) {
+        std::array<uint8_t, 3> v = LinearSrgbTo8Bit(
+            ApplyExposure(Vec3d(rgb[3 * p], rgb[3 * p + 1], rgb[3 * p + 2]), ev));
+        for (int i = 0; i < 3; ++i) png[3 * p + i] = v[i];
+    }
+    std::filesystem::path png_path = exr_path;
+    png_path.replace_extension(".png");
+    return WriteRgb8(png_path, width_, height_, png, metadata);
+}
+
+}  // namespace nave::render

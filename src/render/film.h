@@ -1,0 +1,65 @@
+#pragma once
+// The film: per-pixel sums of spectral samples converted to CIE XYZ, taking concurrent adds from every
+// worker. Sums are doubles updated atomically, so the order in which bricks and threads add their samples
+// changes a pixel only by double rounding (relative ~1e-15 per add), far below the float of the output.
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/color.h"
+#include "core/spectrum.h"
+#include "core/status.h"
+#include "core/vecmath.h"
+#include "render/scene_config.h"
+
+namespace nave::render {
+
+class Film {
+  public:
+    Film(int width, int height, const OutputConfig& output);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    size_t pixel_count() const { return size_t(width_) * height_; }
+
+    /// Adds radiance `L` carried at `lambda` to pixel `pixel` (y * width + x). Thread-safe, lock-free.
+    void AddSample(uint32_t pixel, const SampledSpectrum& L, const SampledWavelengths& lambda) {
+        Vec3d xyz = SampledToXYZ(L, lambda);
+        AddXYZ(pixel, xyz);
+    }
+    void AddXYZ(uint32_t pixel, const Vec3d& xyz);
+    /// Adds to the auxiliary buffers (first-hit albedo, shading normal, depth). Thread-safe.
+    void AddAov(uint32_t pixel, const Vec3f& albedo, const Vec3f& normal, float depth);
+
+    /// The sum of XYZ added to `pixel`.
+    Vec3d SumXYZ(uint32_t pixel) const;
+    /// Divides every sum by `samples_per_pixel` for output.
+    void SetSamplesPerPixel(double spp) { spp_ = spp; }
+    double samples_per_pixel() const { return spp_; }
+    /// The estimate of `pixel` in XYZ: sum / spp.
+    Vec3d PixelXYZ(uint32_t pixel) const { return SumXYZ(pixel) * (1.0 / spp_); }
+    /// Overwrites a pixel's XYZ estimate (for estimators that are not running sums, like SPPM).
+    void SetPixelXYZ(uint32_t pixel, const Vec3d& xyz);
+
+    /// Writes linear RGB (plus AOV channels) as EXR with `metadata`, and a tone-mapped sRGB PNG beside it
+    /// (same name, .png). Both through temp name + rename.
+    Status Write(const std::filesystem::path& exr_path,
+                 const std::vector<std::pair<std::string, std::string>>& metadata) const;
+    /// Linear RGB of the output space (sRGB primaries) after white balance, per pixel.
+    std::vector<float> LinearRgb() const;
+
+  private:
+    int width_, height_;
+    OutputConfig output_;
+    double spp_ = 1;
+    std::unique_ptr<std::atomic<double>[]> xyz_;
+    std::unique_ptr<std::atomic<float>[]> aov_;  // albedo rgb, normal xyz, depth: 7 per pixel
+    std::unique_ptr<std::atomic<uint32_t>[]> aov_count_;
+};
+
+}  // namespace nave::render

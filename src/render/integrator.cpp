@@ -1,0 +1,810 @@
+#include "render/integrator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/memory.h"
+#include "core/progress.h"
+#include "core/sampling.h"
+#include "render/brick_walk.h"
+#include "render/photon_portals.h"
+#include "render/ray_queue.h"
+#include "render/ray.h"
+#include "render/rng.h"
+#include "render/sppm.h"
+
+namespace nave::render {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+/// Rays taken from a queue per scheduler step, and rays per task within it.
+constexpr size_t kMaxBatch = 1u << 18;
+constexpr size_t kChunk = 256;
+
+// Dimensions of a vertex's random numbers (VertexRng::Uniform).
+enum Dim : uint32_t {
+    kDimPixelX = 0, kDimPixelY, kDimLens0, kDimLens1, kDimLambda,  // camera stream only
+    kDimBsdfChoice = 8, kDimBsdf0, kDimBsdf1, kDimRoulette,
+    kDimLight0 = 16,  // two per light
+};
+
+enum RngStream : uint32_t { kStreamPath = 0, kStreamPhoton = 1, kStreamCamera = 2, kStreamEmit = 3, kStreamLambda = 4 };
+
+/// Moves p off the surface to the side of `w`, so that the spawned ray does not hit the surface it leaves.
+/// The offset grows with |p| because float spacing does (2^-23 relative).
+Vec3f OffsetOrigin(const Vec3f& p, const Vec3f& ng, const Vec3f& w) {
+    float scale = 1e-5f * (1.f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}));
+    return p + ng * (Dot(ng, w) >= 0 ? scale : -scale);
+}
+
+float PowerHeuristic(float a, float b) {
+    // Veach 1997, eq. 9.13 with beta = 2.
+    if (std::isinf(a)) return 1;
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0;
+}
+
+struct LocalCounters {
+    uint64_t segments = 0, shadow_segments = 0, moves = 0, rays = 0;
+};
+
+/// Rays spawned or moved by one task, flushed to the queues grouped by brick.
+using Outbox = std::vector<std::pair<uint32_t, RayRecord>>;
+
+/// The geometry of a hit, from the brick's mesh.
+struct SurfaceHit {
+    Vec3f p, ng, ns;
+    const SurfaceMaterial* material = nullptr;
+};
+
+class Engine {
+  public:
+    Engine(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker)
+        : picker_(picker ? std::move(picker) : BrickPicker(PickFullestBrick)),
+          scene_(scene),
+          film_(film),
+          stats_(stats),
+          tree_(scene.source->tree()),
+          queues_(scene.source->brick_count()) {}
+
+    Status Run();
+
+  private:
+    Status RunPath();
+    Status RunPhoton();
+    /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or the
+    /// iteration's when `lambda` is given).
+    void GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample, const SampledWavelengths* lambda);
+    /// The photon emitters and their selection weights (photon mode).
+    Status BuildEmitters();
+    /// Queues photons [first, last) of this iteration.
+    void EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths& lambda);
+
+    /// Sets r's segment to the first brick after `from_t` other than `current`; returns it or kNoBrick.
+    uint32_t Route(RayRecord& r, float from_t, uint32_t current) const {
+        BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current);
+        r.t_enter = s.t_enter;
+        r.t_exit = s.t_exit;
+        return s.brick;
+    }
+    /// Runs the scheduler until every queue is empty.
+    Status Drain();
+    void Flush(Outbox& out, const LocalCounters& c);
+    void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
+    /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if the path ends.
+    bool ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit, Outbox& out,
+                   LocalCounters& c);
+    /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
+    bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
+    void SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
+                     const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick, Outbox& out,
+                     LocalCounters& c);
+    void Escape(const RayRecord& r);
+    /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin glass
+    /// (windows) lets it through, scaled by the pane's transmittance at that angle: panes do not bend rays.
+    bool ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const;
+    /// A straight pass through thin glass: the path continues in the same direction, and this is not a
+    /// scattering event (depth, MIS state unchanged), as for shadow rays.
+    static bool IsPassThrough(const SurfaceMaterial& m, const BsdfSample& bs) {
+        return m.kind == MaterialConfig::Kind::kThinDielectric && bs.IsTransmission();
+    }
+    void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
+    SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
+    RngKey Key(const RayRecord& r, uint32_t stream) const {
+        return RngKey{scene_.settings.seed, r.pixel, r.sample, r.vertex, iteration_, stream};
+    }
+
+    BrickPicker picker_;
+    const RenderScene& scene_;
+    Film* film_;
+    RenderStats* stats_;
+    const store::BrickTree& tree_;
+    BrickQueues<RayRecord> queues_;
+    std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
+    uint32_t iteration_ = 0;
+    bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
+        return m.kind == MaterialConfig::Kind::kThinDielectric;
+    });
+    std::unique_ptr<VisiblePoints> visible_;  // photon mode
+
+    struct Emitter {
+        enum class Kind { kLight, kSky, kTriangle };
+        Kind kind = Kind::kLight;
+        const Light* light = nullptr;
+        Vec3f v0, v1, v2, n;  // kTriangle
+        float area = 0;
+        const Spectrum* emission = nullptr;
+        int portal = -1;      // kLight (sun, directional): index in portals_ when aiming at windows
+    };
+    std::vector<PortalProjection> portals_;
+    std::vector<Emitter> emitters_;
+    std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
+    Vec3f scene_center_;
+    float scene_radius_ = 1;
+};
+
+SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const {
+    const store::BrickMesh& m = brick.mesh();
+    const uint32_t i0 = m.indices[3 * hit.triangle], i1 = m.indices[3 * hit.triangle + 1],
+                   i2 = m.indices[3 * hit.triangle + 2];
+    const float w0 = 1 - hit.u - hit.v;
+    SurfaceHit h;
+    // The point from the barycentrics (not o + t d): exact to the triangle's plane whatever t's magnitude.
+    h.p = m.positions[i0] * w0 + m.positions[i1] * hit.u + m.positions[i2] * hit.v;
+    h.ng = Normalize(Cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+    h.ns = h.ng;
+    if (m.HasNormals()) {
+        Vec3f n = m.normals[i0] * w0 + m.normals[i1] * hit.u + m.normals[i2] * hit.v;
+        float len = Length(n);
+        if (len > 0) h.ns = n / len;
+        if (Dot(h.ns, h.ng) < 0) h.ns = -h.ns;  // winding decides the front; normals only bend it
+    }
+    uint32_t mat = m.material_ids[hit.triangle];
+    static const SurfaceMaterial kBlack = [] {
+        SurfaceMaterial s;
+        s.kind = MaterialConfig::Kind::kBlack;
+        return s;
+    }();
+    h.material = mat < scene_.materials.size() ? &scene_.materials[mat] : &kBlack;
+    return h;
+}
+
+void Engine::Escape(const RayRecord& r) {
+    if (r.kind != kPathRay) return;  // photons leaving the model carry nothing back
+    SampledSpectrum L;
+    if (scene_.sky) L += scene_.sky_radiance.Sample(r.lambda);
+    if (scene_.sun >= 0) {
+        const Light& sun = scene_.lights[size_t(scene_.sun)];
+        if (Dot(r.dir, sun.to_light) >= sun.cos_sun) {
+            // A BSDF-sampled direction that found the sun: weighted against next-event estimation of the
+            // sun (power heuristic). Camera rays and specular bounces cannot be light-sampled: weight 1.
+            float w = 1;
+            if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
+                w = PowerHeuristic(r.prev_pdf, UniformConePdf(sun.cos_sun));
+            }
+            L += sun.spectrum.Sample(r.lambda) * w;
+        }
+    }
+    if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda);
+}
+
+bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const {
+    float t0 = r.t_enter;
+    for (;;) {
+        ++c.shadow_segments;
+        if (!has_thin_glass_) return !brick.Occluded(r.origin, r.dir, t0, t1);
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
+        SurfaceHit h = MakeSurfaceHit(brick, hit);
+        const SurfaceMaterial& m = *h.material;
+        if (m.kind != MaterialConfig::Kind::kThinDielectric) return false;
+        SampledSpectrum reflected, transmitted;
+        ThinDielectricBxdf(m.eta.Sample(r.lambda), m.transmittance.Sample(r.lambda))
+            .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
+        r.beta *= transmitted;
+        if (r.beta.IsZero()) return false;
+        t0 = hit.t + 1e-5f * (1.f + std::abs(hit.t));  // past this pane
+    }
+}
+
+void Engine::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c) {
+    ++c.rays;
+    uint32_t next = Route(r, 0, store::kNoBrick);
+    if (next == store::kNoBrick) {
+        if (r.kind == kShadowRay) {
+            film_->AddSample(r.pixel, r.beta, r.lambda);
+        } else {
+            Escape(r);
+        }
+        return;
+    }
+    if (next == b && brick != nullptr && r.kind == kShadowRay) {
+        ProcessRay(r, b, *brick, out, c);  // same brick, resident now: no need to queue
+        return;
+    }
+    if (next != b) ++c.moves;
+    out.emplace_back(next, r);
+}
+
+void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
+                         const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick,
+                         Outbox& out, LocalCounters& c) {
+    Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
+    Vec3f wi;
+    SampledSpectrum Li;
+    float t_max = kInfinity;
+    float light_pdf = 0;  // solid angle; 0 for delta lights
+    switch (light.kind) {
+        case Light::Kind::kSun: {
+            // Uniform over the solar disc's cone (radiance constant over the disc: no limb darkening).
+            wi = Frame::FromZ(light.to_light).FromLocal(SampleUniformCone(u, light.cos_sun));
+            light_pdf = UniformConePdf(light.cos_sun);
+            Li = light.spectrum.Sample(r.lambda) / light_pdf;
+            break;
+        }
+        case Light::Kind::kDirectional:
+            // The paper's eq. 3: L_r = F_r(w_s, w_o) L_s (n . w_s), with L_s the irradiance at normal incidence.
+            wi = light.to_light;
+            Li = light.spectrum.Sample(r.lambda);
+            break;
+        case Light::Kind::kPoint:
+        case Light::Kind::kSpot: {
+            Vec3f d = light.position - h.p;
+            float dist2 = Dot(d, d);
+            if (dist2 == 0) return;
+            float dist = std::sqrt(dist2);
+            wi = d / dist;
+            float falloff = 1;
+            if (light.kind == Light::Kind::kSpot) {
+                // Smoothstep between the cone and the start of the falloff (pbrt-v4 SpotLight::I).
+                float cos_a = Dot(-wi, light.spot_axis);
+                float x = std::clamp((cos_a - light.cos_cone) / std::max(1e-6f, light.cos_falloff - light.cos_cone),
+                                     0.f, 1.f);
+                falloff = x * x * (3 - 2 * x);
+            }
+            Li = light.spectrum.Sample(r.lambda) * (falloff / dist2);
+            t_max = dist * (1 - 1e-4f);
+            break;
+        }
+    }
+    if (Li.IsZero()) return;
+    SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
+    if (f.IsZero()) return;
+    float w = 1;
+    if (light_pdf > 0) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.dir = wi;
+    s.t_max = t_max;
+    s.beta = r.beta * f * Li * w;
+    Spawn(s, b, &brick, out, c);
+}
+
+bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit, Outbox& out,
+                       LocalCounters& c) {
+    SurfaceHit h = MakeSurfaceHit(brick, hit);
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    if (r.depth == 0) film_->AddAov(r.pixel, Vec3f(1, 1, 1) * mat.AlbedoForAov(), h.ns, hit.t);
+    if (mat.emissive) {
+        // Emission found by the path itself (two-sided; emissive surfaces are not light-sampled, so weight
+        // 1). In photon mode paths stop at their first diffuse vertex, so this only sees specular and glossy
+        // chains; light reaching diffuse vertices from emitters comes with the photons.
+        film_->AddSample(r.pixel, r.beta * mat.emission.Sample(r.lambda), r.lambda);
+    }
+    if (r.depth >= uint32_t(scene_.settings.max_depth)) return false;
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    VertexRng rng(Key(r, kStreamPath));
+    const bool non_specular = flags & (kBxdfDiffuse | kBxdfGlossy);
+    if (non_specular) {
+        for (size_t i = 0; i < scene_.lights.size(); ++i) {
+            SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, b, brick, out, c);
+        }
+    }
+    if (scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse)) {
+        // SPPM: the path stops at its first diffuse vertex; indirect light there comes from photons.
+        visible_->Add(r.pixel, h.p, h.ns, wo, mat, r.beta);
+        return false;
+    }
+    std::optional<BsdfSample> bs = bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice),
+                                               Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)), r.lambda);
+    if (!bs) return false;
+    r.beta *= bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        if (r.beta.IsZero()) return false;
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
+    r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
+    r.prev_pdf = bs->pdf;
+    if (r.depth >= 2) {
+        // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1.
+        float m = r.beta.MaxValue();
+        if (m < 1) {
+            float q = std::max(0.f, 1 - m);
+            if (rng.Uniform(kDimRoulette) < q) return false;
+            r.beta /= 1 - q;
+        }
+    }
+    if (r.beta.IsZero()) return false;
+    r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.dir = bs->wi;
+    r.t_max = kInfinity;
+    r.depth += 1;
+    return true;
+}
+
+bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit) {
+    SurfaceHit h = MakeSurfaceHit(brick, hit);
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    // Direct light from the sun and the other delta or disc lights is next-event estimated at the visible
+    // points: deposit only photons that bounced, or that come from emitters no estimator samples.
+    if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
+        visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
+    }
+    if (uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth)) return false;
+    VertexRng rng(Key(r, kStreamPhoton));
+    std::optional<BsdfSample> bs =
+        bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice), Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),
+                    r.lambda, TransportMode::kImportance);
+    if (!bs) return false;
+    SampledSpectrum beta = r.beta * bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        // Through a window pane: not a bounce, so a photon that arrives next at a diffuse surface is still
+        // direct sunlight, which next-event estimation through glass already counts.
+        r.beta = beta;
+        if (r.beta.IsZero()) return false;
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
+    // Russian roulette on the photon's change of power (pbrt-v4 SPPM photon pass).
+    float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
+    if (rng.Uniform(kDimRoulette) < q) return false;
+    r.beta = beta / (1 - q);
+    if (r.beta.IsZero()) return false;
+    r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.dir = bs->wi;
+    r.t_max = kInfinity;
+    r.depth += 1;
+    return true;
+}
+
+void Engine::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c) {
+    for (;;) {
+        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        if (r.kind == kShadowRay) {
+            if (!ShadowThroughBrick(r, brick, t1, c)) return;
+            uint32_t next = Route(r, r.t_exit, b);
+            if (next == store::kNoBrick) {
+                film_->AddSample(r.pixel, r.beta, r.lambda);  // unoccluded all the way
+            } else {
+                ++c.moves;
+                out.emplace_back(next, r);
+            }
+            return;
+        }
+        ++c.segments;
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, r.t_enter, t1, &hit)) {
+            uint32_t next = Route(r, r.t_exit, b);
+            if (next == store::kNoBrick) {
+                Escape(r);
+            } else {
+                ++c.moves;
+                out.emplace_back(next, r);
+            }
+            return;
+        }
+        bool go_on = r.kind == kPhotonRay ? ShadePhoton(r, b, brick, hit) : ShadePath(r, b, brick, hit, out, c);
+        if (!go_on) return;
+        ++c.rays;
+        uint32_t next = Route(r, 0, store::kNoBrick);
+        if (next == store::kNoBrick) {
+            Escape(r);
+            return;
+        }
+        if (next == b) continue;  // still in this brick: keep tracing without queueing
+        ++c.moves;
+        out.emplace_back(next, r);
+        return;
+    }
+}
+
+void Engine::Flush(Outbox& out, const LocalCounters& c) {
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<RayRecord> group;
+    for (size_t i = 0; i < out.size();) {
+        size_t j = i;
+        group.clear();
+        while (j < out.size() && out[j].first == out[i].first) group.push_back(out[j++].second);
+        queues_.Push(out[i].first, group.data(), group.size());
+        i = j;
+    }
+    out.clear();
+    segments_.fetch_add(c.segments, std::memory_order_relaxed);
+    shadow_segments_.fetch_add(c.shadow_segments, std::memory_order_relaxed);
+    moves_.fetch_add(c.moves, std::memory_order_relaxed);
+    rays_.fetch_add(c.rays, std::memory_order_relaxed);
+}
+
+Status Engine::Drain() {
+    std::vector<RayRecord> batch;
+    std::vector<size_t> waiting(queues_.brick_count());
+    for (;;) {
+        size_t total = 0;
+        for (uint32_t i = 0; i < queues_.brick_count(); ++i) total += waiting[i] = queues_.Waiting(i);
+        if (total == 0) break;
+        const uint32_t b = picker_(waiting, *scene_.source);
+        NAVE_CHECK(b < waiting.size() && waiting[b] > 0) << "the brick picker chose brick " << b
+                                                         << " which has no rays waiting";
+        stats_->peak_queue_bytes = std::max<uint64_t>(stats_->peak_queue_bytes, queues_.MemoryBytes());
+        NAVE_ASSIGN_OR_RETURN(BrickHandle handle, scene_.source->Acquire(b));
+        queues_.Take(b, kMaxBatch, &batch);
+        batches_.fetch_add(1, std::memory_order_relaxed);
+        const ResidentBrick& brick = *handle;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), kChunk), [&](const tbb::blocked_range<size_t>& range) {
+            Outbox out;
+            LocalCounters c;
+            for (size_t i = range.begin(); i != range.end(); ++i) ProcessRay(batch[i], b, brick, out, c);
+            Flush(out, c);
+        });
+    }
+    return Status::Ok();
+}
+
+void Engine::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample, const SampledWavelengths* lambda) {
+    const Camera& camera = *scene_.camera;
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
+        Outbox out;
+        LocalCounters c;
+        for (uint64_t p = range.begin(); p != range.end(); ++p) {
+            RayRecord r{};
+            r.kind = kPathRay;
+            r.pixel = uint32_t(p);
+            r.sample = sample;
+            VertexRng rng(Key(r, kStreamCamera));
+            float x = float(p % uint64_t(camera.width())) + rng.Uniform(kDimPixelX);
+            float y = float(p / uint64_t(camera.width())) + rng.Uniform(kDimPixelY);
+            camera.GenerateRay(x, y, rng.Uniform(kDimLens0), rng.Uniform(kDimLens1), &r.origin, &r.dir);
+            r.lambda = lambda ? *lambda : SampledWavelengths::SampleVisible(rng.Uniform(kDimLambda));
+            r.beta = SampledSpectrum(1.f);
+            r.t_max = kInfinity;
+            Spawn(r, store::kNoBrick, nullptr, out, c);
+        }
+        Flush(out, c);
+    });
+}
+
+Status Engine::RunPath() {
+    const Camera& camera = *scene_.camera;
+    const uint64_t pixels = uint64_t(camera.width()) * camera.height();
+    const int spp = scene_.settings.spp;
+    const uint64_t wave = scene_.settings.wave_paths;
+    ProgressBar progress("render", pixels * uint64_t(spp), "paths");
+    auto start = std::chrono::steady_clock::now();
+    int passes = 0;
+    // Small images put several passes in one wave, so that the streams stay long enough to keep every thread
+    // busy; large images split a pass into waves to bound the memory of the queues.
+    const int passes_per_wave = int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
+    for (int s = 0; s < spp; s += passes_per_wave) {
+        const int s_end = std::min(spp, s + passes_per_wave);
+        for (uint64_t first = 0; first < pixels; first += wave) {
+            const uint64_t last = std::min(pixels, first + wave);
+            for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
+            NAVE_RETURN_IF_ERROR(Drain());
+            progress.Add((last - first) * uint64_t(s_end - s));
+        }
+        passes = s_end;
+        double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+    }
+    progress.Finish();
+    stats_->samples_per_pixel = passes;
+    stats_->camera_paths = pixels * uint64_t(passes);
+    film_->SetSamplesPerPixel(passes);
+    return Status::Ok();
+}
+
+namespace {
+/// A rough power of a spectrum for choosing emitters: its mean over 400-700 nm.
+float MeanVisible(const Spectrum& s) {
+    double sum = 0;
+    for (int l = 400; l <= 700; l += 10) sum += s.Evaluate(float(l));
+    return float(sum / 31);
+}
+}  // namespace
+
+Status Engine::BuildEmitters() {
+    const Bounds3f& bounds = scene_.source->bounds();
+    scene_center_ = bounds.Center();
+    scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
+    const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
+    const float kPiF = 3.14159265358979f;
+
+    // One pass over the bricks that hold emissive or portal materials. A triangle stored in several bricks
+    // (it crosses cells) is kept only in the brick whose cell holds its centroid.
+    const bool want_portals = scene_.settings.photon_target == RenderSettings::PhotonTarget::kPortals;
+    bool any_emissive = false, any_portal = false;
+    for (const SurfaceMaterial& m : scene_.materials) {
+        any_emissive |= m.emissive;
+        any_portal |= m.portal;
+    }
+    if (want_portals && !any_portal) {
+        return InvalidArgumentError("render.photon_target = \"portals\" but no material has portal = true");
+    }
+    std::vector<double> weights;
+    std::vector<Emitter> triangles;
+    std::vector<double> triangle_weights;
+    std::vector<std::array<Vec3f, 3>> portal_triangles;
+    if (any_emissive || (want_portals && any_portal)) {
+        for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
+            NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
+            const store::BrickMesh& m = h->mesh();
+            for (size_t t = 0; t < m.TriangleCount(); ++t) {
+                uint32_t mat = m.material_ids[t];
+                if (mat >= scene_.materials.size()) continue;
+                const SurfaceMaterial& sm = scene_.materials[mat];
+                if (!sm.emissive && !(want_portals && sm.portal)) continue;
+                Vec3f v0 = m.positions[m.indices[3 * t]], v1 = m.positions[m.indices[3 * t + 1]],
+                      v2 = m.positions[m.indices[3 * t + 2]];
+                if (tree_.Locate((v0 + v1 + v2) * (1.f / 3.f)) != b) continue;
+                if (want_portals && sm.portal) portal_triangles.push_back({v0, v1, v2});
+                if (!sm.emissive) continue;
+                Emitter e;
+                e.kind = Emitter::Kind::kTriangle;
+                e.v0 = v0;
+                e.v1 = v1;
+                e.v2 = v2;
+                Vec3f c = Cross(v1 - v0, v2 - v0);
+                e.area = 0.5f * Length(c);
+                if (e.area <= 0) continue;
+                e.n = Normalize(c);
+                e.emission = &sm.emission;
+                triangles.push_back(e);
+                // Two-sided Lambertian emitter: power = L pi A per side.
+                triangle_weights.push_back(MeanVisible(*e.emission) * 2 * kPiF * e.area);
+            }
+        }
+    }
+    for (const Light& l : scene_.lights) {
+        Emitter e;
+        e.light = &l;
+        float w = MeanVisible(l.spectrum);
+        float target_area = disk_area;
+        if (want_portals && (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional)) {
+            PortalProjection projection(portal_triangles, l.to_light);
+            if (!projection.empty()) {
+                e.portal = int(portals_.size());
+                target_area = float(projection.total_area());
+                portals_.push_back(std::move(projection));
+            }
+        }
+        switch (l.kind) {
+            case Light::Kind::kSun: w *= l.SunSolidAngle() * target_area; break;
+            case Light::Kind::kDirectional: w *= target_area; break;
+            case Light::Kind::kPoint:
+            case Light::Kind::kSpot: w *= 4 * kPiF; break;
+        }
+        emitters_.push_back(e);
+        weights.push_back(w);
+    }
+    if (scene_.sky) {
+        Emitter e;
+        e.kind = Emitter::Kind::kSky;
+        emitters_.push_back(e);
+        weights.push_back(MeanVisible(scene_.sky_radiance) * 4 * kPiF * disk_area);
+    }
+    emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
+    weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
+    double total = 0;
+    for (double w : weights) total += w;
+    if (emitters_.empty() || !(total > 0)) {
+        return InvalidArgumentError("photon mode needs a light: the scene has no sun, light, sky or emissive "
+                                    "material with power");
+    }
+    emitter_cdf_.assign(1, 0.0);
+    for (double w : weights) emitter_cdf_.push_back(emitter_cdf_.back() + w / total);
+    emitter_cdf_.back() = 1.0;
+    return Status::Ok();
+}
+
+void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths& lambda) {
+    const float kPiF = 3.14159265358979f;
+    const float disk_area = kPiF * scene_radius_ * scene_radius_;
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
+        Outbox out;
+        LocalCounters c;
+        for (uint64_t i = range.begin(); i != range.end(); ++i) {
+            RayRecord r{};
+            r.kind = kPhotonRay;
+            r.pixel = uint32_t(i);
+            r.lambda = lambda;
+            r.t_max = kInfinity;
+            VertexRng rng(Key(r, kStreamEmit));
+            float u = rng.Uniform(0);
+            size_t k = size_t(std::upper_bound(emitter_cdf_.begin() + 1, emitter_cdf_.end(), double(u)) -
+                              (emitter_cdf_.begin() + 1));
+            k = std::min(k, emitters_.size() - 1);
+            const float p_choice = float(emitter_cdf_[k + 1] - emitter_cdf_[k]);
+            if (p_choice <= 0) continue;
+            const Emitter& e = emitters_[k];
+            Point2f u1(rng.Uniform(1), rng.Uniform(2)), u2(rng.Uniform(3), rng.Uniform(4));
+            // Photons from distant sources (sun, directional, sky) start on a disc facing the source that
+            // covers the model's bounding sphere: every photon that can reach the model does (the model's
+            // bounds projected onto the light's direction; windows are reached through them).
+            auto disc_origin = [&](const Vec3f& toward) {
+                Frame f = Frame::FromZ(toward);
+                Point2f d = SampleUniformDiskConcentric(u1);
+                return scene_center_ + toward * (2 * scene_radius_) + f.x * (d.x * scene_radius_) +
+                       f.y * (d.y * scene_radius_);
+            };
+            if (e.kind == Emitter::Kind::kLight) {
+                const Light& l = *e.light;
+                switch (l.kind) {
+                    case Light::Kind::kSun:
+                    case Light::Kind::kDirectional: {
+                        const bool sun = l.kind == Light::Kind::kSun;
+                        Vec3f to = sun ? Frame::FromZ(l.to_light).FromLocal(SampleUniformCone(u2, l.cos_sun))
+                                       : l.to_light;
+                        // Area density of the start point on the plane facing the light: 1/A on the disc,
+                        // count(x)/A_total on the portals' projections (photon_portals.h).
+                        float area = disk_area;
+                        if (e.portal >= 0) {
+                            const PortalProjection& portals = portals_[size_t(e.portal)];
+                            int coverage = 1;
+                            Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
+                            r.origin = p + to * (2 * scene_radius_);
+                            area = float(portals.total_area()) / float(coverage);
+                        } else {
+                            r.origin = disc_origin(l.to_light);
+                        }
+                        r.dir = -to;
+                        // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E / p_area.
+                        r.beta = sun ? l.spectrum.Sample(lambda) * (Dot(to, l.to_light) * area * l.SunSolidAngle())
+                                     : l.spectrum.Sample(lambda) * area;
+                        break;
+                    }
+                    case Light::Kind::kPoint:
+                    case Light::Kind::kSpot: {
+                        r.origin = l.position;
+                        r.dir = SampleUniformSphere(u2);
+                        float falloff = 1;
+                        if (l.kind == Light::Kind::kSpot) {
+                            float cos_a = Dot(r.dir, l.spot_axis);
+                            float x = std::clamp((cos_a - l.cos_cone) / std::max(1e-6f, l.cos_falloff - l.cos_cone),
+                                                 0.f, 1.f);
+                            falloff = x * x * (3 - 2 * x);
+                        }
+                        r.beta = l.spectrum.Sample(lambda) * (falloff * 4 * kPiF);
+                        break;
+                    }
+                }
+            } else if (e.kind == Emitter::Kind::kSky) {
+                Vec3f to = SampleUniformSphere(u2);
+                r.origin = disc_origin(to);
+                r.dir = -to;
+                r.beta = scene_.sky_radiance.Sample(lambda) * (4 * kPiF * disk_area);
+                r.flags = kFromAreaLight;
+            } else {
+                // Uniform point on the triangle (Turk 1990 square-root parameterisation), cosine-weighted
+                // direction on a side chosen with probability 1/2.
+                float su = std::sqrt(u1.x);
+                Vec3f p = e.v0 * (1 - su) + e.v1 * (su * (1 - u1.y)) + e.v2 * (su * u1.y);
+                Vec3f n = rng.Uniform(5) < 0.5f ? e.n : -e.n;
+                r.dir = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                r.origin = OffsetOrigin(p, n, r.dir);
+                // L cos / (1/A * cos/pi * 1/2).
+                r.beta = e.emission->Sample(lambda) * (2 * kPiF * e.area);
+                r.flags = kFromAreaLight;
+            }
+            r.beta /= p_choice;
+            if (r.beta.IsZero()) continue;
+            Spawn(r, store::kNoBrick, nullptr, out, c);
+        }
+        Flush(out, c);
+    });
+}
+
+Status Engine::RunPhoton() {
+    const Camera& camera = *scene_.camera;
+    const uint64_t pixels = uint64_t(camera.width()) * camera.height();
+    const int iterations = scene_.settings.iterations;
+    const uint64_t photons = scene_.settings.photons_per_iteration;
+    const uint64_t wave = scene_.settings.wave_paths;
+    NAVE_RETURN_IF_ERROR(BuildEmitters());
+    float radius = scene_.settings.initial_radius_m > 0 ? scene_.settings.initial_radius_m
+                                                         : 0.01f * 2 * scene_radius_;
+    visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius);
+    ProgressBar progress("photon mapping", uint64_t(iterations), "iterations");
+    auto start = std::chrono::steady_clock::now();
+    int done = 0;
+    for (int it = 0; it < iterations; ++it) {
+        iteration_ = uint32_t(it);
+        SampledWavelengths lambda =
+            SampledWavelengths::SampleVisible(VertexRng(RngKey{scene_.settings.seed, 0, 0, 0, iteration_,
+                                                               kStreamLambda}).Uniform(0));
+        visible_->BeginIteration(lambda);
+        for (uint64_t first = 0; first < pixels; first += wave) {
+            GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda);
+            NAVE_RETURN_IF_ERROR(Drain());
+        }
+        visible_->BuildBrickGrids(tree_);
+        for (uint64_t first = 0; first < photons; first += wave) {
+            EmitPhotons(first, std::min(photons, first + wave), lambda);
+            NAVE_RETURN_IF_ERROR(Drain());
+        }
+        visible_->EndIteration(scene_.settings.alpha);
+        done = it + 1;
+        progress.Add(1);
+        double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+    }
+    progress.Finish();
+    // Direct light and specular chains were summed by the film over `done` iterations; the photon estimate
+    // is added as `done` times the per-iteration mean so the film's division by its sample count holds.
+    film_->SetSamplesPerPixel(done);
+    const double emitted = double(photons) * done;
+    for (uint64_t p = 0; p < pixels; ++p) {
+        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done));
+    }
+    stats_->iterations = done;
+    stats_->samples_per_pixel = done;
+    stats_->camera_paths = pixels * uint64_t(done);
+    stats_->photons = emitted;
+    return Status::Ok();
+}
+
+Status Engine::Run() {
+    auto start = std::chrono::steady_clock::now();
+    BrickSourceStats before = scene_.source->stats();
+    Status status = scene_.settings.mode == RenderSettings::Mode::kPath ? RunPath() : RunPhoton();
+    NAVE_RETURN_IF_ERROR(status);
+    BrickSourceStats after = scene_.source->stats();
+    stats_->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats_->segments_traced = segments_.load();
+    stats_->shadow_segments = shadow_segments_.load();
+    stats_->brick_moves = moves_.load();
+    stats_->rays = rays_.load();
+    stats_->batches = batches_.load();
+    stats_->brick_loads = after.loads - before.loads;
+    stats_->bytes_read = after.bytes_read - before.bytes_read;
+    stats_->peak_rss_bytes = PeakRssBytes();
+    return Status::Ok();
+}
+
+}  // namespace
+
+uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource&) {
+    return uint32_t(std::max_element(waiting.begin(), waiting.end()) - waiting.begin());
+}
+
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker) {
+    NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
+    int threads = scene.settings.threads > 0 ? scene.settings.threads : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    Status status;
+    arena.execute([&] {
+        Engine engine(scene, film, stats, std::move(picker));
+        status = engine.Run();
+    });
+    return status;
+}
+
+}  // namespace nave::render

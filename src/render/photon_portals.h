@@ -1,0 +1,51 @@
+#pragma once
+// Aiming photons from distant lights (sun, directional) at windows. Photons start on the projections of the
+// portal triangles onto the plane perpendicular to the light. Where projections overlap (the windows of the
+// north and the south walls seen along the sunlight), a point is reachable from several triangles: sampling a
+// triangle by projected area and a point on it gives the density count(x) / A_total over the plane, where
+// count(x) is the number of projections covering x (a one-sample balance-heuristic estimator over the
+// portals, Veach 1997 §9.2), so the photon's power is L Omega A_total / count(x) and the flux through the
+// union of the windows is unbiased. Light that enters elsewhere (open doors, gaps) is not sampled: that is
+// what the "bounds" target is for.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/vecmath.h"
+#include "render/materials/frame.h"
+
+namespace nave::render {
+
+class PortalProjection {
+  public:
+    PortalProjection() = default;
+    /// `to_light`: unit direction toward the light. Triangles edge-on to it are dropped.
+    PortalProjection(const std::vector<std::array<Vec3f, 3>>& triangles, const Vec3f& to_light);
+
+    bool empty() const { return cdf_.size() < 2; }
+    /// Sum of the projected areas (m^2), overlaps counted as many times as they overlap.
+    double total_area() const { return total_area_; }
+    size_t triangle_count() const { return tris_.size(); }
+    /// A point on a portal triangle chosen in proportion to projected area; `coverage` receives the number of
+    /// projections covering its projection (>= 1).
+    Vec3f Sample(float u_choice, float u0, float u1, int* coverage) const;
+    /// Number of projected triangles that contain the projection of `p`.
+    int Coverage(const Vec3f& p) const;
+
+  private:
+    struct Tri2 {
+        float ax, ay, bx, by, cx, cy;
+        Vec3f v0, v1, v2;
+    };
+    bool Contains(const Tri2& t, float x, float y) const;
+    Frame frame_;
+    std::vector<Tri2> tris_;
+    std::vector<double> cdf_;
+    double total_area_ = 0;
+    float min_x_ = 0, min_y_ = 0, cell_ = 1;
+    int nx_ = 0, ny_ = 0;
+    std::vector<std::vector<uint32_t>> grid_;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,41 @@
+#pragma once
+// The compact record of a ray in flight. Everything a worker needs to continue the ray in whichever brick it
+// lands in travels with it: geometry, the segment in the current brick, the path's identity (for the
+// counter-based random numbers), its throughput and wavelengths.
+
+#include <cstdint>
+
+#include "core/spectrum.h"
+#include "core/vecmath.h"
+
+namespace nave::render {
+
+enum RayKind : uint8_t {
+    kPathRay = 0,    ///< camera ray or continuation of a camera path
+    kShadowRay = 1,  ///< carries a potential contribution, added if nothing occludes it up to t_max
+    kPhotonRay = 2,  ///< a photon of SPPM's photon pass
+};
+
+enum RayFlags : uint8_t {
+    kSpecularBounce = 1 << 0,  ///< the last scattering was specular (no light sampling possible there)
+    kFromAreaLight = 1 << 1,   ///< photon emitted by a surface (its direct light is not next-event estimated)
+};
+
+struct RayRecord {
+    Vec3f origin;
+    float t_max = 0;       ///< end of the ray (infinity, or just short of a point light)
+    Vec3f dir;             ///< unit length
+    float t_enter = 0;     ///< start of the segment in the current brick's cell
+    float t_exit = 0;      ///< end of the segment in the current brick's cell
+    uint32_t pixel = 0;    ///< pixel index (y * width + x), or photon index
+    uint32_t sample = 0;   ///< sample index within the pixel
+    uint16_t depth = 0;    ///< scatterings so far (straight passes through thin glass do not count)
+    uint8_t kind = kPathRay;
+    uint8_t flags = 0;
+    uint16_t vertex = 0;   ///< surfaces met so far, passes through thin glass included (keys the random numbers)
+    float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun)
+    SampledSpectrum beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
+    SampledWavelengths lambda;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,174 @@
+#include "render/scene.h"
+
+#include <cmath>
+
+#include "core/log.h"
+#include "render/sun/sun.h"
+
+namespace nave::render {
+
+Spectrum ToSpectrum(const SpectrumSpec& spec) {
+    if (spec.kind == SpectrumSpec::Kind::kConstant) return Spectrum::Constant(spec.value * spec.scale);
+    return Spectrum::FromFunction([&](double lambda_nm) { return spec.Evaluate(float(lambda_nm)); });
+}
+
+Bsdf SurfaceMaterial::MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
+    const Vec3f no_tangent(0, 0, 0);
+    switch (kind) {
+        case MaterialConfig::Kind::kDiffuse:
+            return Bsdf(ns, no_tangent, DiffuseBxdf(reflectance.Sample(*lambda)));
+        case MaterialConfig::Kind::kConductor: {
+            float a = RoughnessToAlpha(roughness);
+            return Bsdf(ns, no_tangent, ConductorBxdf(TrowbridgeReitz(a, a), eta.Sample(*lambda), k.Sample(*lambda)));
+        }
+        case MaterialConfig::Kind::kDielectric:
+            // A dispersive interface sends each wavelength its own way: keep the hero wavelength only
+            // (pbrt-v4 §10.1.2's treatment; SampledWavelengths::TerminateSecondary keeps the film unbiased).
+            if (dispersive) lambda->TerminateSecondary();
+            return Bsdf(ns, no_tangent, DielectricBxdf(eta.Evaluate(lambda->lambda_nm(0))));
+        case MaterialConfig::Kind::kThinDielectric:
+            return Bsdf(ns, no_tangent, ThinDielectricBxdf(eta.Sample(*lambda), transmittance.Sample(*lambda)));
+        case MaterialConfig::Kind::kBlack: break;
+    }
+    return Bsdf(ns, no_tangent, Bxdf());
+}
+
+float SurfaceMaterial::AlbedoForAov() const {
+    switch (kind) {
+        case MaterialConfig::Kind::kDiffuse: return reflectance.Evaluate(550);
+        case MaterialConfig::Kind::kBlack: return 0;
+        default: return 1;
+    }
+}
+
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
+    SunState s;
+    if (sun.direction) {
+        s.to_sun = *sun.direction;
+        s.cos_max = std::cos(sun.angular_radius_deg * 3.14159265358979f / 180.f);
+        s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / 3.14159265358979;
+        s.azimuth_deg = std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / 3.14159265358979 + 360.0, 360.0);
+        if (sun.radiance) {
+            s.radiance = ToSpectrum(*sun.radiance);
+        } else {
+            // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for that
+            // zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490) spread over the
+            // disc, i.e. the sun without an atmosphere.
+            double omega = 2 * 3.14159265358979 * (1 - double(s.cos_max));
+            s.radiance = ExtraterrestrialSolarSpectrum() * float(1.0 / omega);
+        }
+    } else {
+        SunInput in;
+        in.time = CivilTime{sun.when.year, sun.when.month, sun.when.day, sun.when.hour, sun.when.minute,
+                            sun.when.second, sun.when.utc_offset_minutes / 60.0};
+        in.latitude_deg = sun.latitude_deg;
+        in.longitude_deg = sun.longitude_deg;
+        in.elevation_m = sun.elevation_m;
+        in.atmosphere.pressure_hpa = sun.pressure_mbar;  // 1 mbar = 1 hPa
+        in.atmosphere.temperature_c = sun.temperature_c;
+        in.atmosphere.turbidity = sun.turbidity;
+        StatusOr<Sun> model = ComputeSun(in);
+        if (!model.ok()) return model.status().WithContext(fmt::format("{}: [sun]", file));
+        s.to_sun = model->direction;
+        s.zenith_deg = model->position.zenith_deg;
+        s.azimuth_deg = model->position.azimuth_deg;
+        s.cos_max = model->CosThetaMax();
+        s.radiance = sun.radiance ? ToSpectrum(*sun.radiance) : model->radiance;
+        s.above_horizon = model->AboveHorizon();
+    }
+    s.radiance *= sun.scale;
+    return s;
+}
+
+StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source) {
+    RenderScene scene;
+    scene.source = &source;
+    scene.camera = std::make_unique<Camera>(config.camera);
+    scene.settings = config.render;
+    scene.output = config.output;
+    const std::string file = config.path.string();
+
+    // Materials: every model material needs a mapping (or the default).
+    const auto& records = source.materials();
+    auto default_it = config.materials.find("default");
+    for (size_t i = 0; i < records.size(); ++i) {
+        const store::MaterialRecord& rec = records[i];
+        auto it = config.materials.find(rec.name);
+        if (it == config.materials.end()) it = default_it;
+        if (it == config.materials.end()) {
+            return InvalidArgumentError("{}: the model's material '{}' has no mapping: add [materials.{}] or "
+                                        "[materials.default]",
+                                        file, rec.name, rec.name);
+        }
+        const MaterialConfig& mc = it->second;
+        SurfaceMaterial m;
+        m.kind = mc.kind;
+        m.name = rec.name;
+        m.reflectance = ToSpectrum(mc.reflectance);
+        m.eta = ToSpectrum(mc.eta);
+        m.k = ToSpectrum(mc.k);
+        m.transmittance = ToSpectrum(mc.transmittance);
+        m.roughness = mc.roughness;
+        m.portal = mc.portal;
+        m.dispersive = mc.kind == MaterialConfig::Kind::kDielectric && !m.eta.IsConstant();
+        if (mc.emission) {
+            m.emissive = true;
+            m.emission = ToSpectrum(*mc.emission);
+        } else if (rec.emission[0] > 0 || rec.emission[1] > 0 || rec.emission[2] > 0) {
+            // The model's own emission (MTL Ke, glTF emissiveFactor) is RGB: keep its luminance as a flat
+            // spectrum (Rec. 709 luma weights, ITU-R BT.709-6 item 3.2); a config emission overrides it.
+            m.emissive = true;
+            m.emission = Spectrum::Constant(0.2126f * rec.emission[0] + 0.7152f * rec.emission[1] +
+                                            0.0722f * rec.emission[2]);
+        }
+        scene.materials.push_back(std::move(m));
+    }
+    for (const auto& [name, mc] : config.materials) {
+        if (name == "default") continue;
+        bool used = std::any_of(records.begin(), records.end(), [&](const auto& r) { return r.name == name; });
+        if (!used) log::Warning("{}: [materials.{}] maps no material of the model", mc.where, name);
+    }
+
+    if (config.sun.enabled) {
+        NAVE_ASSIGN_OR_RETURN(SunState sun, ResolveSun(config.sun, file));
+        if (!sun.above_horizon) log::Warning("{}: the sun is below the horizon at that date and place", file);
+        Light l;
+        l.kind = Light::Kind::kSun;
+        l.to_light = sun.to_sun;
+        l.cos_sun = sun.cos_max;
+        l.spectrum = sun.radiance;
+        scene.sun = int(scene.lights.size());
+        scene.lights.push_back(std::move(l));
+        scene.sun_description = fmt::format("azimuth {:.2f} deg, elevation {:.2f} deg", sun.azimuth_deg,
+                                            90.0 - sun.zenith_deg);
+    }
+    for (const LightConfig& lc : config.lights) {
+        Light l;
+        l.spectrum = ToSpectrum(lc.spectrum);
+        switch (lc.kind) {
+            case LightConfig::Kind::kDirectional:
+                l.kind = Light::Kind::kDirectional;
+                l.to_light = -lc.direction;
+                break;
+            case LightConfig::Kind::kPoint:
+                l.kind = Light::Kind::kPoint;
+                l.position = lc.position;
+                break;
+            case LightConfig::Kind::kSpot:
+                l.kind = Light::Kind::kSpot;
+                l.position = lc.position;
+                l.spot_axis = lc.direction;
+                l.cos_cone = std::cos(lc.cone_deg * 3.14159265358979f / 180.f);
+                l.cos_falloff = std::cos(lc.falloff_start_deg * 3.14159265358979f / 180.f);
+                break;
+        }
+        scene.lights.push_back(std::move(l));
+    }
+    if (config.sky.kind == SkyConfig::Kind::kUniform) {
+        scene.sky = true;
+        scene.sky_radiance = ToSpectrum(config.sky.radiance);
+    }
+    return scene;
+}
+
+}  // namespace nave::render

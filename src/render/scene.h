@@ -1,0 +1,82 @@
+#pragma once
+// A scene ready to render: the config resolved against a model. Material names of the model are mapped to
+// spectral materials (a name with no mapping is an error naming it, unless a "default" mapping exists),
+// config spectra are tabulated, and the sun's direction and spectrum are computed from date and place.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/spectrum.h"
+#include "core/status.h"
+#include "core/vecmath.h"
+#include "render/brick_source.h"
+#include "render/camera.h"
+#include "render/materials/bxdf.h"
+#include "render/scene_config.h"
+
+namespace nave::render {
+
+/// A spectral material as the integrators use it. Builds a Bsdf per hit for the path's wavelengths.
+struct SurfaceMaterial {
+    MaterialConfig::Kind kind = MaterialConfig::Kind::kDiffuse;
+    std::string name;
+    Spectrum reflectance, eta, k, transmittance;
+    float roughness = 0;
+    bool emissive = false;
+    Spectrum emission;           ///< radiance, W m^-2 sr^-1 nm^-1, both sides
+    bool portal = false;         ///< photons are aimed at it
+    bool dispersive = false;     ///< eta varies with wavelength: refraction keeps the hero wavelength only
+
+    /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the secondary
+    /// wavelengths of `lambda`.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const;
+    /// Diffuse albedo at 550 nm, for the albedo AOV.
+    float AlbedoForAov() const;
+};
+
+/// A light that next-event estimation samples.
+struct Light {
+    enum class Kind { kSun, kDirectional, kPoint, kSpot };
+    Kind kind = Kind::kSun;
+    Vec3f to_light{0, 0, 1};     ///< sun and directional: unit direction toward the light
+    Vec3f position;              ///< point and spot
+    Vec3f spot_axis{0, 0, -1};   ///< spot: direction light travels
+    float cos_cone = 1, cos_falloff = 1;  ///< spot
+    float cos_sun = 1;           ///< sun: cosine of the disc's angular radius
+    Spectrum spectrum;           ///< sun: radiance; directional: irradiance (normal incidence); point/spot: intensity
+    float SunSolidAngle() const { return 2 * 3.14159265358979f * (1 - cos_sun); }
+};
+
+struct RenderScene {
+    BrickSource* source = nullptr;
+    std::unique_ptr<Camera> camera;
+    std::vector<SurfaceMaterial> materials;  ///< indexed by the store's material id
+    std::vector<Light> lights;
+    int sun = -1;                            ///< index of the sun in `lights`, or -1
+    bool sky = false;
+    Spectrum sky_radiance;
+    RenderSettings settings;
+    OutputConfig output;
+    std::string sun_description;             ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary
+};
+
+/// Resolves `config` against the model in `source`.
+StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source);
+
+/// The tabulated form of a config spectrum.
+Spectrum ToSpectrum(const SpectrumSpec& spec);
+
+/// The sun's position and spectrum for a place and time: the physics sun model (NREL SPA, clear-sky
+/// transmittance, render/sun/sun.h), or the config's fixed direction and spectrum.
+struct SunState {
+    Vec3f to_sun;            ///< unit vector, world frame (+X east, +Y north, +Z up)
+    double zenith_deg = 0, azimuth_deg = 0;
+    float cos_max = 1;       ///< cosine of the disc's angular radius
+    Spectrum radiance;       ///< disc radiance at the ground, W m^-2 sr^-1 nm^-1
+    bool above_horizon = true;
+};
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file);
+
+}  // namespace nave::render

@@ -1,0 +1,137 @@
+#pragma once
+// The scene description a render reads besides the model: camera, sun, sky, lights, the mapping from the
+// model's material names to spectral materials, render and output settings. Parsed from TOML; every key is
+// documented in configs/README.md. Like Mitsuba's "unused parameters" check, a key that nothing reads is an
+// error naming it with its file, line and column, so a misspelt key never passes silently.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/status.h"
+#include "core/vecmath.h"
+
+namespace nave::render {
+
+/// A spectral quantity as written in a config: a constant, a table of (wavelength, value) pairs linearly
+/// interpolated, or a blackbody normalised to 1 at its peak, each times `scale`.
+struct SpectrumSpec {
+    enum class Kind { kConstant, kTable, kBlackbody };
+    Kind kind = Kind::kConstant;
+    float value = 0.f;                   ///< kConstant
+    std::vector<float> wavelengths_nm;   ///< kTable, increasing
+    std::vector<float> values;           ///< kTable
+    float temperature_k = 0.f;           ///< kBlackbody
+    float scale = 1.f;
+    static SpectrumSpec Constant(float v) { SpectrumSpec s; s.value = v; return s; }
+    /// The value at `lambda_nm` (tables are clamped at their ends).
+    float Evaluate(float lambda_nm) const;
+};
+
+struct CameraConfig {
+    Vec3f position{0, 0, 0};
+    Vec3f look_at{1, 0, 0};
+    Vec3f up{0, 0, 1};
+    float fov_deg = 60.f;            ///< vertical field of view
+    int width = 640, height = 480;
+    float lens_radius_m = 0.f;       ///< thin lens aperture radius; 0 is a pinhole
+    float focus_distance_m = 0.f;    ///< 0: the distance to look_at
+};
+
+/// A civil date and time with its UTC offset (the sun's position needs all three).
+struct DateTime {
+    int year = 2025, month = 6, day = 21, hour = 12, minute = 0;
+    double second = 0;
+    int utc_offset_minutes = 0;
+};
+
+struct SunConfig {
+    bool enabled = false;
+    DateTime when;
+    double latitude_deg = 0, longitude_deg = 0, elevation_m = 0;
+    double pressure_mbar = 1013.25, temperature_c = 15.0;
+    double turbidity = 3.0;          ///< Linke/Angstrom-style haze factor handed to the sun model
+    float scale = 1.f;               ///< multiplies the sun's radiance
+    std::optional<Vec3f> direction; ///< toward the sun; overrides date/place (tests, studios)
+    float angular_radius_deg = 0.2666f;  ///< apparent radius of the disc with `direction` (the model computes its own)
+    std::optional<SpectrumSpec> radiance;  ///< overrides the atmospheric model's spectrum (W m^-2 sr^-1 nm^-1)
+};
+
+struct SkyConfig {
+    enum class Kind { kNone, kUniform };
+    Kind kind = Kind::kNone;
+    SpectrumSpec radiance;           ///< kUniform: radiance of every direction above and below
+};
+
+struct LightConfig {
+    enum class Kind { kDirectional, kPoint, kSpot };
+    Kind kind = Kind::kDirectional;
+    Vec3f direction{0, 0, -1};       ///< directional and spot: the direction light travels
+    Vec3f position{0, 0, 0};         ///< point and spot
+    SpectrumSpec spectrum;           ///< irradiance (directional, W m^-2 nm^-1) or intensity (W sr^-1 nm^-1)
+    float cone_deg = 30.f, falloff_start_deg = 25.f;  ///< spot
+    std::string where;               ///< "scene.toml:12" for messages
+};
+
+struct MaterialConfig {
+    enum class Kind { kDiffuse, kConductor, kDielectric, kThinDielectric, kBlack };
+    Kind kind = Kind::kDiffuse;
+    SpectrumSpec reflectance = SpectrumSpec::Constant(0.5f);   ///< diffuse albedo
+    SpectrumSpec eta = SpectrumSpec::Constant(1.5f);           ///< dielectric index, conductor eta
+    SpectrumSpec k = SpectrumSpec::Constant(0.f);              ///< conductor absorption
+    SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< tint of thin glass per pass
+    float roughness = 0.f;
+    std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface
+    bool portal = false;             ///< with render.photon_target = "portals", sun photons aim at it
+    std::string where;
+};
+
+struct RenderSettings {
+    enum class Mode { kPath, kPhoton };
+    Mode mode = Mode::kPath;
+    int spp = 16;                    ///< path mode: samples per pixel; photon mode: camera samples per iteration
+    double time_limit_s = 0;         ///< 0: none
+    int iterations = 16;             ///< photon mode
+    uint64_t photons_per_iteration = 200000;
+    float initial_radius_m = 0.f;    ///< 0: chosen from the model size
+    float alpha = 2.f / 3.f;         ///< SPPM radius reduction (Hachisuka & Jensen 2009)
+    int max_depth = 8;
+    uint64_t seed = 1;
+    int threads = 0;                 ///< 0: all cores
+    uint32_t wave_paths = 1u << 20;  ///< camera paths in flight at once
+    /// Where photons from the sun and directional lights are aimed: the model's bounds projected onto the
+    /// light's direction, or the triangles of materials marked `portal` (windows) only.
+    enum class PhotonTarget { kBounds, kPortals };
+    PhotonTarget photon_target = PhotonTarget::kBounds;
+};
+
+struct OutputConfig {
+    std::string white_balance = "none";  ///< "none" (E), "D65", "D50" or a colour temperature "5000K"
+    float exposure_ev = 0.f;              ///< PNG only; EXR stays linear
+    bool aov_albedo = false, aov_normal = false, aov_depth = false;
+};
+
+struct SceneConfig {
+    std::filesystem::path path;
+    CameraConfig camera;
+    SunConfig sun;
+    SkyConfig sky;
+    std::vector<LightConfig> lights;
+    std::map<std::string, MaterialConfig> materials;  ///< by model material name; "default" for the rest
+    RenderSettings render;
+    OutputConfig output;
+};
+
+/// Parses and checks a scene config file. Errors name the file, line and column, and the key.
+StatusOr<SceneConfig> LoadSceneConfig(const std::filesystem::path& path);
+/// Same from text (`name` is used in messages).
+StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string& name);
+
+/// Parses "2025-06-21T08:00+02:00" (seconds optional, "Z" for UTC). Errors say which field is wrong.
+StatusOr<DateTime> ParseDateTime(std::string_view text);
+
+}  // namespace nave::render

@@ -1,0 +1,145 @@
+#include "render/sppm.h"
+
+#include <cmath>
+
+#include "core/color.h"
+#include "render/rng.h"
+#include "render/scene.h"
+
+namespace nave::render {
+
+void BricksOverlapping(const store::BrickTree& tree, const Bounds3f& box, std::vector<uint32_t>* out) {
+    out->clear();
+    const auto& nodes = tree.nodes();
+    if (nodes.empty() || !tree.bounds().Overlaps(box)) return;
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const store::BrickTreeNode& n = nodes[stack[--top]];
+        if (n.IsLeaf()) {
+            if (n.brick != store::kNoBrick) out->push_back(n.brick);
+            continue;
+        }
+        // Below the plane: [.., split); above: [split, ..]. Closed tests: a sphere touching the plane is
+        // registered on both sides.
+        if (box.min[n.axis] <= n.split && top < 128) stack[top++] = n.child[0];
+        if (box.max[n.axis] >= n.split && top < 128) stack[top++] = n.child[1];
+    }
+}
+
+VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius)
+    : points_(pixel_count), pixels_(new PixelState[pixel_count]), pixel_count_(pixel_count), grids_(brick_count) {
+    for (size_t i = 0; i < pixel_count; ++i) {
+        pixels_[i].radius = initial_radius;
+        for (auto& f : pixels_[i].phi) f.store(0, std::memory_order_relaxed);
+    }
+}
+
+void VisiblePoints::BeginIteration(const SampledWavelengths& lambda) {
+    lambda_ = lambda;
+    for (Point& p : points_) p.valid = false;
+    for (BrickGrid& g : grids_) g.cells.clear();
+}
+
+void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
+                        const SurfaceMaterial& material, const SampledSpectrum& beta) {
+    Point& vp = points_[pixel];
+    vp.p = p;
+    vp.ns = ns;
+    vp.wo = wo;
+    vp.material = &material;
+    vp.beta = beta;
+    vp.valid = true;
+}
+
+uint64_t VisiblePoints::CellKey(const Vec3f& p, float cell) const {
+    int64_t x = int64_t(std::floor(p.x / cell)), y = int64_t(std::floor(p.y / cell)),
+            z = int64_t(std::floor(p.z / cell));
+    return HashCombine(HashCombine(MixBits(uint64_t(x)), uint64_t(y)), uint64_t(z));
+}
+
+void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
+    float max_radius = 0;
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        if (points_[i].valid) max_radius = std::max(max_radius, pixels_[i].radius);
+    }
+    if (max_radius <= 0) return;
+    for (BrickGrid& g : grids_) g.cell = 2 * max_radius;
+    std::vector<uint32_t> bricks;
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        const Point& vp = points_[i];
+        if (!vp.valid) continue;
+        float r = pixels_[i].radius;
+        Bounds3f box(vp.p - Vec3f(r, r, r), vp.p + Vec3f(r, r, r));
+        BricksOverlapping(tree, box, &bricks);
+        for (uint32_t b : bricks) {
+            BrickGrid& g = grids_[b];
+            int lo[3], hi[3];
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = int(std::floor(box.min[a] / g.cell));
+                hi[a] = int(std::floor(box.max[a] / g.cell));
+            }
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        Vec3f c((float(x) + 0.5f) * g.cell, (float(y) + 0.5f) * g.cell, (float(z) + 0.5f) * g.cell);
+                        g.cells[CellKey(c, g.cell)].push_back(uint32_t(i));
+                    }
+        }
+    }
+}
+
+void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
+                            const SampledSpectrum& beta, const SampledWavelengths& lambda) {
+    const BrickGrid& g = grids_[brick];
+    auto it = g.cells.find(CellKey(p, g.cell));
+    if (it == g.cells.end()) return;
+    for (uint32_t i : it->second) {
+        const Point& vp = points_[i];
+        PixelState& px = pixels_[i];
+        Vec3f d = vp.p - p;
+        if (Dot(d, d) > px.radius * px.radius) continue;
+        SampledWavelengths l = lambda;
+        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l).Eval(vp.wo, wi, l);
+        if (f.IsZero()) continue;
+        SampledSpectrum phi = beta * f;
+        for (int k = 0; k < kNumWavelengths; ++k) {
+            float old = px.phi[k].load(std::memory_order_relaxed);
+            while (!px.phi[k].compare_exchange_weak(old, old + phi[k], std::memory_order_relaxed)) {
+            }
+        }
+        px.m.fetch_add(1, std::memory_order_relaxed);
+        deposits_.fetch_add(1, std::memory_order_relaxed);
+    }
+}
+
+void VisiblePoints::EndIteration(float alpha) {
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        PixelState& px = pixels_[i];
+        uint32_t m = px.m.load(std::memory_order_relaxed);
+        if (m > 0 && points_[i].valid) {
+            // Hachisuka & Jensen 2009: N' = N + alpha M, R' = R sqrt(N' / (N + M)), tau' = (tau + Phi) R'^2/R^2.
+            double n_new = px.n + alpha * m;
+            float r_new = px.radius * float(std::sqrt(n_new / (px.n + m)));
+            SampledSpectrum phi;
+            for (int k = 0; k < kNumWavelengths; ++k) phi[k] = px.phi[k].load(std::memory_order_relaxed);
+            Vec3d phi_xyz = SampledToXYZ(points_[i].beta * phi, lambda_);
+            double shrink = double(r_new) * r_new / (double(px.radius) * px.radius);
+            px.tau = (px.tau + phi_xyz) * shrink;
+            px.n = n_new;
+            px.radius = r_new;
+        }
+        px.m.store(0, std::memory_order_relaxed);
+        for (auto& f : px.phi) f.store(0, std::memory_order_relaxed);
+    }
+}
+
+Vec3d VisiblePoints::IndirectXYZ(uint32_t pixel, double photons_emitted) const {
+    const PixelState& px = pixels_[pixel];
+    double area = 3.14159265358979 * double(px.radius) * px.radius;
+    if (photons_emitted <= 0 || area <= 0) return {};
+    return px.tau * (1.0 / (photons_emitted * area));
+}
+
+}  // namespace nave::render

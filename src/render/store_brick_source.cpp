@@ -1,0 +1,27 @@
+#include "render/brick_source.h"
+#include "store/store_reader.h"
+
+namespace nave::render {
+
+// ---------------------------------------------------------------------------------------------- store source
+
+StoreBrickSource::StoreBrickSource(std::unique_ptr<store::Store> st, std::shared_ptr<EmbreeDevice> device)
+    : BrickSource(std::move(device), st->tree(), st->tree().BrickCells(uint32_t(st->bricks().size())),
+                  st->materials(), st->header().bounds),
+      store_(std::move(st)) {}
+
+StoreBrickSource::~StoreBrickSource() = default;
+
+StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(const std::filesystem::path& path,
+                                                                   std::shared_ptr<EmbreeDevice> device) {
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> st, store::Store::Open(path));
+    return std::unique_ptr<StoreBrickSource>(new StoreBrickSource(std::move(st), std::move(device)));
+}
+
+StatusOr<store::BrickMesh> StoreBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
+    NAVE_ASSIGN_OR_RETURN(store::BrickMesh mesh, store_->ReadBrick(id));
+    *bytes_read += store_->bricks()[id].BytesOnDisk();
+    return mesh;
+}
+
+}  // namespace nave::render

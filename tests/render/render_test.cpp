@@ -1,0 +1,320 @@
+// End-to-end renders of small in-memory scenes: furnace, analytic sun irradiance, brick-count and
+// thread-count independence.
+
+#include <gtest/gtest.h>
+
+#include "core/color.h"
+#include "core/progress.h"
+#include "render/procedural_meshes.h"
+#include "render_test_util.h"
+
+namespace nave::render {
+namespace {
+
+using testing::MeanY;
+using testing::Render;
+
+class RenderTest : public ::testing::Test {
+  protected:
+    void SetUp() override { ProgressBar::SetEnabled(false); }
+};
+
+// White furnace: inside a closed sphere of albedo a whose surface emits Le, the radiance everywhere is
+// Le / (1 - a) (the Neumann series of the rendering equation, Kajiya 1986, with constant L). With a = 0.5,
+// Le = 0.5: L = 1, and a constant spectrum of 1 has Y = 1 (CIE normalisation of SampledToXYZ).
+store::BrickMesh FurnaceMesh() {
+    store::BrickMesh m;
+    AppendSphere(&m, {0, 0, 0}, 1.0f, 24, 48, 0, /*inward=*/true);
+    return m;
+}
+constexpr const char* kFurnace = R"(
+[camera]
+position = [0.1, 0.05, 0.0]
+look_at = [1, 0.2, 0.1]
+fov_deg = 90
+resolution = [16, 12]
+[materials.shell]
+reflectance = 0.5
+emission = 0.5
+[render]
+mode = "{}"
+spp = 64
+iterations = 12
+photons_per_iteration = 60000
+max_depth = 64
+seed = 3
+)";
+
+TEST_F(RenderTest, WhiteFurnacePathTracing) {
+    auto t = Render(FurnaceMesh(), {"shell"}, fmt::format(fmt::runtime(kFurnace), "path"), 1);
+    ASSERT_TRUE(t);
+    EXPECT_NEAR(MeanY(*t->film), 1.0, 0.02);
+}
+
+TEST_F(RenderTest, WhiteFurnacePhotonMapping) {
+    auto t = Render(FurnaceMesh(), {"shell"}, fmt::format(fmt::runtime(kFurnace), "photon"), 2);
+    ASSERT_TRUE(t);
+    EXPECT_NEAR(MeanY(*t->film), 1.0, 0.02);
+    EXPECT_GT(t->stats.photons, 0u);
+}
+
+// A diffuse plane of albedo R lit by the sun alone: L = R / pi * E, E = L_sun * Omega_sun * cos(zenith)
+// (Lambert's cosine law; the disc's radiance is uniform, and cos varies by < 1e-4 across the disc).
+TEST_F(RenderTest, SunOnDiffusePlaneMatchesCosineLaw) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
+    for (float elevation_deg : {90.f, 30.f}) {
+        float e = elevation_deg * 3.14159265f / 180.f;
+        std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 5]
+look_at = [0.01, 0, 0]
+fov_deg = 20
+resolution = [8, 8]
+[sun]
+direction = [{}, 0, {}]
+radiance = 1000.0
+[materials.plane]
+reflectance = 0.6
+[render]
+spp = 4
+)",
+                                         std::cos(e), std::sin(e));
+        auto t = Render(m, {"plane"}, config, 1);
+        ASSERT_TRUE(t);
+        float cos_sun = std::cos(0.2666f * 3.14159265f / 180.f);
+        double omega = 2 * 3.14159265 * (1 - cos_sun);
+        double expected = 0.6 / 3.14159265 * 1000.0 * omega * std::sin(e);
+        // Y of a constant spectrum equals its value; the estimate is exact up to the 4 wavelengths' pdf
+        // weighting of a flat spectrum, which is exact.
+        EXPECT_NEAR(MeanY(*t->film), expected, 0.01 * expected) << "elevation " << elevation_deg;
+    }
+}
+
+// The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
+store::BrickMesh ClutterMesh() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {4, 0, 0}, {0, 4, 0}, 6, 0);
+    AppendSphere(&m, {0.5f, 0.3f, 1.0f}, 0.8f, 16, 32, 1);
+    AppendSphere(&m, {-1.5f, -1.0f, 0.6f}, 0.6f, 12, 24, 2);
+    AppendBox(&m, Bounds3f({1.0f, -2.5f, 0.01f}, {2.5f, -1.2f, 1.8f}), 0);
+    return m;
+}
+constexpr const char* kClutter = R"(
+[camera]
+position = [6, 5, 3.5]
+look_at = [0, 0, 0.6]
+fov_deg = 45
+resolution = [32, 24]
+[sun]
+direction = [0.4, -0.5, 0.75]
+[sky]
+radiance = 0.05
+[materials.floor]
+reflectance = 0.7
+[materials.ball]
+reflectance = {{ wavelengths_nm = [400, 550, 700], values = [0.1, 0.5, 0.9] }}
+[materials.chrome]
+type = "conductor"
+roughness = 0.2
+[render]
+mode = "{}"
+spp = 4
+iterations = 3
+photons_per_iteration = 20000
+seed = 11
+)";
+
+double MaxRelativeDifference(const Film& a, const Film& b) {
+    double worst = 0;
+    for (size_t p = 0; p < a.pixel_count(); ++p) {
+        Vec3d x = a.PixelXYZ(uint32_t(p)), y = b.PixelXYZ(uint32_t(p));
+        for (int c = 0; c < 3; ++c) {
+            double d = std::abs(x[c] - y[c]) / std::max(1e-3, std::abs(x[c]) + std::abs(y[c]));
+            worst = std::max(worst, d);
+        }
+    }
+    return worst;
+}
+
+TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePath) {
+    std::string config = fmt::format(fmt::runtime(kClutter), "path");
+    auto one = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 1, 1);
+    auto many = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
+    auto many_more_threads = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 4);
+    ASSERT_TRUE(one && many && many_more_threads);
+    EXPECT_GT(many->source->brick_count(), 30u);
+    EXPECT_GT(many->stats.brick_moves, 0u);
+    EXPECT_GT(MeanY(*one->film), 0.0);
+    // Bound: the sums differ only by double summation order (relative ~1e-15 per add).
+    EXPECT_LT(MaxRelativeDifference(*one->film, *many->film), 1e-9);
+    EXPECT_LT(MaxRelativeDifference(*many->film, *many_more_threads->film), 1e-9);
+}
+
+TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
+    // Process bricks emptiest-first and highest-id-first instead of fullest-first: the same image.
+    std::string config = fmt::format(fmt::runtime(kClutter), "path");
+    auto fullest = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
+    ASSERT_TRUE(fullest);
+    for (int policy = 0; policy < 2; ++policy) {
+        Film film(fullest->film->width(), fullest->film->height(), fullest->config.output);
+        RenderStats stats;
+        BrickPicker picker = [policy](const std::vector<size_t>& waiting, const BrickSource&) {
+            uint32_t best = store::kNoBrick;
+            for (uint32_t b = 0; b < waiting.size(); ++b) {
+                if (waiting[b] == 0) continue;
+                if (best == store::kNoBrick || (policy == 0 ? waiting[b] < waiting[best] : true)) best = b;
+            }
+            return best;
+        };
+        ASSERT_TRUE(RenderStreams(fullest->scene, &film, &stats, picker).ok());
+        EXPECT_GT(stats.batches, fullest->stats.batches / 2);
+        EXPECT_LT(MaxRelativeDifference(*fullest->film, film), 1e-9) << "policy " << policy;
+    }
+}
+
+TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePhoton) {
+    std::string config = fmt::format(fmt::runtime(kClutter), "photon");
+    auto one = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 1, 1);
+    auto many = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 3);
+    ASSERT_TRUE(one && many);
+    EXPECT_GT(MeanY(*one->film), 0.0);
+    // Photon deposits add floats atomically per pixel: summation order changes the float flux by ~1e-6.
+    EXPECT_LT(MaxRelativeDifference(*one->film, *many->film), 1e-4);
+}
+
+TEST_F(RenderTest, MissingMaterialMappingNamesIt) {
+    auto device = EmbreeDevice::Create();
+    ASSERT_TRUE(device.ok());
+    GridBricks grid = SplitIntoGridBricks(FurnaceMesh(), 1, 1, 1);
+    store::MaterialRecord rec;
+    rec.name = "glass_blue";
+    MemoryBrickSource source(*device, grid.tree, grid.meshes, {rec});
+    auto config = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.limestone]\n", "abbey.toml");
+    ASSERT_TRUE(config.ok()) << config.status().ToString();
+    auto scene = BuildRenderScene(*config, source);
+    ASSERT_FALSE(scene.ok());
+    EXPECT_NE(scene.status().message().find("glass_blue"), std::string::npos) << scene.status().message();
+    EXPECT_NE(scene.status().message().find("abbey.toml"), std::string::npos) << scene.status().message();
+}
+
+}  // namespace
+}  // namespace nave::render
+
+#include "store/store_writer.h"
+
+namespace nave::render {
+namespace {
+
+/// Writes `mesh` as a store cut into n^3 bricks (triangles in every cell they overlap, as preprocess does).
+Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh& mesh,
+                      const std::vector<std::string>& names, int n) {
+    GridBricks grid = SplitIntoGridBricks(mesh, n, n, n);
+    store::GlobalGrid g;
+    g.origin = Vec3d(-10, -10, -10);
+    g.step = 1e-4;
+    NAVE_ASSIGN_OR_RETURN(auto writer, store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
+    std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
+    for (size_t b = 0; b < grid.meshes.size(); ++b) {
+        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e, store::EncodeBrick(grid.meshes[b], cells[b], g, {}));
+        NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(e));
+        NAVE_CHECK_EQ(id, uint32_t(b));
+    }
+    std::vector<store::MaterialRecord> materials;
+    for (const auto& name : names) {
+        store::MaterialRecord r;
+        r.name = name;
+        materials.push_back(r);
+    }
+    return writer->Finish(materials, grid.tree, mesh.TriangleCount());
+}
+
+TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
+    auto dir = std::filesystem::temp_directory_path() / fmt::format("nave_render_test_{}", getpid());
+    std::filesystem::create_directories(dir);
+    std::vector<std::string> names = {"floor", "ball", "chrome"};
+    ASSERT_TRUE(WriteTestStore(dir / "one.nave", ClutterMesh(), names, 1).ok());
+    Status s = WriteTestStore(dir / "many.nave", ClutterMesh(), names, 4);
+    ASSERT_TRUE(s.ok()) << s.ToString();
+    auto device = EmbreeDevice::Create();
+    ASSERT_TRUE(device.ok());
+    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kClutter), "path"), "clutter.toml");
+    ASSERT_TRUE(config.ok());
+    std::vector<std::unique_ptr<Film>> films;
+    for (const char* name : {"one.nave", "many.nave"}) {
+        auto source = StoreBrickSource::Open(dir / name, *device);
+        ASSERT_TRUE(source.ok()) << source.status().ToString();
+        auto scene = BuildRenderScene(*config, **source);
+        ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+        films.push_back(std::make_unique<Film>(32, 24, config->output));
+        RenderStats stats;
+        ASSERT_TRUE(RenderStreams(*scene, films.back().get(), &stats).ok());
+        EXPECT_EQ(stats.brick_loads, (*source)->brick_count());
+        EXPECT_GT(stats.bytes_read, 0u);
+    }
+    EXPECT_GT(MeanY(*films[0]), 0.0);
+    // Each brick is Draco-encoded on its own, which may rotate a triangle's corners: Embree's t and the hit
+    // point then differ in the last float bits (measured 6e-8 relative). Random decisions are keyed by the
+    // path, not by position, so paths do not diverge and the image stays within float precision.
+    EXPECT_LT(MaxRelativeDifference(*films[0], *films[1]), 1e-5);
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace nave::render
+
+namespace nave::render {
+namespace {
+
+// A closed room (black walls and roof) with a thin glass window in the roof and the sun at the zenith: the
+// floor under the window receives E = L_sun Omega T_tot, T_tot = (1-r)^2 tau / (1 - r^2 tau^2) for a pane of
+// internal transmittance tau (Stokes; Hecht, Optics §9.7), r = ((n-1)/(n+1))^2 at normal incidence.
+// Shadow rays pass through thin glass, so path tracing gets this by next-event estimation; photon mode must
+// give the same (no double counting by photons that merely crossed the pane).
+TEST_F(RenderTest, SunThroughThinGlassWindow) {
+    constexpr const char* kRoom = R"(
+[camera]
+position = [0.3, 0.2, 2.0]
+look_at = [0.3, 0.2, 0]
+up = [0, 1, 0]
+fov_deg = 10
+resolution = [8, 8]
+[sun]
+direction = [0, 0, 1]
+radiance = 1000.0
+[materials.floor]
+reflectance = 0.5
+[materials.wall]
+type = "black"
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+transmittance = 0.8
+portal = true
+[render]
+mode = "{}"
+spp = 4
+iterations = 32
+photons_per_iteration = 1000
+photon_target = "{}"
+max_depth = 1
+)";
+    float cos_sun = std::cos(0.2666f * 3.14159265f / 180.f);
+    double omega = 2 * 3.14159265 * (1 - cos_sun);
+    double r = 0.04, tau = 0.8;
+    double t_tot = (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
+    double expected = 0.5 / 3.14159265 * 1000.0 * omega * t_tot;
+    std::vector<std::string> names = {"floor", "wall", "window"};
+    auto path = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "path", "bounds"), 2);
+    ASSERT_TRUE(path);
+    EXPECT_NEAR(MeanY(*path->film), expected, 0.01 * expected);
+    for (const char* target : {"bounds", "portals"}) {
+        auto photon = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "photon", target), 2);
+        ASSERT_TRUE(photon);
+        // One wavelength set per iteration: 32 sets give the flat spectrum's Y to about 0.5 %.
+        EXPECT_NEAR(MeanY(*photon->film), expected, 0.015 * expected) << target;
+    }
+}
+
+}  // namespace
+}  // namespace nave::render

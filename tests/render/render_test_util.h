@@ -1,0 +1,78 @@
+#pragma once
+// Building small scenes in memory for render tests: a mesh, split into a grid of bricks, plus a config.
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "render/brick_source.h"
+#include "render/film.h"
+#include "render/integrator.h"
+#include "render/procedural_meshes.h"
+#include "render/scene.h"
+#include "render/scene_config.h"
+
+namespace nave::render::testing {
+
+struct TestRender {
+    std::unique_ptr<MemoryBrickSource> source;
+    SceneConfig config;
+    RenderScene scene;
+    std::unique_ptr<Film> film;
+    RenderStats stats;
+};
+
+/// Splits `mesh` into n^3 bricks, parses `config_text`, renders. Material names: material_names[id].
+inline std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh, const std::vector<std::string>& material_names,
+                                          const std::string& config_text, int n_split, int threads = 0) {
+    auto t = std::make_unique<TestRender>();
+    auto device = EmbreeDevice::Create();
+    EXPECT_TRUE(device.ok());
+    GridBricks grid = SplitIntoGridBricks(mesh, n_split, n_split, n_split);
+    std::vector<store::MaterialRecord> materials;
+    for (const auto& name : material_names) {
+        store::MaterialRecord r;
+        r.name = name;
+        materials.push_back(r);
+    }
+    t->source = std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
+    auto config = ParseSceneConfig(config_text, "test.toml");
+    EXPECT_TRUE(config.ok()) << config.status().ToString();
+    if (!config.ok()) return nullptr;
+    t->config = *config;
+    if (threads > 0) t->config.render.threads = threads;
+    auto scene = BuildRenderScene(t->config, *t->source);
+    EXPECT_TRUE(scene.ok()) << scene.status().ToString();
+    if (!scene.ok()) return nullptr;
+    t->scene = std::move(*scene);
+    t->film = std::make_unique<Film>(t->config.camera.width, t->config.camera.height, t->config.output);
+    Status s = RenderStreams(t->scene, t->film.get(), &t->stats);
+    EXPECT_TRUE(s.ok()) << s.ToString();
+    return t;
+}
+
+inline double MeanY(const Film& film) {
+    double sum = 0;
+    for (size_t p = 0; p < film.pixel_count(); ++p) sum += film.PixelXYZ(uint32_t(p)).y;
+    return sum / double(film.pixel_count());
+}
+
+/// A 4 x 4 x 3 m closed room (materials: 0 floor, 1 walls and roof) with a 2 x 2 m window (material 2) in
+/// the roof.
+inline store::BrickMesh RoomWithRoofWindow() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 4, 0);                  // floor, facing up
+    AppendQuad(&m, {2, 0, 1.5f}, {0, 2, 0}, {0, 0, 1.5f}, 1, 1);            // walls
+    AppendQuad(&m, {-2, 0, 1.5f}, {0, 0, 1.5f}, {0, 2, 0}, 1, 1);
+    AppendQuad(&m, {0, 2, 1.5f}, {0, 0, 1.5f}, {2, 0, 0}, 1, 1);
+    AppendQuad(&m, {0, -2, 1.5f}, {2, 0, 0}, {0, 0, 1.5f}, 1, 1);
+    AppendQuad(&m, {1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);             // roof around a 2 x 2 m hole
+    AppendQuad(&m, {-1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);
+    AppendQuad(&m, {0, 1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
+    AppendQuad(&m, {0, -1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
+    AppendQuad(&m, {0, 0, 3}, {1, 0, 0}, {0, 1, 0}, 2, 2);                   // the window
+    return m;
+}
+
+}  // namespace nave::render::testing
