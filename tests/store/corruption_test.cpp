@@ -171,6 +171,93 @@ TEST_F(StoreCorruption, DamagedPayloadBehindValidChecksumsNeverCrashes) {
     EXPECT_GT(errors, 0);
 }
 
+// Tables that pass their checksums but make no sense (what a buggy writer could produce) are
+// refused too.
+TEST_F(StoreCorruption, InconsistentTablesBehindValidChecksumsAreRefused) {
+    auto rechecksum = [&](std::string bytes) {
+        format::RawHeader h = header_;
+        for (format::TableRef* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
+            t->checksum = Checksum64(bytes.data() + t->offset, t->length);
+        }
+        const std::string header = format::EncodeHeader(h);
+        return bytes.replace(0, header.size(), header);
+    };
+    const uint64_t entry1 = header_.directory.offset + format::kDirectoryEntryBytes;
+    {
+        std::string bytes = bytes_;
+        const uint64_t past_end = header_.materials.offset + 100;
+        std::memcpy(&bytes[entry1 + 80], &past_end, 8);  // brick 1's mesh offset
+        auto store = OpenBytes(rechecksum(bytes));
+        ExpectError(store.status(), StatusCode::kDataLoss,
+                    {bad_.string() + " brick 1 @" + Hex(entry1), "mesh section",
+                     "outside the payload area"});
+    }
+    {
+        std::string bytes = bytes_;
+        const uint32_t wrong_id = 7;
+        std::memcpy(&bytes[entry1], &wrong_id, 4);
+        auto store = OpenBytes(rechecksum(bytes));
+        ExpectError(store.status(), StatusCode::kDataLoss, {"brick 1", "says id 7"});
+    }
+    {
+        std::string bytes = bytes_;
+        const uint64_t triangles = bricks_[1].triangle_count + 1;
+        std::memcpy(&bytes[entry1 + 56], &triangles, 8);  // also breaks decoded bytes and the total
+        auto store = OpenBytes(rechecksum(bytes));
+        ExpectError(store.status(), StatusCode::kDataLoss, {"brick 1", "decoded size"});
+    }
+    {
+        // The root's second child pointed back at the root: a cycle.
+        std::string bytes = bytes_;
+        const uint32_t root = 0;
+        std::memcpy(&bytes[header_.tree.offset + 24 + 12], &root, 4);
+        auto store = OpenBytes(rechecksum(bytes));
+        ExpectError(store.status(), StatusCode::kDataLoss,
+                    {bad_.string() + " tree @" + Hex(header_.tree.offset)});
+    }
+    {
+        // A material record that claims more bytes than the table holds.
+        std::string bytes = bytes_;
+        const uint32_t huge = 1u << 30;
+        std::memcpy(&bytes[header_.materials.offset], &huge, 4);
+        auto store = OpenBytes(rechecksum(bytes));
+        ExpectError(store.status(), StatusCode::kDataLoss, {"material 0", "overruns the table"});
+    }
+}
+
+// Random damage to the tables with every checksum recomputed: Open and ReadBrick must return a
+// Status or work, never crash or allocate without bound (run under the asan preset).
+TEST_F(StoreCorruption, RandomTableDamageBehindValidChecksumsNeverCrashes) {
+    std::mt19937 rng(2024);
+    const uint64_t tables_begin = header_.provenance.offset;
+    std::uniform_int_distribution<uint64_t> pos(tables_begin, bytes_.size() - 1);
+    int refused = 0;
+    for (int trial = 0; trial < 120; ++trial) {
+        std::string bytes = bytes_;
+        for (int k = 0; k < 1 + trial % 4; ++k) bytes[pos(rng)] ^= char(1 + rng() % 255);
+        format::RawHeader h = header_;
+        for (format::TableRef* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
+            t->checksum = Checksum64(bytes.data() + t->offset, t->length);
+        }
+        const std::string header = format::EncodeHeader(h);
+        bytes.replace(0, header.size(), header);
+        auto store = OpenBytes(bytes);
+        if (!store.ok()) {
+            ++refused;
+            EXPECT_EQ(store.status().code(), StatusCode::kDataLoss) << store.status().ToString();
+            continue;
+        }
+        for (uint32_t b = 0; b < (*store)->bricks().size(); ++b) {
+            const Status s = (*store)->VerifyBrick(b);
+            if (!s.ok()) {
+                EXPECT_TRUE(s.code() == StatusCode::kDataLoss || s.code() == StatusCode::kNotFound)
+                    << s.ToString();
+            }
+        }
+    }
+    EXPECT_GT(refused, 20);
+}
+
 TEST_F(StoreCorruption, FutureMajorVersionIsRefusedNamingBothVersions) {
     format::RawHeader h = header_;
     h.major = kFormatMajor + 1;
