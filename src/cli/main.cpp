@@ -1,6 +1,8 @@
 // `nave`: one executable, one subcommand per tool. Exit codes: 0 success, 1 bad data or failed work,
 // 2 bad usage (unknown option, invalid argument), 130 interrupted.
 
+#include <malloc.h>
+
 #include <cstdio>
 
 #include "cli/commands.h"
@@ -21,6 +23,11 @@ int ExitCodeFor(const nave::Status& status) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Brick decoding allocates and frees large buffers all the time. With glibc's defaults each one is a fresh
+    // mmap whose page faults cost more than Draco's decoding itself (measured 2-5x slower in
+    // bench_store_decode); keep such buffers in the heap and return memory to the OS less eagerly.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
     CLI::App app{"nave: out-of-core spectral rendering of very large models (CAD, scans, the procedural abbey)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("nave ") + NAVE_VERSION);
