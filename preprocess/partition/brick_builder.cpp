@@ -78,7 +78,8 @@ BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::G
     if (uvs) mesh.uvs.reserve(triangles.size());
     mesh.indices.reserve(triangles.size() * 3);
     mesh.material_ids.reserve(triangles.size());
-    VertexTable table(triangles.size() + 16);
+    // At most three vertices per triangle; the table stays at most half full.
+    VertexTable table(3 * triangles.size() + 16);
     for (const Triangle& t : triangles) {
         Vec3f face_normal(0, 0, 1);
         if (normals) {
