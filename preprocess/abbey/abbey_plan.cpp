@@ -34,7 +34,10 @@ constexpr double kAisleRise = 5.25;       // aisle vault crown at 14 m
 constexpr double kWallTop = 30.0, kAisleWallTop = 15.5;
 constexpr double kRidge = 39.0;
 constexpr double kAmbulatory = 13.0;      // inner face of the ambulatory wall (radius)
-constexpr double kChapelRadius = 2.6;
+constexpr double kChapelRadius = 3.0;
+// The hemicycle: five bays of 36 degrees round the apse centre, so that one radiating chapel is on the axis.
+constexpr int kApseBays = 5;
+constexpr double kApseStep = 180.0 / kApseBays;
 const Vec3d kApse(kChoirX1, 0, 0);
 
 Vec3d Dir(double degrees) {
@@ -43,9 +46,11 @@ Vec3d Dir(double degrees) {
 }
 
 // The ambulatory's radiating chapels sit on the bisectors of the hemicycle's six bays.
-double ChapelAngle(int k) { return -75.0 + 30.0 * k; }
+double ChapelAngle(int k) { return -90.0 + kApseStep * (k + 0.5); }
+// Angle of the k-th radial line of the hemicycle (k = 0 south, kApseBays north).
+double ApseAngle(int k) { return -90.0 + kApseStep * k; }
 Vec3d ChapelCentre(int k) {
-    return kApse + Dir(ChapelAngle(k)) * (kAmbulatory * std::cos(15 * kPi / 180) + kOuterWallT);
+    return kApse + Dir(ChapelAngle(k)) * (kAmbulatory * std::cos(kApseStep / 2 * kPi / 180) + kOuterWallT);
 }
 
 // A triangular prism: the triangle a b c extruded by `e` (gables).
@@ -104,10 +109,10 @@ bool InsidePlan(double x, double y) {
     if (x >= kChoirX1) {
         Vec3d d(x - kApse.x, y, 0);
         double r = Length(d);
-        // The ambulatory is a polygon of six sides whose inner faces are at distance 13 cos 15 deg at the
-        // bisectors; a disc of that radius is inside it.
-        if (r <= kAmbulatory * std::cos(15 * kPi / 180)) return true;
-        for (int k = 0; k < 6; ++k) {
+        // The ambulatory is a polygon whose inner faces are at distance 13 cos(step / 2) at the bisectors; a
+        // disc of that radius is inside it.
+        if (r <= kAmbulatory * std::cos(kApseStep / 2 * kPi / 180)) return true;
+        for (int k = 0; k < kApseBays; ++k) {
             Vec3d q = ChapelCentre(k);
             Vec3d dq(x - q.x, y - q.y, 0);
             Vec3d axis = Dir(ChapelAngle(k));
@@ -115,13 +120,13 @@ bool InsidePlan(double x, double y) {
             // Between the chapel and the ambulatory: the opening through the wall.
             double along = Dot(dq, axis);
             double across = std::abs(Dot(dq, Cross(Vec3d(0, 0, 1), axis)));
-            if (along <= 0 && along >= -kOuterWallT - 0.05 && across <= 2.2) return true;
+            if (along <= 0 && along >= -kOuterWallT - 0.05 && across <= 2.6) return true;
         }
         // Ambulatory sectors: inside the polygon through the six bay corners at radius 13.
         double a = std::atan2(y, x - kApse.x) * 180 / kPi;
         if (a < -90 || a > 90) return false;
-        int k = std::min(5, int((a + 90) / 30));
-        Vec3d p0 = kApse + Dir(-90 + 30.0 * k) * kAmbulatory, p1 = kApse + Dir(-60 + 30.0 * k) * kAmbulatory;
+        int k = std::min(kApseBays - 1, int((a + 90) / kApseStep));
+        Vec3d p0 = kApse + Dir(ApseAngle(k)) * kAmbulatory, p1 = kApse + Dir(ApseAngle(k + 1)) * kAmbulatory;
         Vec3d e = p1 - p0, v(x - p0.x, y - p0.y, 0);
         return Cross(e, v).z >= 0;  // left of the edge going counter-clockwise = inside
     }
@@ -151,7 +156,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     for (double x : {kCrossingX0, kCrossingX1, kCrossingX1 + kBay}) {
         for (double s : {-1.0, 1.0}) piers.push_back(Vec3d(x, s * kArcadeY, 0));
     }
-    for (int k = 0; k <= 6; ++k) piers.push_back(kApse + Dir(-90 + 30.0 * k) * kArcadeY);
+    for (int k = 0; k <= kApseBays; ++k) piers.push_back(kApse + Dir(ApseAngle(k)) * kArcadeY);
     for (size_t i = 0; i < piers.size(); ++i) {
         PierSpec p;
         p.base = piers[i];
@@ -178,14 +183,14 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         upper_wall(0, kNaveBays, s, "nave upper wall");
         upper_wall(kCrossingX1, 2, s, "choir upper wall");
     }
-    // Hemicycle upper walls: six narrow bays between the apse piers.
-    for (int k = 0; k < 6; ++k) {
-        Vec3d a = kApse + Dir(-90 + 30.0 * k) * kNaveInner, b = kApse + Dir(-60 + 30.0 * k) * kNaveInner;
+    // Hemicycle upper walls: narrow bays between the apse piers.
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d a = kApse + Dir(ApseAngle(k)) * kNaveInner, b = kApse + Dir(ApseAngle(k + 1)) * kNaveInner;
         Vec3d along = Normalize(b - a);
         Vec3d inward = Cross(Vec3d(0, 0, 1), along);  // counter-clockwise round the apse: left is inside
         WallSpec w = Wall(a, along, inward, Length(b - a), kArcadeSpring, kWallTop, kUpperWallT, seed++);
         double c = Length(b - a) / 2;
-        w.openings.push_back(Arch(c, 0.8, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
+        w.openings.push_back(Arch(c, 0.95, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
         w.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
         add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) { EmitWall(em, w, d); });
     }
@@ -284,12 +289,12 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     }
 
     // Ambulatory wall, with an arch into each radiating chapel.
-    for (int k = 0; k < 6; ++k) {
-        Vec3d a = kApse + Dir(-90 + 30.0 * k) * kAmbulatory, b = kApse + Dir(-60 + 30.0 * k) * kAmbulatory;
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d a = kApse + Dir(ApseAngle(k)) * kAmbulatory, b = kApse + Dir(ApseAngle(k + 1)) * kAmbulatory;
         Vec3d along = Normalize(b - a);
         WallSpec w = Wall(a, along, Cross(Vec3d(0, 0, 1), along), Length(b - a), 0, kAisleWallTop, kOuterWallT,
                           seed++);
-        w.openings = {Arch(Length(b - a) / 2, 2.2, 0, 5.5, 3.0)};
+        w.openings = {Arch(Length(b - a) / 2, 2.6, 0, 5.5, 3.0)};
         Vec3d q = ChapelCentre(k);
         Vec3d axis = Dir(ChapelAngle(k));
         std::vector<WallSpec> chapel;
@@ -356,14 +361,14 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
                 false, "choir aisle vault");
         }
     }
-    for (int k = 0; k < 6; ++k) {
-        Vec3d d0 = Dir(-90 + 30.0 * k), d1 = Dir(-60 + 30.0 * k);
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d d0 = Dir(ApseAngle(k)), d1 = Dir(ApseAngle(k + 1));
         double ri = kArcadeY + kUpperWallT / 2;
         bay(kApse + d0 * ri, kApse + d1 * ri, kApse + d1 * kAmbulatory, kApse + d0 * kAmbulatory, kArcadeSpring,
-            kAisleRise, k == 5, "ambulatory vault");
+            kAisleRise, k == kApseBays - 1, "ambulatory vault");
     }
     add("apse vault", [=](Emitter& em) {
-        EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, 5, d);
+        EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, kApseBays - 1, d);
     });
 
     // Roofs: the main roof over nave and choir, the transept roof, the apse's half cone, lean-to roofs
