@@ -259,7 +259,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             double x = east ? kCrossingX1 : kCrossingX0;
             Vec3d inward(east ? -1 : 1, 0, 0);
             // Over the aisle (|y| 6.5..13): wall above the aisle vault only.
-            WallSpec over = Wall(Vec3d(x, s * kArcadeY, 0), Vec3d(0, s, 0), inward, kAisleWall - kArcadeY, 14.6,
+            WallSpec over = Wall(Vec3d(x, s * kArcadeY, 0), Vec3d(0, s, 0), inward, kAisleWall - kArcadeY, 13.0,
                                  kWallTop, kOuterWallT, seed++);
             WallSpec arm = Wall(Vec3d(x, s * kAisleWall, 0), Vec3d(0, s, 0), inward, kTransept - kAisleWall, 0,
                                 kWallTop, kOuterWallT, seed++);
@@ -406,6 +406,24 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             }
         });
     }
+    add("ridges", [=](Emitter& em) {
+        // Half-round ridge tiles over the main and transept ridges.
+        auto ridge = [&](Vec3d a, Vec3d b, Vec3d side) {
+            std::vector<Vec2> profile;
+            int n = d.Seg(8);
+            for (int i = 0; i <= n; ++i) {
+                double t = kPi * i / n;
+                profile.push_back({0.2 * std::cos(t), 0.2 * std::sin(t)});
+            }
+            std::vector<Vec3d> path;
+            int m = std::max(2, d.Seg(40));
+            for (int i = 0; i <= m; ++i) path.push_back(a + (b - a) * (double(i) / m));
+            Sweep(em, path, side, profile, kRoofSlate);
+        };
+        ridge(Vec3d(-1.5, 0, kRidge - 0.05), Vec3d(kChoirX1, 0, kRidge - 0.05), Vec3d(0, 1, 0));
+        double y1 = kTransept + kOuterWallT + 0.3, xc = 0.5 * (kCrossingX0 + kCrossingX1);
+        ridge(Vec3d(xc, -y1, kRidge - 0.05), Vec3d(xc, y1, kRidge - 0.05), Vec3d(1, 0, 0));
+    });
     add("apse roof", [=](Emitter& em) {
         auto cone = [=](double u, double t) {
             return kApse + Dir(-90 + 180 * u) * (eave * (1 - t)) + Vec3d(0, 0, kWallTop + pitch * t);
