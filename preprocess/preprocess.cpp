@@ -35,9 +35,10 @@ double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 // buffers, the sample, the split buffers per thread, and a margin for the allocator and libraries.
 constexpr uint64_t kFixedBytes = 48ull << 20;
 
-std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step, int threads) {
-    return fmt::format("brick-triangles={} memory={} precision={} threads={} draco-speed={}", o.brick_triangles,
-                       budget, step, threads, o.encode.draco_speed);
+std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step, int threads,
+                        const std::string& units) {
+    return fmt::format("brick-triangles={} memory={} precision={} threads={} draco-speed={} units={}",
+                       o.brick_triangles, budget, step, threads, o.encode.draco_speed, units);
 }
 
 }  // namespace
@@ -168,7 +169,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     for (const auto& in : options.inputs) provenance.source_files.push_back(in.string());
     if (!options.generate.empty()) provenance.source_files.push_back(options.generate);
     provenance.tool_version = options.tool_version;
-    provenance.options = OptionsText(options, stats.memory_budget, stats.grid_step, stats.threads);
+    provenance.options = OptionsText(options, stats.memory_budget, stats.grid_step, stats.threads, stats.units);
     NAVE_ASSIGN_OR_RETURN(auto writer, store::StoreWriter::Create(options.output, grid, provenance));
 
     phase = Clock::now();

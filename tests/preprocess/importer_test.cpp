@@ -168,6 +168,21 @@ TEST(GltfImporter, NodeTransformsAndMaterials) {
     EXPECT_EQ(source->units(), "m");
 }
 
+TEST(GltfImporter, BinaryGlbGivesTheSameTriangle) {
+    auto text = ReadModel(Fixture("node_transform.gltf"));
+    auto binary = ReadModel(Fixture("node_transform.glb"));
+    ASSERT_EQ(binary.size(), 1u);
+    EXPECT_EQ(binary[0].p, text[0].p);
+}
+
+TEST(AssimpImporter, OtherFormatsThroughAssimp) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("square.off"), &source);
+    ASSERT_EQ(tris.size(), 2u);  // the quad, triangulated
+    EXPECT_NEAR(Area(tris[0]) + Area(tris[1]), 1.0, 1e-6);
+    EXPECT_EQ(source->units(), "unknown");
+}
+
 TEST(MergedInputs, MaterialNamesAreMadeUnique) {
     auto source = OpenModels({Fixture("shapes_crlf.obj"), Fixture("shapes_crlf.obj"), Fixture("ascii.stl")});
     ASSERT_TRUE(source.ok()) << source.status().ToString();
