@@ -82,6 +82,18 @@ WallSpec Wall(Vec3d origin, Vec3d along, Vec3d inward, double length, double z0,
     return w;
 }
 
+// A side of a convex polygonal wall (hemicycle, ambulatory, chapels) from a to b, interior to the left. Each
+// side is lengthened by thickness * tan(turn / 2) at both ends so that neighbouring sides close the wedge
+// between them on the outside (the overlap is hidden inside the neighbour).
+WallSpec PolygonSide(Vec3d a, Vec3d b, double turn_degrees, double z0, double z1, double thickness,
+                     uint64_t seed) {
+    Vec3d along = Normalize(b - a);
+    double e = thickness * std::tan(turn_degrees / 2 * kPi / 180);
+    WallSpec w = Wall(a - along * e, along, Cross(Vec3d(0, 0, 1), along), Length(b - a) + 2 * e, z0, z1,
+                      thickness, seed);
+    return w;
+}
+
 Opening Window(double center, double half_width, double sill, double spring, double rise) {
     Opening o;
     o.center = center;
@@ -167,17 +179,24 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         add(fmt::format("pier {}", i), [=](Emitter& em) { EmitPier(em, p, d); });
     }
 
-    // Upper walls of nave and choir: arcade arches below, clerestory windows above.
+    // Upper walls of nave and choir: arcade arches below, clerestory windows above. A wall course holds one
+    // opening per column, so the arcade storey and the clerestory storey are two courses (split at 17 m).
+    const double kStorey = 17.0;
     auto upper_wall = [&](double x0, int bays, double side, const std::string& name) {
         Vec3d origin(x0, side * kNaveInner, 0);
-        WallSpec w = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kArcadeSpring, kWallTop,
-                          kUpperWallT, seed++);
+        WallSpec arcade = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kArcadeSpring, kStorey,
+                               kUpperWallT, seed++);
+        WallSpec clerestory = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kStorey, kWallTop,
+                                   kUpperWallT, seed++);
         for (int b = 0; b < bays; ++b) {
             double c = (b + 0.5) * kBay;
-            w.openings.push_back(Arch(c, kBay / 2 - 0.9, kArcadeSpring, kArcadeSpring, 4.9));
-            w.openings.push_back(Window(c, 1.3, kVaultSpring, 23.6, 2.2));
+            arcade.openings.push_back(Arch(c, kBay / 2 - 0.9, kArcadeSpring, kArcadeSpring, 4.9));
+            clerestory.openings.push_back(Window(c, 1.3, kVaultSpring, 23.6, 2.2));
         }
-        add(name, [=](Emitter& em) { EmitWall(em, w, d); });
+        add(name, [=](Emitter& em) {
+            EmitWall(em, arcade, d);
+            EmitWall(em, clerestory, d);
+        });
     };
     for (double s : {-1.0, 1.0}) {
         upper_wall(0, kNaveBays, s, "nave upper wall");
@@ -186,13 +205,16 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     // Hemicycle upper walls: narrow bays between the apse piers.
     for (int k = 0; k < kApseBays; ++k) {
         Vec3d a = kApse + Dir(ApseAngle(k)) * kNaveInner, b = kApse + Dir(ApseAngle(k + 1)) * kNaveInner;
-        Vec3d along = Normalize(b - a);
-        Vec3d inward = Cross(Vec3d(0, 0, 1), along);  // counter-clockwise round the apse: left is inside
-        WallSpec w = Wall(a, along, inward, Length(b - a), kArcadeSpring, kWallTop, kUpperWallT, seed++);
-        double c = Length(b - a) / 2;
+        // Counter-clockwise round the apse: the interior is on the left. Two storeys, as in the nave.
+        WallSpec w = PolygonSide(a, b, kApseStep, kArcadeSpring, kStorey, kUpperWallT, seed++);
+        WallSpec up = PolygonSide(a, b, kApseStep, kStorey, kWallTop, kUpperWallT, seed++);
+        double c = w.length / 2;
         w.openings.push_back(Arch(c, 0.95, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
-        w.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
-        add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) { EmitWall(em, w, d); });
+        up.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
+        add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) {
+            EmitWall(em, w, d);
+            EmitWall(em, up, d);
+        });
     }
 
     // Aisle walls with a window per bay, and the buttresses and flying buttresses between the bays.
@@ -291,10 +313,8 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     // Ambulatory wall, with an arch into each radiating chapel.
     for (int k = 0; k < kApseBays; ++k) {
         Vec3d a = kApse + Dir(ApseAngle(k)) * kAmbulatory, b = kApse + Dir(ApseAngle(k + 1)) * kAmbulatory;
-        Vec3d along = Normalize(b - a);
-        WallSpec w = Wall(a, along, Cross(Vec3d(0, 0, 1), along), Length(b - a), 0, kAisleWallTop, kOuterWallT,
-                          seed++);
-        w.openings = {Arch(Length(b - a) / 2, 2.6, 0, 5.5, 3.0)};
+        WallSpec w = PolygonSide(a, b, kApseStep, 0, kAisleWallTop, kOuterWallT, seed++);
+        w.openings = {Arch(w.length / 2, 2.6, 0, 5.5, 3.0)};
         Vec3d q = ChapelCentre(k);
         Vec3d axis = Dir(ChapelAngle(k));
         std::vector<WallSpec> chapel;
@@ -302,9 +322,8 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         for (int j = 0; j < kSides; ++j) {
             double a0 = ChapelAngle(k) - 90 + 180.0 * j / kSides, a1 = ChapelAngle(k) - 90 + 180.0 * (j + 1) / kSides;
             Vec3d p0 = q + Dir(a0) * kChapelRadius, p1 = q + Dir(a1) * kChapelRadius;
-            Vec3d al = Normalize(p1 - p0);
-            WallSpec c = Wall(p0, al, Cross(Vec3d(0, 0, 1), al), Length(p1 - p0), 0, 11.0, 0.9, seed++);
-            c.openings = {Window(Length(p1 - p0) / 2, 0.35, 3.0, 6.2, 1.0)};
+            WallSpec c = PolygonSide(p0, p1, 180.0 / kSides, 0, 11.0, 0.9, seed++);
+            c.openings = {Window(c.length / 2, 0.35, 3.0, 6.2, 1.0)};
             chapel.push_back(c);
         }
         add(fmt::format("ambulatory bay {}", k), [=](Emitter& em) {
