@@ -61,7 +61,7 @@ TEST(AbbeySlow, DetailScalesTriangles) {
                 (unsigned long long)d1.triangles);
 }
 
-TEST(AbbeySlow, DetailFourIsAboutFourTimesDetailOne) {
+TEST(AbbeySlow, DetailFourHasMoreThanTwiceDetailOne) {
     Digest d1 = Consume(*MakeAbbeySource(1.0));
     Digest d4 = Consume(*MakeAbbeySource(4.0));
     double ratio = double(d4.triangles) / double(d1.triangles);
