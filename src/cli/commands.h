@@ -15,6 +15,10 @@ using CommandRun = std::function<Status()>;
 
 // One line per subcommand; main.cpp calls them in this order (the order of `nave --help`).
 void RegisterVersionCommand(CLI::App& app, CommandRun& run);
+void RegisterInspectCommand(CLI::App& app, CommandRun& run);
+void RegisterVerifyCommand(CLI::App& app, CommandRun& run);
+void RegisterPreprocessCommand(CLI::App& app, CommandRun& run);
+void RegisterGenerateCommand(CLI::App& app, CommandRun& run);
 void RegisterRenderCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

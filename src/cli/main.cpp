@@ -30,6 +30,10 @@ int main(int argc, char** argv) {
 
     nave::cli::CommandRun run;
     nave::cli::RegisterVersionCommand(app, run);
+    nave::cli::RegisterInspectCommand(app, run);
+    nave::cli::RegisterVerifyCommand(app, run);
+    nave::cli::RegisterPreprocessCommand(app, run);
+    nave::cli::RegisterGenerateCommand(app, run);
     nave::cli::RegisterRenderCommand(app, run);
 
     try {

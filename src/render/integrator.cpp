@@ -103,9 +103,13 @@ class Engine {
     /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
     bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
     void SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
-                     const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick, Outbox& out,
+                     const RayRecord& r, const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out,
                      LocalCounters& c);
     void Escape(const RayRecord& r);
+    /// Next-event estimation of the uniform sky: a uniform direction on the sphere (its pdf does not depend on
+    /// the vertex, so an escaping path can weigh itself against it), power heuristic with the BSDF.
+    void SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r, const VertexRng& rng,
+                   bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
     /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin glass
     /// (windows) lets it through, scaled by the pane's transmittance at that angle: panes do not bend rays.
     bool ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const;
@@ -178,7 +182,12 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
 void Engine::Escape(const RayRecord& r) {
     if (r.kind != kPathRay) return;  // photons leaving the model carry nothing back
     SampledSpectrum L;
-    if (scene_.sky) L += scene_.sky_radiance.Sample(r.lambda);
+    if (scene_.sky) {
+        // The sky is also next-event estimated (uniform directions): weight the BSDF-sampled escape.
+        float w = 1;
+        if (r.depth > 0 && !(r.flags & kSpecularBounce)) w = PowerHeuristic(r.prev_pdf, UniformSpherePdf());
+        L += scene_.sky_radiance.Sample(r.lambda) * w;
+    }
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
         if (Dot(r.dir, sun.to_light) >= sun.cos_sun) {
@@ -233,7 +242,7 @@ void Engine::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& 
 }
 
 void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
-                         const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick,
+                         const RayRecord& r, const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick,
                          Outbox& out, LocalCounters& c) {
     Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
     Vec3f wi;
@@ -277,13 +286,31 @@ void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, con
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return;
     float w = 1;
-    if (light_pdf > 0) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
+    if (light_pdf > 0 && mis) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = t_max;
     s.beta = r.beta * f * Li * w;
+    Spawn(s, b, &brick, out, c);
+}
+
+void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r,
+                       const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c) {
+    const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
+    Vec3f wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+    SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
+    if (f.IsZero()) return;
+    const float light_pdf = UniformSpherePdf();
+    float w = mis ? PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda)) : 1.f;
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.dir = wi;
+    s.t_max = kInfinity;
+    s.beta = r.beta * f * scene_.sky_radiance.Sample(r.lambda) * (w / light_pdf);
+    if (s.beta.IsZero()) return;
     Spawn(s, b, &brick, out, c);
 }
 
@@ -305,12 +332,16 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     if (flags == kBxdfUnset) return false;
     VertexRng rng(Key(r, kStreamPath));
     const bool non_specular = flags & (kBxdfDiffuse | kBxdfGlossy);
+    // In photon mode the path stops at its first diffuse vertex: no BSDF-sampled direction will find the
+    // lights from here, so next-event estimation takes the full weight.
+    const bool visible_point = scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse);
     if (non_specular) {
         for (size_t i = 0; i < scene_.lights.size(); ++i) {
-            SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, b, brick, out, c);
+            SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, !visible_point, b, brick, out, c);
         }
+        if (scene_.sky) SampleSky(h, bsdf, wo, r, rng, !visible_point, b, brick, out, c);
     }
-    if (scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse)) {
+    if (visible_point) {
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from photons.
         visible_->Add(r.pixel, h.p, h.ns, wo, mat, r.beta);
         return false;
@@ -701,7 +732,8 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                 r.origin = disc_origin(to);
                 r.dir = -to;
                 r.beta = scene_.sky_radiance.Sample(lambda) * (4 * kPiF * disk_area);
-                r.flags = kFromAreaLight;
+                // Direct skylight is next-event estimated at the visible points: sky photons deposit only
+                // after a bounce.
             } else {
                 // Uniform point on the triangle (Turk 1990 square-root parameterisation), cosine-weighted
                 // direction on a side chosen with probability 1/2.

@@ -91,6 +91,35 @@ spp = 4
     }
 }
 
+// A diffuse plane under a uniform sky of radiance L: E = pi L from the open hemisphere, so the reflected
+// radiance is R L (Lambert). Both modes (next-event estimation of the sky, weighted against BSDF sampling).
+TEST_F(RenderTest, UniformSkyOnDiffusePlane) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
+    for (const char* mode : {"path", "photon"}) {
+        std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 5]
+look_at = [0.01, 0, 0]
+fov_deg = 20
+resolution = [8, 8]
+[sky]
+radiance = 2.0
+[materials.plane]
+reflectance = 0.6
+[render]
+mode = "{}"
+spp = 64
+iterations = 64
+photons_per_iteration = 1000
+)", mode);
+        auto t = Render(m, {"plane"}, config, 1);
+        ASSERT_TRUE(t);
+        // The 50 m plane seen from 5 m hides a little sky near the horizon from nothing: exact up to noise.
+        EXPECT_NEAR(MeanY(*t->film), 0.6 * 2.0, 0.02 * 1.2) << mode;
+    }
+}
+
 // The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
 store::BrickMesh ClutterMesh() {
     store::BrickMesh m;

@@ -1,0 +1,184 @@
+#include "preprocess/abbey/primitives.h"
+
+#include <algorithm>
+
+namespace nave::preprocess::abbey {
+
+double Hash01(uint64_t a, uint64_t b, uint64_t c) {
+    // SplitMix64 finaliser (Steele, Lea, Flood 2014) over a combination of the inputs.
+    uint64_t x = a * 0x9E3779B97F4A7C15ull ^ (b + 0x632BE59BD9B4E019ull) * 0xC2B2AE3D27D4EB4Full ^
+                 (c + 0x165667B19E3779F9ull) * 0x27D4EB2F165667C5ull;
+    x ^= x >> 30;
+    x *= 0xBF58476D1CE4E5B9ull;
+    x ^= x >> 27;
+    x *= 0x94D049BB133111EBull;
+    x ^= x >> 31;
+    return double(x >> 11) * (1.0 / 9007199254740992.0);
+}
+
+double PointedArch(double t, double rho) {
+    t = std::clamp(t, 0.0, 1.0);
+    double d = t + rho - 1;
+    double h = std::sqrt(std::max(0.0, rho * rho - d * d));
+    return h / std::sqrt(2 * rho - 1);
+}
+
+void Box(Emitter& em, const Vec3d& lo, const Vec3d& hi, uint32_t m) {
+    Vec3d c = (lo + hi) * 0.5, h = (hi - lo) * 0.5;
+    OrientedBox(em, c, Vec3d(h.x, 0, 0), Vec3d(0, h.y, 0), Vec3d(0, 0, h.z), m);
+}
+
+void OrientedBox(Emitter& em, const Vec3d& o, const Vec3d& a, const Vec3d& b, const Vec3d& c, uint32_t m) {
+    const Vec3d* axes[3] = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+        const Vec3d& n = *axes[k];
+        const Vec3d& p = *axes[(k + 1) % 3];
+        const Vec3d& q = *axes[(k + 2) % 3];
+        for (double s : {-1.0, 1.0}) {
+            Vec3d f = o + n * s;
+            em.Quad(f - p - q, f + p - q, f + p + q, f - p + q, n * s, m);
+        }
+    }
+}
+
+void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& s, uint64_t seed, uint32_t m) {
+    double j = s.joint, c = std::min({s.chamfer, lu * 0.25, lv * 0.25});
+    double u0 = j, u1 = lu - j, v0 = j, v1 = lv - j;
+    if (u1 - u0 <= 2 * c || v1 - v0 <= 2 * c) return;
+    int n = std::max(1, s.subdivisions);
+    // Front face grid, tooled inside (the border stays flat so the chamfers meet it exactly).
+    auto front = [&](int i, int k) {
+        double x = u0 + c + (u1 - u0 - 2 * c) * i / n;
+        double y = v0 + c + (v1 - v0 - 2 * c) * k / n;
+        double z = s.relief;
+        if (i > 0 && i < n && k > 0 && k < n) z += s.tooling * (2 * Hash01(seed, i, k) - 1);
+        return f.At(x, y, z);
+    };
+    for (int k = 0; k < n; ++k) {
+        for (int i = 0; i < n; ++i) {
+            em.Quad(front(i, k), front(i + 1, k), front(i + 1, k + 1), front(i, k + 1), f.w, m);
+        }
+    }
+    // Chamfers: from the face border down to the wall face at the stone's edge, n segments per side.
+    auto base = [&](double x, double y) { return f.At(x, y, 0); };
+    for (int i = 0; i < n; ++i) {
+        double a = double(i) / n, b = double(i + 1) / n;
+        double xa = u0 + (u1 - u0) * a, xb = u0 + (u1 - u0) * b;
+        double ya = v0 + (v1 - v0) * a, yb = v0 + (v1 - v0) * b;
+        // Bottom (v0) and top (v1) edges.
+        em.Quad(base(xa, v0), base(xb, v0), front(i + 1, 0), front(i, 0), f.w - f.v, m);
+        em.Quad(base(xa, v1), base(xb, v1), front(i + 1, n), front(i, n), f.w + f.v, m);
+        // Left (u0) and right (u1) edges.
+        em.Quad(base(u0, ya), base(u0, yb), front(0, i + 1), front(0, i), f.w - f.u, m);
+        em.Quad(base(u1, ya), base(u1, yb), front(n, i + 1), front(n, i), f.w + f.u, m);
+    }
+}
+
+void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, int segments, uint32_t m, int sides,
+             double phase) {
+    const double kTwoPi = 6.283185307179586;
+    auto dir = [&](int i) {
+        double a = phase + kTwoPi * i / segments;
+        if (sides > 0) {
+            // A regular polygon: the radius is scaled so that the apothem equals the profile radius.
+            double sector = kTwoPi / sides;
+            double local = std::fmod(a - phase, sector) - sector / 2;
+            double scale = std::cos(sector / 2) / std::cos(local) / std::cos(sector / 2);
+            return Vec3d(std::cos(a) * scale, std::sin(a) * scale, 0);
+        }
+        return Vec3d(std::cos(a), std::sin(a), 0);
+    };
+    for (size_t k = 0; k + 1 < profile.size(); ++k) {
+        Vec2 p0 = profile[k], p1 = profile[k + 1];
+        double dr = p1.x - p0.x, dz = p1.y - p0.y;
+        double len = std::hypot(dr, dz);
+        if (len == 0) continue;
+        double nr = dz / len, nz = -dr / len;  // the profile's right-hand normal: outward for an upward profile
+        for (int i = 0; i < segments; ++i) {
+            Vec3d d0 = dir(i), d1 = dir(i + 1);
+            Vec3d a = base + d0 * p0.x + Vec3d(0, 0, p0.y), b = base + d1 * p0.x + Vec3d(0, 0, p0.y);
+            Vec3d c = base + d1 * p1.x + Vec3d(0, 0, p1.y), d = base + d0 * p1.x + Vec3d(0, 0, p1.y);
+            Vec3d n0 = Normalize(Vec3d(d0.x, d0.y, 0)) * nr + Vec3d(0, 0, nz);
+            Vec3d n1 = Normalize(Vec3d(d1.x, d1.y, 0)) * nr + Vec3d(0, 0, nz);
+            Vec3d out = (n0 + n1) * 0.5;
+            if (sides > 0) {
+                em.Quad(a, b, c, d, out, m);
+            } else {
+                em.QuadN(a, b, c, d, n0, n1, n1, n0, out, m);
+            }
+        }
+    }
+}
+
+void Sweep(Emitter& em, const std::vector<Vec3d>& path, const Vec3d& side, const std::vector<Vec2>& profile,
+           uint32_t m, bool caps) {
+    size_t np = path.size(), nq = profile.size();
+    if (np < 2 || nq < 3) return;
+    std::vector<Vec3d> ring_prev(nq), ring(nq);
+    Vec3d center_prev;
+    auto make_ring = [&](size_t i, std::vector<Vec3d>& out) {
+        Vec3d t = path[std::min(i + 1, np - 1)] - path[i > 0 ? i - 1 : 0];
+        Vec3d n = Normalize(Cross(side, t));
+        for (size_t q = 0; q < nq; ++q) out[q] = path[i] + side * profile[q].x + n * profile[q].y;
+    };
+    make_ring(0, ring_prev);
+    for (size_t i = 1; i < np; ++i) {
+        make_ring(i, ring);
+        for (size_t q = 0; q < nq; ++q) {
+            size_t r = (q + 1) % nq;
+            Vec3d mid = (path[i - 1] + path[i]) * 0.5;
+            Vec3d out = (ring_prev[q] + ring_prev[r] + ring[q] + ring[r]) * 0.25 - mid;
+            Vec3d n0 = ring_prev[q] - path[i - 1], n1 = ring_prev[r] - path[i - 1];
+            Vec3d n2 = ring[r] - path[i], n3 = ring[q] - path[i];
+            em.QuadN(ring_prev[q], ring_prev[r], ring[r], ring[q], n0, n1, n2, n3, out, m);
+        }
+        std::swap(ring_prev, ring);
+    }
+    if (caps) {
+        std::vector<Vec3d> first(nq), last(nq);
+        make_ring(0, first);
+        make_ring(np - 1, last);
+        Vec3d t0 = path[0] - path[1], t1 = path[np - 1] - path[np - 2];
+        for (size_t q = 1; q + 1 < nq; ++q) {
+            em.Tri(first[0], first[q], first[q + 1], t0, m);
+            em.Tri(last[0], last[q], last[q + 1], t1, m);
+        }
+    }
+}
+
+void ParamGrid(Emitter& em, const std::function<Vec3d(double, double)>& p, int ns, int nt,
+               const std::function<Vec3d(const Vec3d&)>& outward, uint32_t m) {
+    std::vector<Vec3d> pts((ns + 1) * (nt + 1)), nrm((ns + 1) * (nt + 1));
+    const double e = 1e-4;
+    for (int j = 0; j <= nt; ++j) {
+        for (int i = 0; i <= ns; ++i) {
+            double s = double(i) / ns, t = double(j) / nt;
+            pts[j * (ns + 1) + i] = p(s, t);
+            double s0 = std::max(0.0, s - e), s1 = std::min(1.0, s + e);
+            double t0 = std::max(0.0, t - e), t1 = std::min(1.0, t + e);
+            Vec3d n = Cross(p(s1, t) - p(s0, t), p(s, t1) - p(s, t0));
+            Vec3d o = outward(pts[j * (ns + 1) + i]);
+            double len = Length(n);
+            if (len > 0 && Dot(n, o) < 0) n = -n;
+            nrm[j * (ns + 1) + i] = len > 0 ? n / len : Normalize(o);
+        }
+    }
+    for (int j = 0; j < nt; ++j) {
+        for (int i = 0; i < ns; ++i) {
+            int a = j * (ns + 1) + i, b = a + 1, c = a + ns + 2, d = a + ns + 1;
+            Vec3d out = outward((pts[a] + pts[c]) * 0.5);
+            em.QuadN(pts[a], pts[b], pts[c], pts[d], nrm[a], nrm[b], nrm[c], nrm[d], out, m);
+        }
+    }
+}
+
+std::vector<Vec2> CircleProfile(double radius, int n, double center_n) {
+    std::vector<Vec2> out;
+    for (int i = 0; i < n; ++i) {
+        double a = 6.283185307179586 * i / n;
+        out.push_back({radius * std::cos(a), center_n + radius * std::sin(a)});
+    }
+    return out;
+}
+
+}  // namespace nave::preprocess::abbey

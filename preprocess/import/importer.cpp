@@ -1,0 +1,63 @@
+#include "preprocess/import/importer.h"
+
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+
+#include "preprocess/import/assimp_importer.h"
+#include "preprocess/import/gltf_importer.h"
+#include "preprocess/import/obj_importer.h"
+#include "preprocess/import/ply_importer.h"
+#include "preprocess/import/stl_importer.h"
+#include "preprocess/merged_source.h"
+
+namespace nave::preprocess {
+namespace {
+
+std::string Lower(std::string s) {
+    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+// The first bytes, to recognise files by content when the extension says nothing.
+std::string Sniff(const std::filesystem::path& path) {
+    char bytes[16] = {};
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (f == nullptr) return {};
+    size_t got = std::fread(bytes, 1, sizeof(bytes), f);
+    std::fclose(f);
+    return std::string(bytes, got);
+}
+
+}  // namespace
+
+StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
+    if (std::filesystem::file_size(path, ec) == 0 && !ec) {
+        return InvalidArgumentError("{}: empty file: expected a model", path.string());
+    }
+    std::string ext = Lower(path.extension().string());
+    if (ext == ".obj") return OpenObj(path);
+    if (ext == ".ply") return OpenPly(path);
+    if (ext == ".stl") return OpenStl(path);
+    if (ext == ".gltf" || ext == ".glb") return OpenGltf(path);
+    std::string head = Sniff(path);
+    if (head.rfind("ply", 0) == 0) return OpenPly(path);
+    if (head.rfind("glTF", 0) == 0) return OpenGltf(path);
+    if (!ext.empty() && AssimpSupports(path)) return OpenWithAssimp(path);
+    return UnsupportedError("{}: unknown model format '{}': nave reads .obj, .ply, .stl, .gltf, .glb and what "
+                            "Assimp reads (.fbx, .dae, .3ds, ...)", path.string(), ext.empty() ? "(none)" : ext);
+}
+
+StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths) {
+    if (paths.empty()) return InvalidArgumentError("no input model given");
+    std::vector<std::unique_ptr<TriangleSource>> sources;
+    for (const auto& p : paths) {
+        NAVE_ASSIGN_OR_RETURN(auto source, OpenModel(p));
+        sources.push_back(std::move(source));
+    }
+    return std::unique_ptr<TriangleSource>(new MergedSource(std::move(sources)));
+}
+
+}  // namespace nave::preprocess

@@ -1,0 +1,20 @@
+#pragma once
+// Opening model files: the format is chosen by extension (and, for files without a known extension, by the
+// first bytes), and several inputs become one merged source.
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "preprocess/triangle_source.h"
+
+namespace nave::preprocess {
+
+/// Opens one model file: .obj, .ply, .stl (streamed), .gltf/.glb (tinygltf), anything Assimp reads.
+/// Errors: NotFound, Unsupported (unknown format, naming the extension and the formats nave reads).
+StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path);
+
+/// Opens every input and merges them (material names made unique). One input is returned as is.
+StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths);
+
+}  // namespace nave::preprocess

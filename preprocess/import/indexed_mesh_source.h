@@ -1,0 +1,47 @@
+#pragma once
+// A model already in memory as indexed meshes (what glTF and Assimp give), served as a TriangleSource.
+// These formats are not streamed: their libraries load the whole file, so they suit models that fit in
+// memory (memory_bytes() says how much they hold).
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "preprocess/triangle_source.h"
+
+namespace nave::preprocess {
+
+/// One mesh in world space: positions already transformed by its node, one material.
+struct IndexedMesh {
+    std::vector<Vec3f> positions;
+    std::vector<Vec3f> normals;                  ///< empty or one per position
+    std::vector<std::array<float, 2>> uvs;       ///< empty or one per position
+    std::vector<uint32_t> indices;               ///< 3 per triangle
+    uint32_t material = 0;
+    std::string where;                           ///< "helmet.gltf mesh 0 primitive 1", for warnings
+};
+
+class IndexedMeshSource final : public TriangleSource {
+  public:
+    IndexedMeshSource(std::string name, std::string units, std::vector<IndexedMesh> meshes,
+                      std::vector<store::MaterialRecord> materials, ImportWarnings warnings);
+
+    StatusOr<bool> Next(std::vector<Triangle>& batch, size_t max_triangles) override;
+    const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
+    std::string name() const override { return name_; }
+    std::string units() const override { return units_; }
+    uint64_t progress_done() const override { return done_; }
+    uint64_t progress_total() const override { return total_; }
+    uint64_t memory_bytes() const override;
+    const ImportWarnings& warnings() const override { return warnings_; }
+
+  private:
+    std::string name_, units_;
+    std::vector<IndexedMesh> meshes_;
+    std::vector<store::MaterialRecord> materials_;
+    ImportWarnings warnings_;
+    size_t mesh_ = 0, triangle_ = 0;
+    uint64_t done_ = 0, total_ = 0, emitted_ = 0;
+};
+
+}  // namespace nave::preprocess

@@ -1,0 +1,348 @@
+#include "preprocess/partition/partitioner.h"
+
+#include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <thread>
+
+#include "preprocess/partition/bin_file.h"
+#include "preprocess/partition/triangle_box.h"
+
+namespace nave::preprocess {
+namespace {
+
+// Deterministic reservoir sampling (Vitter's algorithm R) with a SplitMix64 stream.
+class Reservoir {
+  public:
+    Reservoir(size_t capacity, uint64_t seed) : capacity_(capacity), state_(seed) {}
+    void Offer(const Vec3f& p) {
+        ++seen_;
+        if (points_.size() < capacity_) {
+            points_.push_back(p);
+            return;
+        }
+        uint64_t j = Next() % seen_;
+        if (j < capacity_) points_[j] = p;
+    }
+    std::vector<Vec3f>& points() { return points_; }
+
+  private:
+    uint64_t Next() {
+        uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    size_t capacity_;
+    uint64_t state_;
+    uint64_t seen_ = 0;
+    std::vector<Vec3f> points_;
+};
+
+Vec3f Centroid(const Triangle& t) { return (t.p[0] + t.p[1] + t.p[2]) * (1.f / 3.f); }
+
+Vec3f ClampTo(const Vec3f& p, const Bounds3f& b) { return Max(b.min, Min(b.max, p)); }
+
+Bounds3d Grow(const Bounds3f& b, double margin) {
+    return Bounds3d(Vec3d(b.min) - Vec3d(margin, margin, margin), Vec3d(b.max) + Vec3d(margin, margin, margin));
+}
+
+// The kd-tree built from a bin's sample, before it joins the brick tree.
+struct LocalNode {
+    int axis = 3;
+    float split = 0;
+    int child[2] = {-1, -1};
+    int leaf = -1;  // index into leaves (for axis == 3)
+};
+struct LocalLeaf {
+    Bounds3f cell;
+    std::vector<Vec3f> points;
+    double estimate = 0;
+    int node = 0;
+    int depth = 0;  // below the bin's node
+    bool splittable = true;
+};
+
+}  // namespace
+
+std::filesystem::path Partitioner::NewBinPath() {
+    return temp_.File("bin-" + std::to_string(bin_counter_.fetch_add(1)) + ".lz4");
+}
+
+void Partitioner::AddTempBytes(int64_t delta) {
+    int64_t now = temp_bytes_.fetch_add(delta) + delta;
+    uint64_t peak = peak_temp_bytes_.load();
+    while (now > 0 && uint64_t(now) > peak && !peak_temp_bytes_.compare_exchange_weak(peak, uint64_t(now))) {
+    }
+}
+
+Status Partitioner::Bin(TriangleSource& source, ProgressBar& progress) {
+    root_.file = NewBinPath();
+    NAVE_ASSIGN_OR_RETURN(auto writer, BinWriter::Create(root_.file, config_.block_bytes));
+    Reservoir sample(config_.root_sample, 1);
+    std::vector<Triangle> batch;
+    while (true) {
+        NAVE_RETURN_IF_ERROR(CheckCancelled());
+        NAVE_ASSIGN_OR_RETURN(bool more, source.Next(batch, 1 << 14));
+        if (!more) break;
+        for (const Triangle& t : batch) {
+            for (const Vec3f& p : t.p) bounds_.Extend(Vec3d(p));
+            sample.Offer(Centroid(t));
+            NAVE_RETURN_IF_ERROR(writer->Append(t));
+        }
+        source_triangles_ += batch.size();
+        uint64_t done = source.progress_done();
+        if (done > progress.done()) progress.Add(done - progress.done());
+    }
+    NAVE_RETURN_IF_ERROR(writer->Close());
+    AddTempBytes(int64_t(writer->file_bytes()));
+    root_.triangles = source_triangles_;
+    root_.sample = std::move(sample.points());
+    if (source_triangles_ == 0) return InvalidArgumentError("{}: no triangles", source.name());
+    return Status::Ok();
+}
+
+uint64_t Partitioner::duplicated_triangles() const {
+    uint64_t refs = 0;
+    for (const LeafBin& l : leaves_) refs += l.triangles;
+    return refs > source_triangles_ ? refs - source_triangles_ : 0;
+}
+
+Status Partitioner::Split(const Bounds3f& root, double margin, ProgressBar& progress) {
+    margin_ = margin;
+    progress_ = &progress;
+    nodes_.assign(1, store::BrickTreeNode{});
+    root_.cell = root;
+    root_.node = 0;
+
+    // A work queue of bins; workers split or retire them until none is left.
+    std::mutex qm;
+    std::condition_variable cv;
+    std::deque<Task> queue;
+    queue.push_back(std::move(root_));
+    int busy = 0;
+    Status failure;
+    auto worker = [&] {
+        while (true) {
+            Task task;
+            {
+                std::unique_lock<std::mutex> lock(qm);
+                cv.wait(lock, [&] { return !queue.empty() || busy == 0 || !failure.ok(); });
+                if (!failure.ok() || (queue.empty() && busy == 0)) {
+                    cv.notify_all();
+                    return;
+                }
+                task = std::move(queue.front());
+                queue.pop_front();
+                ++busy;
+            }
+            std::vector<Task> children;
+            Status s = SplitTask(std::move(task), children);
+            {
+                std::lock_guard<std::mutex> lock(qm);
+                --busy;
+                if (!s.ok() && failure.ok()) failure = s;
+                for (Task& c : children) queue.push_back(std::move(c));
+            }
+            cv.notify_all();
+        }
+    };
+    std::vector<std::thread> threads;
+    for (int i = 1; i < config_.threads; ++i) threads.emplace_back(worker);
+    worker();
+    for (auto& t : threads) t.join();
+    // Bigger bricks first: the encoder's threads balance better.
+    std::sort(leaves_.begin(), leaves_.end(), [](const LeafBin& a, const LeafBin& b) {
+        return a.triangles != b.triangles ? a.triangles > b.triangles : a.node < b.node;
+    });
+    return failure;
+}
+
+Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
+    NAVE_RETURN_IF_ERROR(CheckCancelled());
+    const uint64_t leaf_max = config_.brick_triangles + config_.brick_triangles / 4;
+    if (task.triangles <= leaf_max || task.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        leaves_.push_back({task.file, task.cell, task.triangles, task.node, task.triangles > leaf_max});
+        return Status::Ok();
+    }
+
+    // The local kd-tree: split the leaf with the largest estimate at the sample's median along its longest
+    // axis, until every estimate is under the target or the fan-out limit is reached.
+    std::vector<LocalNode> lnodes(1);
+    std::vector<LocalLeaf> lleaves(1);
+    lleaves[0].cell = task.cell;
+    lleaves[0].points = std::move(task.sample);
+    lleaves[0].estimate = double(task.triangles);
+    lnodes[0].leaf = 0;
+    const double target = double(config_.brick_triangles);
+    while (int(lleaves.size()) < config_.max_fanout) {
+        int best = -1;
+        for (size_t i = 0; i < lleaves.size(); ++i) {
+            if (lleaves[i].splittable && lleaves[i].estimate > target &&
+                (best < 0 || lleaves[i].estimate > lleaves[best].estimate)) {
+                best = int(i);
+            }
+        }
+        if (best < 0) break;
+        LocalLeaf& leaf = lleaves[best];
+        int axis = leaf.cell.MaxAxis();
+        float lo = leaf.cell.min[axis], hi = leaf.cell.max[axis];
+        if (double(hi) - double(lo) < 8 * margin_ ||
+            task.depth + leaf.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
+            leaf.splittable = false;
+            continue;
+        }
+        float split = 0.5f * (lo + hi);
+        std::vector<Vec3f>& pts = leaf.points;
+        if (pts.size() >= 8) {
+            auto mid = pts.begin() + pts.size() / 2;
+            std::nth_element(pts.begin(), mid, pts.end(),
+                             [axis](const Vec3f& a, const Vec3f& b) { return a[axis] < b[axis]; });
+            split = (*mid)[axis];
+        }
+        // Keep the plane strictly inside the cell, away from its faces by a few grid steps.
+        float guard = float(2 * margin_);
+        if (!(split > lo + guard && split < hi - guard)) split = 0.5f * (lo + hi);
+        LocalLeaf below, above;
+        below.cell = above.cell = leaf.cell;
+        below.depth = above.depth = leaf.depth + 1;
+        below.cell.max[axis] = split;
+        above.cell.min[axis] = split;
+        for (const Vec3f& p : pts) (p[axis] < split ? below.points : above.points).push_back(p);
+        double total = double(pts.size());
+        below.estimate = total > 0 ? leaf.estimate * below.points.size() / total : leaf.estimate / 2;
+        above.estimate = total > 0 ? leaf.estimate * above.points.size() / total : leaf.estimate / 2;
+        // Triangles crossing the plane go to both sides; never let an estimate vanish entirely.
+        below.estimate = std::max(below.estimate, 1.0);
+        above.estimate = std::max(above.estimate, 1.0);
+        int node = leaf.node;
+        below.node = int(lnodes.size());
+        above.node = int(lnodes.size() + 1);
+        lnodes[node].axis = axis;
+        lnodes[node].split = split;
+        lnodes[node].leaf = -1;
+        lnodes[node].child[0] = below.node;
+        lnodes[node].child[1] = above.node;
+        LocalNode nb, na;
+        nb.leaf = best;
+        na.leaf = int(lleaves.size());
+        lnodes.push_back(nb);
+        lnodes.push_back(na);
+        lleaves[best] = std::move(below);
+        lleaves.push_back(std::move(above));
+    }
+    if (lleaves.size() == 1) {
+        // Nothing to split along (a cell a few grid steps wide): keep it as one oversized brick.
+        std::lock_guard<std::mutex> lock(mutex_);
+        leaves_.push_back({task.file, task.cell, task.triangles, task.node, true});
+        return Status::Ok();
+    }
+
+    // One pass over the bin: each triangle to every leaf cell it overlaps.
+    const size_t fanout = lleaves.size();
+    size_t block = std::max<size_t>(16 << 10, std::min(config_.block_bytes, (size_t(64) << 20) / fanout));
+    std::vector<std::unique_ptr<BinWriter>> writers(fanout);
+    std::vector<Reservoir> samples;
+    std::vector<Bounds3d> grown(fanout);
+    for (size_t i = 0; i < fanout; ++i) {
+        NAVE_ASSIGN_OR_RETURN(writers[i], BinWriter::Create(NewBinPath(), block));
+        samples.emplace_back(config_.child_sample, uint64_t(task.node) * 1000 + i + 7);
+        grown[i] = Grow(lleaves[i].cell, margin_);
+    }
+    NAVE_ASSIGN_OR_RETURN(auto reader, BinReader::Open(task.file));
+    std::vector<Triangle> batch;
+    std::vector<int> candidates, stack;
+    const float m = float(margin_);
+    uint64_t processed = 0;
+    while (true) {
+        batch.clear();
+        NAVE_ASSIGN_OR_RETURN(bool more, reader->Read(batch, 1 << 14));
+        if (!more) break;
+        NAVE_RETURN_IF_ERROR(CheckCancelled());
+        for (const Triangle& t : batch) {
+            Bounds3f box;
+            for (const Vec3f& p : t.p) box.Extend(p);
+            candidates.clear();
+            stack.assign(1, 0);
+            while (!stack.empty()) {
+                const LocalNode& n = lnodes[stack.back()];
+                stack.pop_back();
+                if (n.axis == 3) {
+                    candidates.push_back(n.leaf);
+                    continue;
+                }
+                if (box.min[n.axis] - m <= n.split) stack.push_back(n.child[0]);
+                if (box.max[n.axis] + m >= n.split) stack.push_back(n.child[1]);
+            }
+            bool placed = false;
+            for (int c : candidates) {
+                if (candidates.size() > 1 && !TriangleOverlapsBox(t.p, grown[c])) continue;
+                NAVE_RETURN_IF_ERROR(writers[c]->Append(t));
+                samples[c].Offer(ClampTo(Centroid(t), lleaves[c].cell));
+                placed = true;
+            }
+            if (!placed && !candidates.empty()) {
+                // Only rounding can get here (the triangle touches the parent cell): keep it somewhere near.
+                NAVE_RETURN_IF_ERROR(writers[candidates[0]]->Append(t));
+            }
+        }
+        processed += batch.size();
+        progress_->Add(batch.size());
+    }
+    reader.reset();
+    std::error_code ec;
+    int64_t parent_bytes = int64_t(std::filesystem::file_size(task.file, ec));
+    if (ec) parent_bytes = 0;
+    std::filesystem::remove(task.file, ec);
+    AddTempBytes(-parent_bytes);
+    int64_t child_bytes = 0;
+    (void)processed;
+
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Graft the local tree onto the brick tree: the task's leaf becomes the local root.
+    std::vector<uint32_t> global(lnodes.size());
+    global[0] = task.node;
+    for (size_t i = 1; i < lnodes.size(); ++i) {
+        global[i] = uint32_t(nodes_.size());
+        nodes_.push_back(store::BrickTreeNode{});
+    }
+    for (size_t i = 0; i < lnodes.size(); ++i) {
+        store::BrickTreeNode& g = nodes_[global[i]];
+        if (lnodes[i].axis == 3) {
+            g = store::BrickTreeNode{};
+            continue;
+        }
+        g.axis = uint8_t(lnodes[i].axis);
+        g.split = lnodes[i].split;
+        g.child[0] = global[lnodes[i].child[0]];
+        g.child[1] = global[lnodes[i].child[1]];
+        g.brick = store::kNoBrick;
+    }
+    for (size_t i = 0; i < fanout; ++i) {
+        NAVE_RETURN_IF_ERROR(writers[i]->Close());
+        child_bytes += int64_t(writers[i]->file_bytes());
+        uint64_t count = writers[i]->triangles();
+        if (count == 0) {
+            std::filesystem::remove(writers[i]->path(), ec);  // empty space: no brick
+            continue;
+        }
+        Task child;
+        child.file = writers[i]->path();
+        child.cell = lleaves[i].cell;
+        child.triangles = count;
+        child.node = global[lleaves[i].node];
+        child.depth = task.depth + lleaves[i].depth;
+        child.sample = std::move(samples[i].points());
+        // No progress (most triangles span the whole cell): stop splitting this one.
+        if (count > task.triangles * 98 / 100) {
+            leaves_.push_back({child.file, child.cell, child.triangles, child.node, true});
+            continue;
+        }
+        children.push_back(std::move(child));
+    }
+    AddTempBytes(child_bytes);
+    return Status::Ok();
+}
+
+}  // namespace nave::preprocess

@@ -1,0 +1,43 @@
+#pragma once
+// The temporary directory of one preprocess run, and interruption. The directory is removed when the run
+// ends, succeeds or fails. SIGINT and SIGTERM set a flag that the work loops poll (Cancelled()), so the run
+// unwinds normally and removes its files; a second signal ends the process at once. Leftovers of a run that
+// was killed outright (SIGKILL, power loss) are removed by the next run in the same place: their names
+// carry the dead process's id.
+
+#include <filesystem>
+#include <string>
+
+#include "core/status.h"
+
+namespace nave::preprocess {
+
+class TempDir {
+  public:
+    /// Creates `<parent>/.nave-tmp-<pid>-<n>`, after removing stale ones of dead processes.
+    static StatusOr<TempDir> Create(const std::filesystem::path& parent);
+    TempDir(TempDir&& other) noexcept : path_(std::move(other.path_)) { other.path_.clear(); }
+    TempDir& operator=(TempDir&&) = delete;
+    TempDir(const TempDir&) = delete;
+    ~TempDir();
+
+    const std::filesystem::path& path() const { return path_; }
+    /// "<dir>/<name>"
+    std::filesystem::path File(const std::string& name) const { return path_ / name; }
+
+  private:
+    explicit TempDir(std::filesystem::path path) : path_(std::move(path)) {}
+    std::filesystem::path path_;
+};
+
+/// Removes `<output>.tmp-<pid>-*` files (AtomicFile temporaries) left by dead processes next to `output`.
+void RemoveStaleOutputTemporaries(const std::filesystem::path& output);
+
+/// Installs the SIGINT / SIGTERM handlers (idempotent).
+void InstallInterruptHandlers();
+/// True once SIGINT or SIGTERM arrived.
+bool Cancelled();
+/// A Cancelled status ("interrupted by signal N"), or Ok.
+Status CheckCancelled();
+
+}  // namespace nave::preprocess

@@ -1,0 +1,290 @@
+#include "preprocess/preprocess.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include "core/log.h"
+#include "core/memory.h"
+#include "core/progress.h"
+#include "preprocess/abbey/abbey_source.h"
+#include "preprocess/import/importer.h"
+#include "preprocess/partition/bin_file.h"
+#include "preprocess/partition/brick_builder.h"
+#include "preprocess/partition/partitioner.h"
+#include "preprocess/partition/temp_dir.h"
+#include "store/store_writer.h"
+
+namespace nave::preprocess {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Memory the run needs besides the bricks being encoded: the reading batch, the root bin's block
+// buffers, the sample, the split buffers per thread, and a margin for the allocator and libraries.
+constexpr uint64_t kFixedBytes = 48ull << 20;
+
+// A counting semaphore over bytes: encoders wait until the budget can hold their brick.
+class ByteBudget {
+  public:
+    explicit ByteBudget(uint64_t bytes) : free_(bytes) {}
+    void Acquire(uint64_t n) {
+        std::unique_lock<std::mutex> lock(m_);
+        cv_.wait(lock, [&] { return free_ >= n; });
+        free_ -= n;
+    }
+    void Release(uint64_t n) {
+        {
+            std::lock_guard<std::mutex> lock(m_);
+            free_ += n;
+        }
+        cv_.notify_all();
+    }
+
+  private:
+    std::mutex m_;
+    std::condition_variable cv_;
+    uint64_t free_;
+};
+
+std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step, int threads) {
+    return fmt::format("brick-triangles={} memory={} precision={} threads={} draco-speed={}", o.brick_triangles,
+                       budget, step, threads, o.encode.draco_speed);
+}
+
+}  // namespace
+
+double DefaultGridStep(double diagonal) { return diagonal > 0 ? diagonal / double(1 << 20) : 1e-6; }
+
+StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
+    const auto start = Clock::now();
+    InstallInterruptHandlers();
+    PreprocessStats stats;
+    if (options.output.empty()) return InvalidArgumentError("no output file given (-o MODEL.nave)");
+    if (options.brick_triangles < 1000) {
+        return InvalidArgumentError("--brick-triangles {}: expected at least 1000", options.brick_triangles);
+    }
+    stats.threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    stats.memory_budget = options.memory_bytes > 0 ? options.memory_bytes : PhysicalMemoryBytes() / 4;
+
+    // The budget must hold one brick's work (the largest a leaf may be: 5/4 of the target).
+    const uint64_t leaf_max = options.brick_triangles + options.brick_triangles / 4;
+    const uint64_t per_brick = leaf_max * kEncodeBytesPerTriangle;
+    if (stats.memory_budget < kFixedBytes + per_brick) {
+        uint64_t fit = stats.memory_budget > kFixedBytes
+                           ? (stats.memory_budget - kFixedBytes) / kEncodeBytesPerTriangle * 4 / 5
+                           : 0;
+        return ResourceExhaustedError(
+            "--memory {} cannot hold the work for one brick: {} triangles x {} bytes = {} plus {} fixed; raise "
+            "--memory to at least {} or lower --brick-triangles to at most {}",
+            FormatBytes(stats.memory_budget), leaf_max, kEncodeBytesPerTriangle, FormatBytes(per_brick),
+            FormatBytes(kFixedBytes), FormatBytes(kFixedBytes + per_brick), fit);
+    }
+
+    std::unique_ptr<TriangleSource> source;
+    if (!options.generate.empty()) {
+        NAVE_ASSIGN_OR_RETURN(source, OpenGenerator(options.generate));
+    } else {
+        NAVE_ASSIGN_OR_RETURN(source, OpenModels(options.inputs));
+    }
+    stats.source_name = source->name();
+    stats.units = source->units();
+
+    RemoveStaleOutputTemporaries(options.output);
+    std::filesystem::path temp_parent = !options.temp_dir.empty() ? options.temp_dir
+                                        : options.output.has_parent_path() ? options.output.parent_path()
+                                                                           : std::filesystem::path(".");
+    NAVE_ASSIGN_OR_RETURN(TempDir temp, TempDir::Create(temp_parent));
+
+    // Phase 1: read and bin.
+    PartitionConfig config;
+    config.brick_triangles = options.brick_triangles;
+    config.threads = stats.threads;
+    // Split buffers: each thread holds up to 64 writers' blocks (two copies each).
+    config.block_bytes = std::clamp<uint64_t>(stats.memory_budget / 16 / (uint64_t(stats.threads) * 64 * 2),
+                                              16 << 10, 256 << 10);
+    Partitioner partitioner(config, temp);
+    auto phase = Clock::now();
+    {
+        ProgressBar bar("read", source->progress_total(), source->units() == "m" && !options.generate.empty()
+                                                              ? "parts" : "bytes");
+        NAVE_RETURN_IF_ERROR(partitioner.Bin(*source, bar));
+        bar.Finish();
+    }
+    stats.read_seconds = Since(phase);
+    stats.source_triangles = partitioner.source_triangles();
+    stats.source_memory = source->memory_bytes();
+    for (const std::string& w : source->warnings().Summary()) {
+        log::Warning("{}", w);
+        stats.warnings.push_back(w);
+    }
+    auto materials = source->materials();
+    source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
+
+    // The global grid.
+    const Bounds3d& b = partitioner.bounds();
+    double diagonal = Length(b.max - b.min);
+    stats.grid_step = options.precision > 0 ? options.precision : DefaultGridStep(diagonal);
+    stats.max_error = stats.grid_step * std::sqrt(3.0) / 2;
+    double extent = std::max({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z});
+    if (extent / stats.grid_step > double(1 << 29)) {
+        return InvalidArgumentError("--precision {}: the model is {} units across, {} grid steps; at most 2^29 "
+                                    "fit: use --precision {} or more",
+                                    stats.grid_step, extent, extent / stats.grid_step, extent / double(1 << 29));
+    }
+    store::GlobalGrid grid;
+    grid.origin = b.min;
+    grid.step = stats.grid_step;
+    // The root cell: the bounds grown by a grid step, so snapped positions stay inside.
+    Bounds3f root(Vec3f(b.min) - Vec3f(1, 1, 1) * float(stats.grid_step),
+                  Vec3f(b.max) + Vec3f(1, 1, 1) * float(stats.grid_step));
+
+    // Phase 2: split.
+    phase = Clock::now();
+    {
+        ProgressBar bar("split", 0, "triangles");
+        NAVE_RETURN_IF_ERROR(partitioner.Split(root, stats.grid_step, bar));
+        bar.Finish();
+    }
+    stats.split_seconds = Since(phase);
+    stats.duplicated_triangles = partitioner.duplicated_triangles();
+    const std::vector<LeafBin>& leaves = partitioner.leaves();
+    std::vector<store::BrickTreeNode>& nodes = partitioner.nodes();
+
+    // Phase 3: encode on several threads, append as bricks finish.
+    const uint64_t encode_budget = stats.memory_budget - kFixedBytes;
+    for (const LeafBin& leaf : leaves) {
+        if (leaf.oversized) ++stats.oversized_bricks;
+        uint64_t need = leaf.triangles * kEncodeBytesPerTriangle;
+        if (need > encode_budget) {
+            return ResourceExhaustedError(
+                "a brick of {} triangles (cell {} could not be split further: its triangles overlap) needs {} to "
+                "encode, more than --memory {} allows; raise --memory to at least {}",
+                leaf.triangles, fmt::streamed(leaf.cell), FormatBytes(need), FormatBytes(stats.memory_budget),
+                FormatBytes(need + kFixedBytes));
+        }
+    }
+    store::StoreProvenance provenance;
+    for (const auto& in : options.inputs) provenance.source_files.push_back(in.string());
+    if (!options.generate.empty()) provenance.source_files.push_back(options.generate);
+    provenance.tool_version = options.tool_version;
+    provenance.options = OptionsText(options, stats.memory_budget, stats.grid_step, stats.threads);
+    NAVE_ASSIGN_OR_RETURN(auto writer, store::StoreWriter::Create(options.output, grid, provenance));
+
+    phase = Clock::now();
+    uint64_t total_refs = 0;
+    for (const LeafBin& leaf : leaves) total_refs += leaf.triangles;
+    ProgressBar bar("encode", total_refs, "triangles");
+    ByteBudget budget(encode_budget);
+    std::mutex mutex;
+    size_t next = 0;
+    Status failure;
+    auto worker = [&] {
+        std::vector<Triangle> triangles;
+        while (true) {
+            const LeafBin* leaf = nullptr;
+            {
+                std::lock_guard<std::mutex> lock(mutex);
+                if (next >= leaves.size() || !failure.ok()) return;
+                leaf = &leaves[next++];
+            }
+            uint64_t need = leaf->triangles * kEncodeBytesPerTriangle;
+            budget.Acquire(need);
+            Status s = [&]() -> Status {
+                NAVE_RETURN_IF_ERROR(CheckCancelled());
+                triangles.clear();
+                triangles.reserve(leaf->triangles);
+                NAVE_ASSIGN_OR_RETURN(auto reader, BinReader::Open(leaf->file));
+                while (true) {
+                    NAVE_ASSIGN_OR_RETURN(bool more, reader->Read(triangles, 1 << 16));
+                    if (!more) break;
+                }
+                reader.reset();
+                std::error_code ec;
+                std::filesystem::remove(leaf->file, ec);
+                BuiltBrick built = BuildBrickMesh(triangles, grid);
+                std::vector<Triangle>().swap(triangles);
+                if (built.mesh.indices.empty()) {
+                    std::lock_guard<std::mutex> lock(mutex);
+                    stats.collapsed_triangles += built.collapsed_triangles;
+                    ++stats.empty_cells;
+                    return Status::Ok();
+                }
+                NAVE_ASSIGN_OR_RETURN(store::EncodedBrick encoded,
+                                      store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
+                std::lock_guard<std::mutex> lock(mutex);
+                NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
+                nodes[leaf->node].brick = id;
+                stats.stored_triangles += encoded.triangle_count;
+                stats.collapsed_triangles += built.collapsed_triangles + encoded.dropped_triangle_count;
+                ++stats.bricks;
+                return Status::Ok();
+            }();
+            budget.Release(need);
+            bar.Add(leaf->triangles);
+            if (!s.ok()) {
+                std::lock_guard<std::mutex> lock(mutex);
+                if (failure.ok()) failure = s;
+                return;
+            }
+        }
+    };
+    {
+        std::vector<std::thread> threads;
+        for (int i = 1; i < stats.threads; ++i) threads.emplace_back(worker);
+        worker();
+        for (auto& t : threads) t.join();
+    }
+    NAVE_RETURN_IF_ERROR(failure);
+    bar.Finish();
+    stats.encode_seconds = Since(phase);
+    for (const auto& n : nodes) {
+        if (n.IsLeaf() && n.brick == store::kNoBrick) ++stats.empty_cells;
+    }
+    NAVE_RETURN_IF_ERROR(CheckCancelled());
+    store::BrickTree tree(root, nodes);
+    NAVE_RETURN_IF_ERROR(writer->Finish(materials, tree, stats.source_triangles));
+    stats.output_bytes = writer->bytes_written();
+    stats.peak_temp_bytes = partitioner.peak_temp_bytes();
+    stats.seconds = Since(start);
+    stats.peak_rss = PeakRssBytes();
+    return stats;
+}
+
+std::string FormatSummary(const PreprocessStats& s) {
+    double dup = s.source_triangles ? 100.0 * double(s.duplicated_triangles) / double(s.source_triangles) : 0;
+    std::string out = fmt::format(
+        "input:       {} ({} triangles, units: {})\n"
+        "bricks:      {} (+{} empty cells), {} stored triangles, {} duplicated across cells ({:.2f} %)\n"
+        "grid:        step {:.6g}, max error {:.6g} (model units)\n"
+        "on disk:     {} ({:.2f} bytes per input triangle); temporary files peaked at {}\n"
+        "time:        {} (read {}, split {}, encode {}), {} triangles/s on {} threads\n"
+        "memory:      peak {} of a {} budget (importer held {})",
+        s.source_name, FormatCount(double(s.source_triangles)), s.units, s.bricks, s.empty_cells,
+        FormatCount(double(s.stored_triangles)), FormatCount(double(s.duplicated_triangles)), dup, s.grid_step,
+        s.max_error, FormatBytes(s.output_bytes),
+        s.source_triangles ? double(s.output_bytes) / double(s.source_triangles) : 0.0,
+        FormatBytes(s.peak_temp_bytes), FormatDuration(s.seconds), FormatDuration(s.read_seconds),
+        FormatDuration(s.split_seconds), FormatDuration(s.encode_seconds),
+        FormatCount(double(s.source_triangles) / std::max(s.seconds, 1e-9)), s.threads, FormatBytes(s.peak_rss),
+        FormatBytes(s.memory_budget), FormatBytes(s.source_memory));
+    if (s.collapsed_triangles > 0) {
+        out += fmt::format("\nnote:        {} triangles smaller than the grid step were dropped",
+                           s.collapsed_triangles);
+    }
+    if (s.oversized_bricks > 0) {
+        out += fmt::format("\nnote:        {} bricks exceed the target (triangles too large or overlapping to "
+                           "split)", s.oversized_bricks);
+    }
+    for (const auto& w : s.warnings) out += "\nwarning:     " + w;
+    return out;
+}
+
+}  // namespace nave::preprocess

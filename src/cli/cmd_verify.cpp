@@ -1,0 +1,130 @@
+// `nave verify FILE [--json] [--threads N]`: reads every brick of a store, checks its checksums, decodes it
+// and compares it with the directory. Succeeds (exit 0) only if every brick is intact; otherwise lists each
+// damaged brick with its error and fails (exit 1).
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "cli/commands.h"
+#include "core/log.h"
+#include "core/memory.h"
+#include "core/progress.h"
+#include "store/store_reader.h"
+
+namespace nave::cli {
+namespace {
+
+std::string JsonString(const std::string& s) {
+    std::string out = "\"";
+    for (const char c : s) {
+        switch (c) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\t': out += "\\t"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20) {
+                    out += fmt::format("\\u{:04x}", int(c));
+                } else {
+                    out += c;
+                }
+        }
+    }
+    return out + "\"";
+}
+
+struct BadBrick {
+    uint32_t id;
+    Status status;
+};
+
+Status Verify(const std::string& file, bool json, int threads) {
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> s, store::Store::Open(file));
+    const std::vector<store::BrickInfo>& bricks = s->bricks();
+    const uint32_t brick_count = uint32_t(bricks.size());
+
+    // Bricks are independent and reads are positional: verify on several threads.
+    ProgressBar progress("verify", s->header().triangle_count, "triangles");
+    std::atomic<uint32_t> next{0};
+    std::mutex bad_mutex;
+    std::vector<BadBrick> bad;
+    auto worker = [&] {
+        for (uint32_t id = next.fetch_add(1); id < brick_count; id = next.fetch_add(1)) {
+            Status st = s->VerifyBrick(id);
+            if (!st.ok()) {
+                std::lock_guard<std::mutex> lock(bad_mutex);
+                bad.push_back({id, st});
+            }
+            progress.Add(bricks[id].triangle_count);
+        }
+    };
+    const int n = std::max(1, std::min<int>(threads, int(std::max<uint32_t>(brick_count, 1))));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < n; ++i) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+    progress.Finish();
+    std::sort(bad.begin(), bad.end(), [](const BadBrick& a, const BadBrick& b) { return a.id < b.id; });
+
+    const double seconds = std::max(progress.ElapsedSeconds(), 1e-9);
+    const uint64_t triangles = s->header().triangle_count;
+    if (json) {
+        std::string out = "{\n";
+        out += fmt::format("  \"file\": {},\n", JsonString(file));
+        out += fmt::format("  \"ok\": {},\n", bad.empty() ? "true" : "false");
+        out += fmt::format("  \"bricks\": {},\n", brick_count);
+        out += fmt::format("  \"bad_brick_count\": {},\n", bad.size());
+        out += fmt::format("  \"triangles\": {},\n", triangles);
+        out += fmt::format("  \"bytes_read\": {},\n", s->bytes_read());
+        out += fmt::format("  \"seconds\": {:.6f},\n", seconds);
+        out += fmt::format("  \"triangles_per_second\": {:.1f},\n", double(triangles) / seconds);
+        out += fmt::format("  \"peak_rss_bytes\": {},\n", PeakRssBytes());
+        out += "  \"bad_bricks\": [";
+        for (size_t i = 0; i < bad.size(); ++i) {
+            out += fmt::format("{}\n    {{\"id\": {}, \"error\": {}}}", i ? "," : "", bad[i].id,
+                               JsonString(bad[i].status.ToString()));
+        }
+        out += bad.empty() ? "]\n}\n" : "\n  ]\n}\n";
+        std::fputs(out.c_str(), stdout);
+    } else {
+        for (const BadBrick& b : bad) std::printf("brick %u: %s\n", b.id, b.status.ToString().c_str());
+        std::printf("%s: %u of %u bricks intact, %s triangles, %s read in %s (%s triangles/s, %s/s), peak memory %s\n",
+                    file.c_str(), brick_count - uint32_t(bad.size()), brick_count,
+                    FormatCount(double(triangles)).c_str(), FormatBytes(s->bytes_read()).c_str(),
+                    FormatDuration(seconds).c_str(), FormatCount(double(triangles) / seconds).c_str(),
+                    FormatBytes(uint64_t(double(s->bytes_read()) / seconds)).c_str(),
+                    FormatBytes(PeakRssBytes()).c_str());
+    }
+    std::fflush(stdout);
+    if (!bad.empty()) {
+        return DataLossError("{}: {} of {} bricks are damaged (first: brick {})", file, bad.size(), brick_count,
+                             bad.front().id);
+    }
+    return Status::Ok();
+}
+
+}  // namespace
+
+void RegisterVerifyCommand(CLI::App& app, CommandRun& run) {
+    CLI::App* cmd = app.add_subcommand(
+        "verify", "Read every brick of a store, check its checksums and decode it; exit 0 only if all are intact");
+    auto file = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    auto threads = std::make_shared<int>(int(std::max(1u, std::thread::hardware_concurrency())));
+    cmd->add_option("FILE", *file, "The .nave store")->required();
+    cmd->add_flag("--json", *json, "Print the result as JSON on stdout");
+    cmd->add_option("--threads", *threads, "Threads that read and decode bricks")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1024));
+    cmd->callback([&run, file, json, threads] {
+        run = [file, json, threads]() { return Verify(*file, *json, *threads); };
+    });
+}
+
+}  // namespace nave::cli

@@ -1,0 +1,186 @@
+// Importers on small hand-made fixtures (tests/fixtures/models/make_fixtures.py writes them): every odd case
+// of each format, the triangles they yield, and the errors and warnings bad input gives.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "preprocess/import/importer.h"
+#include "preprocess/import/triangle_check.h"
+#include "test_util.h"
+
+namespace nave::preprocess {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Fixture;
+using testing::ReadError;
+using testing::ReadModel;
+
+double Area(const Triangle& t) {
+    Vec3d a(t.p[0]), b(t.p[1]), c(t.p[2]);
+    return 0.5 * Length(Cross(b - a, c - a));
+}
+Vec3d Normal(const Triangle& t) {
+    Vec3d a(t.p[0]), b(t.p[1]), c(t.p[2]);
+    return Normalize(Cross(b - a, c - a));
+}
+
+TEST(ObjImporter, CrlfQuadsNgonsNegativeIndicesAndMaterials) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("shapes_crlf.obj"), &source);
+    // quad -> 2, pentagon -> 3, triangle -> 1.
+    ASSERT_EQ(tris.size(), 6u);
+    const auto& mats = source->materials();
+    ASSERT_EQ(mats.size(), 3u);
+    EXPECT_EQ(mats[tris[0].material].name, "red");
+    EXPECT_FLOAT_EQ(mats[tris[0].material].diffuse[0], 0.8f);
+    EXPECT_EQ(mats[tris[0].material].textures.at("map_Kd"), "missing_texture.png");
+    EXPECT_EQ(mats[tris[2].material].name, "blue");
+    EXPECT_FLOAT_EQ(mats[tris[2].material].opacity, 0.5f);
+    EXPECT_EQ(mats[tris[5].material].name, "undefined_in_mtl");
+    // The quad keeps its texture coordinates and normals; the pentagon has neither.
+    EXPECT_TRUE(tris[0].has_uvs && tris[0].has_normals);
+    EXPECT_FLOAT_EQ(tris[0].uv[1][0], 1.f);
+    EXPECT_FALSE(tris[2].has_uvs || tris[2].has_normals);
+    EXPECT_TRUE(tris[5].has_normals && !tris[5].has_uvs);
+    // Areas: unit quad, pentagon (0,0)(2,0)(3,1)(1,2)(-1,1) by the shoelace formula = 5.
+    EXPECT_NEAR(Area(tris[0]) + Area(tris[1]), 1.0, 1e-6);
+    EXPECT_NEAR(Area(tris[2]) + Area(tris[3]) + Area(tris[4]), 5.0, 1e-6);
+    // Relative indices -5 -4 -3 after 9 vertices are vertices 5, 6, 7 (1-based).
+    EXPECT_EQ(tris[5].p[0], Vec3f(0, 0, 1));
+    EXPECT_EQ(tris[5].p[2], Vec3f(3, 1, 1));
+    for (const auto& t : tris) EXPECT_GT(Normal(t).z, 0.99);  // counter-clockwise seen from +z
+    EXPECT_EQ(source->warnings().Count("missing textures (material kept, colour used)"), 1u);
+    EXPECT_EQ(source->warnings().Count("materials used but defined in no MTL (default colour used)"), 1u);
+}
+
+TEST(ObjImporter, MissingMtlIsOneWarningAndADefaultMaterial) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("missing_mtl.obj"), &source);
+    ASSERT_EQ(tris.size(), 1u);
+    EXPECT_EQ(source->warnings().Count("missing MTL files (default materials used)"), 1u);
+    EXPECT_EQ(source->materials().at(tris[0].material).name, "default");
+    EXPECT_THAT(source->warnings().Summary()[0], HasSubstr("missing_mtl.obj:1"));
+}
+
+TEST(ObjImporter, BadIndicesNameFileAndLine) {
+    EXPECT_THAT(ReadError(Fixture("bad_index.obj")), HasSubstr("bad_index.obj:5: face vertex index 4 out of range"));
+    EXPECT_THAT(ReadError(Fixture("zero_index.obj")), HasSubstr("zero_index.obj:4: face vertex index 0"));
+    EXPECT_THAT(ReadError(Fixture("malformed.obj")), HasSubstr("malformed.obj:2: 'v' expects 3 numbers, found 'zero'"));
+}
+
+TEST(ObjImporter, NanAndDegenerateFacesAreCountedWarnings) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("nan_degenerate.obj"), &source);
+    EXPECT_EQ(tris.size(), 1u);  // f 1 2 3 (f 1 2 5 is collinear: degenerate)
+    EXPECT_EQ(source->warnings().Count(kWarnNonFinite), 1u);
+    EXPECT_EQ(source->warnings().Count(kWarnDegenerate), 2u);
+    bool found = false;
+    for (const auto& line : source->warnings().Summary()) {
+        if (line.find("degenerate faces") != std::string::npos) {
+            EXPECT_THAT(line, HasSubstr("2 (first at nan_degenerate.obj:8)"));
+            found = true;
+        }
+    }
+    EXPECT_TRUE(found);
+}
+
+TEST(ObjImporter, EmptyAndGarbageFilesAreErrors) {
+    EXPECT_THAT(ReadError(Fixture("empty.obj")), HasSubstr("empty.obj: empty file"));
+    EXPECT_THAT(ReadError(Fixture("comments_only.obj")), HasSubstr("no faces found"));
+    EXPECT_THAT(ReadError(Fixture("garbage.obj")), HasSubstr("garbage.obj:1: "));
+    EXPECT_THAT(ReadError(Fixture("unknown.xyz")), HasSubstr("unknown model format '.xyz'"));
+    EXPECT_THAT(ReadError(Fixture("does_not_exist.obj")), HasSubstr("no such file"));
+}
+
+TEST(PlyImporter, AsciiWithExtraPropertiesAndQuads) {
+    auto tris = ReadModel(Fixture("tetra_ascii.ply"));
+    ASSERT_EQ(tris.size(), 5u);  // 3 triangles + a quad
+    EXPECT_EQ(tris[0].p[1], Vec3f(0, 1, 0));
+    EXPECT_EQ(tris[0].p[2], Vec3f(1, 0, 0));
+    EXPECT_LT(Normal(tris[0]).z, -0.99);  // face 0 2 1 looks down (outward for the tetrahedron)
+}
+
+TEST(PlyImporter, BigEndianTriangleStripsWithRestarts) {
+    auto tris = ReadModel(Fixture("strips_big.ply"));
+    ASSERT_EQ(tris.size(), 4u);
+    // Run 0 1 2 3: (0 1 2), then (1 2 3) flipped to (2 1 3) to keep the winding; run 2 3 4 5 5 after the
+    // restart: (2 3 4), (4 3 5), and (4 5 5) dropped.
+    EXPECT_EQ(tris[0].p[0], Vec3f(0, 0, 0));
+    EXPECT_EQ(tris[1].p[0], Vec3f(0, 1, 0));
+    EXPECT_EQ(tris[1].p[1], Vec3f(1, 0, 0));
+    EXPECT_EQ(tris[2].p[0], Vec3f(0, 1, 0));
+    EXPECT_EQ(tris[3].p[0], Vec3f(0, 2, 0));
+    for (const auto& t : tris) EXPECT_GT(Normal(t).z, 0.99) << "strip winding must alternate";
+}
+
+TEST(PlyImporter, LittleEndianFaces) {
+    auto tris = ReadModel(Fixture("faces_little.ply"));
+    ASSERT_EQ(tris.size(), 3u);
+    double area = 0;
+    for (const auto& t : tris) area += Area(t);
+    EXPECT_NEAR(area, 0.5 + 1.0, 1e-6);
+}
+
+TEST(PlyImporter, ErrorsNameFileAndPlace) {
+    EXPECT_THAT(ReadError(Fixture("bad_index.ply")), HasSubstr("bad_index.ply:13: face 0 vertex index 9 out of range [0, 3)"));
+    EXPECT_THAT(ReadError(Fixture("truncated.ply")), HasSubstr("truncated.ply @"));
+    EXPECT_THAT(ReadError(Fixture("truncated.ply")), HasSubstr("truncated"));
+    EXPECT_THAT(ReadError(Fixture("garbage.obj").replace_filename("strips_big.ply").replace_extension(".ply")),
+                ::testing::IsEmpty());
+}
+
+TEST(StlImporter, BinaryStartingWithSolidIsReadAsBinary) {
+    auto tris = ReadModel(Fixture("solid_binary.stl"));
+    ASSERT_EQ(tris.size(), 3u);
+    EXPECT_EQ(tris[1].p[2], Vec3f(0, 0, 1));
+}
+
+TEST(StlImporter, AsciiWithCrlf) {
+    auto binary = ReadModel(Fixture("solid_binary.stl"));
+    auto ascii = ReadModel(Fixture("ascii.stl"));
+    ASSERT_EQ(ascii.size(), binary.size());
+    for (size_t i = 0; i < ascii.size(); ++i) EXPECT_EQ(ascii[i].p, binary[i].p);
+}
+
+TEST(StlImporter, TruncatedBinaryNamesSizes) {
+    EXPECT_THAT(ReadError(Fixture("truncated.stl")),
+                HasSubstr("binary STL header says 3 triangles, so 234 bytes expected, found 224"));
+}
+
+TEST(GltfImporter, NodeTransformsAndMaterials) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("node_transform.gltf"), &source);
+    ASSERT_EQ(tris.size(), 1u);
+    // World = scale 2 * translate (10, 0, 0): vertex (1, 0, 0) -> (22, 0, 0).
+    EXPECT_EQ(tris[0].p[0], Vec3f(20, 0, 0));
+    EXPECT_EQ(tris[0].p[1], Vec3f(22, 0, 0));
+    EXPECT_EQ(tris[0].p[2], Vec3f(20, 2, 0));
+    ASSERT_TRUE(tris[0].has_normals);
+    EXPECT_NEAR(tris[0].n[0].z, 1.f, 1e-6f);
+    const auto& m = source->materials().at(tris[0].material);
+    EXPECT_EQ(m.name, "brass");
+    EXPECT_FLOAT_EQ(m.diffuse[1], 0.7f);
+    EXPECT_FLOAT_EQ(m.metallic, 1.f);
+    EXPECT_FLOAT_EQ(m.roughness, 0.3f);
+    EXPECT_FLOAT_EQ(m.emission[2], 0.3f);
+    EXPECT_EQ(m.textures.at("baseColorTexture"), "brass.png");
+    EXPECT_EQ(source->units(), "m");
+}
+
+TEST(MergedInputs, MaterialNamesAreMadeUnique) {
+    auto source = OpenModels({Fixture("shapes_crlf.obj"), Fixture("shapes_crlf.obj"), Fixture("ascii.stl")});
+    ASSERT_TRUE(source.ok()) << source.status().ToString();
+    auto tris = ReadAll(**source);
+    ASSERT_TRUE(tris.ok());
+    EXPECT_EQ(tris->size(), 6u + 6u + 3u);
+    std::vector<std::string> names;
+    for (const auto& m : (*source)->materials()) names.push_back(m.name);
+    EXPECT_THAT(names, ::testing::UnorderedElementsAre("red", "blue", "undefined_in_mtl", "red.1", "blue.1",
+                                                       "undefined_in_mtl.1", "default"));
+    EXPECT_EQ((*source)->materials()[(*tris)[6].material].name, "red.1");
+    EXPECT_EQ((*source)->warnings().Count("missing textures (material kept, colour used)"), 2u);
+}
+
+}  // namespace
+}  // namespace nave::preprocess

@@ -1,0 +1,307 @@
+// The partition and the store it writes: the exact triangle/box test, bins round trip, and stores built from
+// closed meshes hold exactly the input's triangles (duplicates aside) and let no ray through between bricks.
+
+#include <embree3/rtcore.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+#include <set>
+
+#include "preprocess/partition/bin_file.h"
+#include "preprocess/partition/triangle_box.h"
+#include "preprocess/preprocess.h"
+#include "store/store_reader.h"
+#include "test_util.h"
+
+namespace nave::preprocess {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(TriangleBox, SeparatingAxes) {
+    Bounds3d box(Vec3d(0, 0, 0), Vec3d(1, 1, 1));
+    // Inside, outside on one axis, and touching a face.
+    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(0.2f, 0.2f, 0.5f), Vec3f(0.8f, 0.2f, 0.5f), Vec3f(0.5f, 0.8f, 0.5f)}, box));
+    EXPECT_FALSE(TriangleOverlapsBox({Vec3f(2, 0, 0), Vec3f(3, 0, 0), Vec3f(2, 1, 0)}, box));
+    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(1, 0, 0), Vec3f(2, 0, 0), Vec3f(1, 1, 0)}, box));
+    // A big triangle through the box with no vertex inside it.
+    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(-10, -10, 0.5f), Vec3f(10, -10, 0.5f), Vec3f(0, 10, 0.5f)}, box));
+    // Its bounding box overlaps the box but the triangle passes by a corner: only an edge axis separates.
+    EXPECT_FALSE(TriangleOverlapsBox({Vec3f(0.9f, 1.6f, 0.5f), Vec3f(1.6f, 0.9f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
+    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(0.3f, 1.6f, 0.5f), Vec3f(1.6f, 0.3f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
+    // A tilted plane crossing the box's bounding region but missing the box (plane axis separates).
+    EXPECT_FALSE(TriangleOverlapsBox({Vec3f(-5, -5, 3.5f), Vec3f(5, -5, 13.5f), Vec3f(-5, 5, 3.5f)}, box));
+}
+
+TEST(BinFile, RoundTripWithAndWithoutAttributes) {
+    auto dir = testing::MakeTempDir("bin");
+    std::vector<Triangle> in;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-100, 100);
+    for (int i = 0; i < 50000; ++i) {
+        Triangle t;
+        for (auto& p : t.p) p = Vec3f(u(rng), u(rng), u(rng));
+        t.material = uint32_t(i % 37);
+        t.has_normals = i % 3 == 0;
+        t.has_uvs = i % 5 == 0;
+        if (t.has_normals) t.n = {Vec3f(0, 0, 1), Vec3f(0, 1, 0), Vec3f(1, 0, 0)};
+        if (t.has_uvs) t.uv = {{{0.1f, 0.2f}, {0.3f, 0.4f}, {0.5f, float(i)}}};
+        in.push_back(t);
+    }
+    {
+        auto w = BinWriter::Create(dir / "a.lz4", 4096);
+        ASSERT_TRUE(w.ok());
+        for (const auto& t : in) ASSERT_TRUE((*w)->Append(t).ok());
+        ASSERT_TRUE((*w)->Close().ok());
+    }
+    auto r = BinReader::Open(dir / "a.lz4");
+    ASSERT_TRUE(r.ok());
+    std::vector<Triangle> out;
+    while (true) {
+        auto more = (*r)->Read(out, 777);
+        ASSERT_TRUE(more.ok());
+        if (!*more) break;
+    }
+    ASSERT_EQ(out.size(), in.size());
+    for (size_t i = 0; i < in.size(); ++i) {
+        ASSERT_EQ(out[i].p, in[i].p);
+        ASSERT_EQ(out[i].material, in[i].material);
+        ASSERT_EQ(out[i].has_normals, in[i].has_normals);
+        ASSERT_EQ(out[i].has_uvs, in[i].has_uvs);
+        if (in[i].has_normals) {
+            ASSERT_EQ(out[i].n, in[i].n);
+        }
+        if (in[i].has_uvs) {
+            ASSERT_EQ(out[i].uv, in[i].uv);
+        }
+    }
+    std::filesystem::remove_all(dir);
+}
+
+// A closed icosphere of radius `r` subdivided `levels` times (20 * 4^levels triangles), outward winding,
+// written as OBJ.
+void WriteIcosphere(const std::filesystem::path& path, int levels, double r) {
+    const double t = (1 + std::sqrt(5.0)) / 2;
+    std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    for (auto& p : v) p = Normalize(p);
+    for (int l = 0; l < levels; ++l) {
+        std::map<std::pair<int, int>, int> mid;
+        auto midpoint = [&](int a, int b) {
+            auto key = std::minmax(a, b);
+            auto it = mid.find(key);
+            if (it != mid.end()) return it->second;
+            v.push_back(Normalize(v[a] + v[b]));
+            return mid[key] = int(v.size() - 1);
+        };
+        std::vector<std::array<int, 3>> next;
+        for (auto [a, b, c] : f) {
+            int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            next.insert(next.end(), {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}});
+        }
+        f = std::move(next);
+    }
+    std::FILE* out = std::fopen(path.c_str(), "w");
+    for (auto& p : v) std::fprintf(out, "v %.9g %.9g %.9g\n", p.x * r + 3, p.y * r - 2, p.z * r + 1);
+    for (auto [a, b, c] : f) std::fprintf(out, "f %d %d %d\n", a + 1, b + 1, c + 1);
+    std::fclose(out);
+}
+
+using QTri = std::array<Vec3i, 3>;
+struct QTriLess {
+    bool operator()(const QTri& a, const QTri& b) const {
+        for (int j = 0; j < 3; ++j) {
+            for (int k = 0; k < 3; ++k) {
+                if (a[j][k] != b[j][k]) return a[j][k] < b[j][k];
+            }
+        }
+        return false;
+    }
+};
+// Rotates the corners so that the smallest comes first (keeping the winding).
+QTri Canonical(QTri q) {
+    QTriLess less;
+    auto key = [](const Vec3i& v) { return std::array<int32_t, 3>{v.x, v.y, v.z}; };
+    int first = 0;
+    for (int j = 1; j < 3; ++j) {
+        if (key(q[j]) < key(q[first])) first = j;
+    }
+    (void)less;
+    return {q[first], q[(first + 1) % 3], q[(first + 2) % 3]};
+}
+
+class PartitionedSphere : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        dir_ = testing::MakeTempDir("sphere");
+        WriteIcosphere(dir_ / "sphere.obj", 5, 2.0);  // 20480 triangles
+    }
+    static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+
+    static PreprocessStats Run(const std::filesystem::path& out, uint64_t memory, int threads) {
+        PreprocessOptions o;
+        o.inputs = {dir_ / "sphere.obj"};
+        o.output = out;
+        o.brick_triangles = 1000;
+        o.memory_bytes = memory;
+        o.threads = threads;
+        auto stats = RunPreprocess(o);
+        EXPECT_TRUE(stats.ok()) << stats.status().ToString();
+        return stats.ok() ? *stats : PreprocessStats{};
+    }
+    static inline std::filesystem::path dir_;
+};
+
+std::set<QTri, QTriLess> StoreTriangles(const store::Store& s, uint64_t* references) {
+    std::set<QTri, QTriLess> all;
+    *references = 0;
+    for (uint32_t b = 0; b < s.bricks().size(); ++b) {
+        auto mesh = s.ReadBrick(b);
+        EXPECT_TRUE(mesh.ok()) << mesh.status().ToString();
+        if (!mesh.ok()) continue;
+        for (size_t t = 0; t < mesh->TriangleCount(); ++t) {
+            QTri q;
+            for (int j = 0; j < 3; ++j) q[j] = s.header().grid.Quantize(mesh->positions[mesh->indices[3 * t + j]]);
+            all.insert(Canonical(q));
+            ++*references;
+        }
+    }
+    return all;
+}
+
+TEST_F(PartitionedSphere, ManyBricksHoldExactlyTheInputTriangles) {
+    auto stats = Run(dir_ / "a.nave", 0, 2);
+    EXPECT_GE(stats.bricks, 16u);
+    auto store = store::Store::Open(dir_ / "a.nave");
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    const auto& grid = (*store)->header().grid;
+    auto input = testing::ReadModel(dir_ / "sphere.obj");
+    std::set<QTri, QTriLess> expected;
+    for (const auto& t : input) expected.insert(Canonical({grid.Quantize(t.p[0]), grid.Quantize(t.p[1]), grid.Quantize(t.p[2])}));
+    uint64_t refs = 0;
+    auto got = StoreTriangles(**store, &refs);
+    EXPECT_EQ(got.size(), expected.size());
+    EXPECT_TRUE(got == expected) << "the bricks' triangles, as a set, differ from the input's";
+    EXPECT_EQ(refs, stats.stored_triangles);
+    EXPECT_EQ(refs - input.size(), stats.duplicated_triangles);
+    EXPECT_EQ((*store)->header().source_triangle_count, input.size());
+    // Quantization bound: every decoded position is within step * sqrt(3) / 2 of an input vertex's.
+    EXPECT_NEAR(stats.max_error, grid.step * std::sqrt(3.0) / 2, 1e-12);
+    // No temporary files left.
+    for (const auto& e : std::filesystem::directory_iterator(dir_)) {
+        EXPECT_THAT(e.path().filename().string(), ::testing::Not(HasSubstr("tmp"))) << e.path();
+    }
+}
+
+TEST_F(PartitionedSphere, SmallBudgetAndOneThreadGiveTheSameTriangles) {
+    auto a = Run(dir_ / "big.nave", 0, 2);
+    auto b = Run(dir_ / "small.nave", 64ull << 20, 1);
+    auto sa = store::Store::Open(dir_ / "big.nave");
+    auto sb = store::Store::Open(dir_ / "small.nave");
+    ASSERT_TRUE(sa.ok() && sb.ok());
+    uint64_t ra = 0, rb = 0;
+    EXPECT_TRUE(StoreTriangles(**sa, &ra) == StoreTriangles(**sb, &rb));
+    EXPECT_EQ(a.source_triangles, b.source_triangles);
+}
+
+// Rays from inside the closed sphere, walked brick by brick front to back as the renderer does: each brick
+// intersected only within its own cell's [t_enter, t_exit]. A crack between bricks lets a ray escape.
+TEST_F(PartitionedSphere, NoRayEscapesBetweenBricks) {
+    Run(dir_ / "w.nave", 0, 2);
+    auto store = store::Store::Open(dir_ / "w.nave");
+    ASSERT_TRUE(store.ok());
+    const store::Store& s = **store;
+    ASSERT_GE(s.bricks().size(), 16u);
+    RTCDevice device = rtcNewDevice(nullptr);
+    ASSERT_NE(device, nullptr);
+    std::vector<RTCScene> scenes;
+    for (uint32_t b = 0; b < s.bricks().size(); ++b) {
+        auto mesh = s.ReadBrick(b);
+        ASSERT_TRUE(mesh.ok());
+        RTCScene scene = rtcNewScene(device);
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), mesh->VertexCount()));
+        for (size_t i = 0; i < mesh->VertexCount(); ++i) {
+            vb[3 * i] = mesh->positions[i].x;
+            vb[3 * i + 1] = mesh->positions[i].y;
+            vb[3 * i + 2] = mesh->positions[i].z;
+        }
+        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(unsigned), mesh->TriangleCount()));
+        std::copy(mesh->indices.begin(), mesh->indices.end(), ib);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(scene);
+        scenes.push_back(scene);
+    }
+    std::mt19937 rng(12345);
+    std::normal_distribution<float> n(0, 1);
+    std::uniform_real_distribution<float> u(-1, 1);
+    const Vec3f centre(3, -2, 1);
+    int escaped = 0;
+    const int kRays = 20000;
+    for (int i = 0; i < kRays; ++i) {
+        Vec3f d = Normalize(Vec3f(n(rng), n(rng), n(rng)));
+        Vec3f o = centre + Vec3f(u(rng), u(rng), u(rng)) * 1.0f;  // anywhere well inside (radius 2)
+        bool hit = false;
+        s.tree().Traverse(o, d, 0.f, 1e30f, [&](uint32_t brick, float t0, float t1) {
+            RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            RTCRayHit rh{};
+            rh.ray.org_x = o.x;
+            rh.ray.org_y = o.y;
+            rh.ray.org_z = o.z;
+            rh.ray.dir_x = d.x;
+            rh.ray.dir_y = d.y;
+            rh.ray.dir_z = d.z;
+            // A few ulps of slack at the cell faces, as a renderer needs for float cell bounds.
+            rh.ray.tnear = std::max(0.f, t0 * (1 - 1e-6f) - 1e-6f);
+            rh.ray.tfar = t1 * (1 + 1e-6f) + 1e-6f;
+            rh.ray.mask = 0xffffffffu;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(scenes[brick], &ctx, &rh);
+            hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+            return !hit;
+        });
+        if (!hit) ++escaped;
+    }
+    for (RTCScene sc : scenes) rtcReleaseScene(sc);
+    rtcReleaseDevice(device);
+    EXPECT_EQ(escaped, 0) << escaped << " of " << kRays << " rays escaped the closed sphere";
+}
+
+TEST(PreprocessErrors, BadInputNamesFileAndLineAndLeavesNothing) {
+    auto dir = testing::MakeTempDir("bad");
+    PreprocessOptions o;
+    o.inputs = {testing::Fixture("bad_index.obj")};
+    o.output = dir / "bad.nave";
+    auto stats = RunPreprocess(o);
+    ASSERT_FALSE(stats.ok());
+    EXPECT_THAT(stats.status().ToString(), HasSubstr("bad_index.obj:5"));
+    EXPECT_TRUE(std::filesystem::is_empty(dir)) << "a failed run must leave no file";
+    std::filesystem::remove_all(dir);
+}
+
+TEST(PreprocessErrors, BudgetTooSmallSaysWhichOptionToChange) {
+    PreprocessOptions o;
+    o.inputs = {testing::Fixture("ascii.stl")};
+    o.output = std::filesystem::temp_directory_path() / "never.nave";
+    o.memory_bytes = 100ull << 20;
+    auto stats = RunPreprocess(o);
+    ASSERT_FALSE(stats.ok());
+    EXPECT_EQ(stats.status().code(), StatusCode::kResourceExhausted);
+    EXPECT_THAT(stats.status().message(), HasSubstr("--memory"));
+    EXPECT_THAT(stats.status().message(), HasSubstr("--brick-triangles"));
+    EXPECT_FALSE(std::filesystem::exists(o.output));
+}
+
+}  // namespace
+}  // namespace nave::preprocess

@@ -1,0 +1,115 @@
+// End to end: `nave inspect` and `nave verify` run as a user runs them, on a small store and a damaged copy.
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/file.h"
+#include "store/store_reader.h"
+#include "store/testing/store_testing.h"
+#include "test_util.h"
+
+namespace nave::store {
+namespace {
+
+using test::ScratchDir;
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string output;  // stdout, or stdout + stderr
+};
+
+CommandResult RunNave(const std::string& args, bool with_stderr = false) {
+    const std::string command = std::string(NAVE_BINARY) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+    CommandResult run;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    NAVE_CHECK(pipe != nullptr) << command;
+    char buffer[4096];
+    size_t n;
+    while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
+    const int status = ::pclose(pipe);
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return run;
+}
+
+class NaveCli : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const BrickMesh mesh = testing::MakeSurface({.quads_x = 20, .quads_y = 20});
+        triangles_ = mesh.TriangleCount();
+        auto written = testing::WriteGridStore(store_, mesh, testing::MakeMaterials(3), {2, 2, 1},
+                                               GlobalGrid{{0, 0, 0}, 1e-3});
+        ASSERT_TRUE(written.ok()) << written.status().ToString();
+    }
+    ScratchDir dir_;
+    std::filesystem::path store_ = dir_ / "small.nave";
+    size_t triangles_ = 0;
+};
+
+TEST_F(NaveCli, VerifyIntactStoreSucceeds) {
+    const CommandResult run = RunNave("-q verify " + store_.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("4 of 4 bricks intact"), std::string::npos) << run.output;
+}
+
+TEST_F(NaveCli, InspectJsonDescribesTheStore) {
+    const CommandResult run = RunNave("inspect --json " + store_.string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    for (const std::string& part :
+         {fmt::format("\"triangles\": {},", triangles_), fmt::format("\"source_triangles\": {},", triangles_),
+          std::string("\"bricks\": 4,"), std::string("\"format_version\": \"1.0\""), std::string("\"step\": 0.001"),
+          std::string("\"max_axis_error\": 0.0005"), std::string("\"name\": \"m2\""),
+          std::string("\"map_Kd\": \"textures/m1.png\""), std::string("\"source_files\": [\"synthetic-surface\"]"),
+          fmt::format("\"bytes_on_disk\": {},", std::filesystem::file_size(store_))}) {
+        EXPECT_NE(run.output.find(part), std::string::npos) << "missing " << part << " in\n" << run.output;
+    }
+    EXPECT_EQ(run.output.front(), '{');
+    EXPECT_EQ(run.output.substr(run.output.size() - 2), "}\n");
+
+    const CommandResult text = RunNave("inspect --bricks " + store_.string());
+    EXPECT_EQ(text.exit_code, 0);
+    EXPECT_NE(text.output.find("bytes/triangle"), std::string::npos) << text.output;
+    EXPECT_NE(text.output.find("max position error 0.5 mm per axis"), std::string::npos) << text.output;
+}
+
+TEST_F(NaveCli, VerifyDamagedStoreFailsNamingTheBrick) {
+    auto store = Store::Open(store_);
+    ASSERT_TRUE(store.ok());
+    const BrickInfo brick = (*store)->bricks()[2];
+    store->reset();
+    auto bytes = ReadFileToString(store_);
+    ASSERT_TRUE(bytes.ok());
+    (*bytes)[brick.mesh.offset + 10] ^= 0x01;
+    const std::filesystem::path damaged = dir_ / "damaged.nave";
+    std::ofstream(damaged, std::ios::binary).write(bytes->data(), std::streamsize(bytes->size()));
+
+    const CommandResult run = RunNave("-q verify " + damaged.string(), true);
+    EXPECT_EQ(run.exit_code, 1) << run.output;
+    EXPECT_NE(run.output.find(fmt::format("brick 2: data loss: {} brick 2 @0x{:x}: mesh checksum", damaged.string(),
+                                          brick.mesh.offset)),
+              std::string::npos)
+        << run.output;
+    EXPECT_NE(run.output.find("3 of 4 bricks intact"), std::string::npos) << run.output;
+    EXPECT_EQ(run.output.find("brick 1:"), std::string::npos) << run.output;
+
+    const CommandResult json = RunNave("-q verify --json " + damaged.string());
+    EXPECT_EQ(json.exit_code, 1);
+    EXPECT_NE(json.output.find("\"ok\": false"), std::string::npos) << json.output;
+    EXPECT_NE(json.output.find("{\"id\": 2, \"error\": \"data loss:"), std::string::npos) << json.output;
+}
+
+TEST_F(NaveCli, MissingOrForeignFilesFailCleanly) {
+    CommandResult run = RunNave("verify " + (dir_ / "absent.nave").string(), true);
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.output.find("absent.nave: no such file"), std::string::npos) << run.output;
+    std::ofstream(dir_ / "text.nave") << "hello, not a store\n";
+    run = RunNave("inspect " + (dir_ / "text.nave").string(), true);
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.output.find("not a nave store"), std::string::npos) << run.output;
+}
+
+}  // namespace
+}  // namespace nave::store
