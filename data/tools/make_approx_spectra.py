@@ -41,6 +41,11 @@ STONE = {
     "limestone": limestone,
     "limestone_dark": lambda l: 0.62 * limestone(l) - 0.02,
     "roof_slate": lambda l: 0.085 + 0.008 * (l - 550) / 280,
+    # Pale polished limestone/marble tile and red terracotta tile (Fe2O3 edge near 560 nm).
+    "floor_tile_light": lambda l: 0.95 * limestone(l) + 0.08,
+    "floor_tile_dark": lambda l: 0.07 + 0.30 / (1 + math.exp(-(l - 575) / 22)),
+    # Aged oak: low in the blue, rising through the red (shape of published wood spectra).
+    "wood": lambda l: 0.06 + 0.36 / (1 + math.exp(-(l - 610) / 45)),
 }
 
 R = 0.04  # Fresnel reflectance of one face at normal incidence, n = 1.5
@@ -57,9 +62,9 @@ with open("stained_glass_approx.csv", "w") as f:
             vals.append((1 - R) ** 2 * tau / (1 - R * R * tau * tau))
         f.write(f"{l}," + ",".join(f"{v:.4f}" for v in vals) + "\n")
 with open("stone_approx.csv", "w") as f:
-    f.write("# APPROXIMATIONS, not measurements: diffuse spectral reflectance of building stone, built by\n")
-    f.write("# tools/make_approx_spectra.py after the shape of published limestone spectra (ECOSTRESS/ASTER library,\n")
-    f.write("# Baldridge et al. 2009; USGS splib07, Kokaly et al. 2017) and of dark slate. See SOURCES.md.\n")
+    f.write("# APPROXIMATIONS, not measurements: diffuse spectral reflectance of building materials, built by\n")
+    f.write("# tools/make_approx_spectra.py after the shape of published stone, terracotta and wood spectra (ECOSTRESS/ASTER library,\n")
+    f.write("# Baldridge et al. 2009; USGS splib07, Kokaly et al. 2017). See SOURCES.md.\n")
     f.write("wavelength_nm," + ",".join(STONE) + "\n")
     for l in range(360, 831, 10):
         f.write(f"{l}," + ",".join(f"{m(l):.4f}" for m in STONE.values()) + "\n")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <iterator>
 
 #include "core/spectrum_data.h"
 
@@ -18,8 +19,8 @@ struct Cmfs {
         x = t.ToSpectrum(0);
         y = t.ToSpectrum(1);
         z = t.ToSpectrum(2);
-        // The table is at 1 nm over exactly nave's range, so the 1 nm sum is the integral (CIE 15:2004
-        // §7.1 recommends summation at the table's interval).
+        // The table is at 1 nm over exactly nave's range, so the 1 nm sum is the integral (CIE
+        // 15:2004 §7.1 recommends summation at the table's interval).
         for (int i = 0; i < Spectrum::kNumSamples; ++i) y_integral += y.sample(i);
     }
 };
@@ -36,7 +37,8 @@ const Spectrum& CieY() { return GetCmfs().y; }
 const Spectrum& CieZ() { return GetCmfs().z; }
 double CieYIntegral() { return GetCmfs().y_integral; }
 
-// ---- Mat3d ------------------------------------------------------------------------------------------
+// ---- Mat3d
+// ------------------------------------------------------------------------------------------
 
 Mat3d Mat3d::Identity() { return Diagonal({1, 1, 1}); }
 
@@ -101,7 +103,8 @@ std::ostream& operator<<(std::ostream& os, const Mat3d& m) {
     return os << "]";
 }
 
-// ---- XYZ --------------------------------------------------------------------------------------------
+// ---- XYZ
+// --------------------------------------------------------------------------------------------
 
 Chromaticity XYZToChromaticity(const Vec3d& xyz) {
     double sum = xyz.x + xyz.y + xyz.z;
@@ -151,7 +154,8 @@ Vec3d SampledToXYZ(const SampledSpectrum& L, const SampledWavelengths& lambda) {
     return xyz / (double(kNumWavelengths) * c.y_integral);
 }
 
-// ---- RGB colour spaces ------------------------------------------------------------------------------
+// ---- RGB colour spaces
+// ------------------------------------------------------------------------------
 
 RgbColorSpace::RgbColorSpace(std::string name, Chromaticity r, Chromaticity g, Chromaticity b,
                              Chromaticity white)
@@ -194,7 +198,8 @@ StatusOr<const RgbColorSpace*> RgbColorSpace::Named(std::string_view name) {
     return NotFoundError("unknown colour space '{}' (known: srgb, rec2020, acescg)", name);
 }
 
-// ---- Chromatic adaptation ---------------------------------------------------------------------------
+// ---- Chromatic adaptation
+// ---------------------------------------------------------------------------
 
 namespace {
 
@@ -203,12 +208,14 @@ Mat3d ConeMatrix(AdaptationMethod method) {
     switch (method) {
         case AdaptationMethod::kBradford:
             // Lam (1985); as in ICC.1:2010 Annex E and Lindbloom's tables.
-            m.m = {{{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}}};
+            m.m = {
+                {{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}}};
             break;
         case AdaptationMethod::kVonKries:
             // Hunt-Pointer-Estévez fundamentals normalised to D65 (Fairchild, Color Appearance
             // Models, 3rd ed., eq. 9.1).
-            m.m = {{{0.40024, 0.70760, -0.08081}, {-0.22630, 1.16532, 0.04570}, {0.0, 0.0, 0.91822}}};
+            m.m = {
+                {{0.40024, 0.70760, -0.08081}, {-0.22630, 1.16532, 0.04570}, {0.0, 0.0, 0.91822}}};
             break;
         case AdaptationMethod::kXyzScaling:
             m = Mat3d::Identity();
@@ -233,7 +240,8 @@ Mat3d WhiteBalancedXyzToRgb(const RgbColorSpace& space, const Chromaticity& scen
     return space.xyz_to_rgb() * ChromaticAdaptationMatrix(scene_white, space.white(), method);
 }
 
-// ---- Output -----------------------------------------------------------------------------------------
+// ---- Output
+// -----------------------------------------------------------------------------------------
 
 double SrgbEncode(double linear) {
     // IEC 61966-2-1:1999 §5.2, eq. (5).
@@ -273,6 +281,51 @@ double CctMcCamy(const Chromaticity& xy) {
     // McCamy (1992) eq. (3): n = (x - xe) / (ye - y), epicentre (0.3320, 0.1858).
     double n = (xy.x - 0.3320) / (0.1858 - xy.y);
     return 449.0 * n * n * n + 3525.0 * n * n + 6823.3 * n + 5520.33;
+}
+
+double CctRobertson(const Chromaticity& xy) {
+    // Isotemperature lines: reciprocal temperature (MK⁻¹), u, v on the Planckian locus, slope t
+    // (Wyszecki & Stiles 1982, Table 1(3.11)).
+    struct Line {
+        double mired, u, v, t;
+    };
+    static constexpr Line kLines[] = {
+        {0, 0.18006, 0.26352, -0.24341},   {10, 0.18066, 0.26589, -0.25479},
+        {20, 0.18133, 0.26846, -0.26876},  {30, 0.18208, 0.27119, -0.28539},
+        {40, 0.18293, 0.27407, -0.30470},  {50, 0.18388, 0.27709, -0.32675},
+        {60, 0.18494, 0.28021, -0.35156},  {70, 0.18611, 0.28342, -0.37915},
+        {80, 0.18740, 0.28668, -0.40955},  {90, 0.18880, 0.28997, -0.44278},
+        {100, 0.19032, 0.29326, -0.47888}, {125, 0.19462, 0.30141, -0.58204},
+        {150, 0.19962, 0.30921, -0.70471}, {175, 0.20525, 0.31647, -0.84901},
+        {200, 0.21142, 0.32312, -1.0182},  {225, 0.21807, 0.32909, -1.2168},
+        {250, 0.22511, 0.33439, -1.4512},  {275, 0.23247, 0.33904, -1.7298},
+        {300, 0.24010, 0.34308, -2.0637},  {325, 0.24792, 0.34655, -2.4681},
+        {350, 0.25591, 0.34951, -2.9641},  {375, 0.26400, 0.35200, -3.5814},
+        {400, 0.27218, 0.35407, -4.3633},  {425, 0.28039, 0.35577, -5.3762},
+        {450, 0.28863, 0.35714, -6.7262},  {475, 0.29685, 0.35823, -8.5955},
+        {500, 0.30505, 0.35907, -11.324},  {525, 0.31320, 0.35968, -15.628},
+        {550, 0.32129, 0.36011, -23.325},  {575, 0.32931, 0.36038, -40.770},
+        {600, 0.33724, 0.36051, -116.45},
+    };
+    // CIE 1960 UCS: u = 4x / (-2x + 12y + 3), v = 6y / (-2x + 12y + 3).
+    double den = -2.0 * xy.x + 12.0 * xy.y + 3.0;
+    if (den == 0.0) return NAN;
+    double u = 4.0 * xy.x / den, v = 6.0 * xy.y / den;
+    // Signed distance of (u, v) from each isotemperature line; the CCT lies between the two lines
+    // where it changes sign (Robertson 1968 eq. 3).
+    double prev_d = 0;
+    for (size_t i = 0; i < std::size(kLines); ++i) {
+        const Line& l = kLines[i];
+        double d = ((v - l.v) - l.t * (u - l.u)) / std::sqrt(1.0 + l.t * l.t);
+        if (i > 0 && ((prev_d < 0) != (d < 0) || d == 0)) {
+            const Line& p = kLines[i - 1];
+            double f = prev_d / (prev_d - d);
+            double mired = p.mired + f * (l.mired - p.mired);
+            return mired > 0 ? 1e6 / mired : INFINITY;
+        }
+        prev_d = d;
+    }
+    return NAN;
 }
 
 }  // namespace nave

@@ -1,7 +1,7 @@
 #pragma once
 // Colorimetry: the CIE 1931 2° observer, spectra -> XYZ (exact sums and the film's Monte Carlo
-// estimator), RGB colour spaces derived from their primaries, chromatic adaptation, CIELAB, the sRGB
-// transfer curve, exposure and 8-bit output, correlated colour temperature.
+// estimator), RGB colour spaces derived from their primaries, chromatic adaptation, CIELAB, the
+// sRGB transfer curve, exposure and 8-bit output, correlated colour temperature.
 
 #include <array>
 #include <cstdint>
@@ -15,8 +15,9 @@
 
 namespace nave {
 
-/// ∫ȳ(λ)dλ of the CIE 1931 2° 1 nm table over 360-830 nm, as published (CIE 018:2019 data; the value
-/// pbrt-v4 uses). CieYIntegral() is the sum of the table nave compiles in, equal to this within 3e-5.
+/// ∫ȳ(λ)dλ of the CIE 1931 2° 1 nm table over 360-830 nm, as published (CIE 018:2019 data; the
+/// value pbrt-v4 uses). CieYIntegral() is the sum of the table nave compiles in, equal to this
+/// within 3e-5.
 inline constexpr double kCieYIntegralPublished = 106.856895;
 
 /// The CIE 1931 2° colour-matching functions x̄, ȳ, z̄ (1 nm, 360-830 nm, CIE 018:2019 CSV).
@@ -63,8 +64,8 @@ Vec3d ReflectanceToXYZ(const Spectrum& reflectance, const Spectrum& illuminant);
 /// so an illuminant's Y is its luminance relative to ∫ȳ. Terminated wavelengths (pdf 0) count 0.
 Vec3d SampledToXYZ(const SampledSpectrum& L, const SampledWavelengths& lambda);
 
-/// An RGB colour space built from its primaries' and white point's chromaticities (SMPTE RP 177-1993
-/// derivation of the normalised primary matrix).
+/// An RGB colour space built from its primaries' and white point's chromaticities (SMPTE RP
+/// 177-1993 derivation of the normalised primary matrix).
 class RgbColorSpace {
   public:
     RgbColorSpace(std::string name, Chromaticity r, Chromaticity g, Chromaticity b,
@@ -106,8 +107,8 @@ enum class AdaptationMethod {
 /// The 3x3 matrix that maps XYZ seen under white `src` to corresponding XYZ under white `dst`.
 Mat3d ChromaticAdaptationMatrix(const Chromaticity& src, const Chromaticity& dst,
                                 AdaptationMethod method = AdaptationMethod::kBradford);
-/// White balance: XYZ -> linear RGB of `space`, adapting the illuminant's white (`scene_white`) to the
-/// space's white so that a neutral surface under that illuminant comes out neutral.
+/// White balance: XYZ -> linear RGB of `space`, adapting the illuminant's white (`scene_white`) to
+/// the space's white so that a neutral surface under that illuminant comes out neutral.
 Mat3d WhiteBalancedXyzToRgb(const RgbColorSpace& space, const Chromaticity& scene_white,
                             AdaptationMethod method = AdaptationMethod::kBradford);
 
@@ -127,5 +128,10 @@ double DeltaE76(const Vec3d& lab1, const Vec3d& lab2);
 /// Correlated colour temperature by McCamy's cubic (McCamy 1992, Color Res. Appl. 17(2) 142-144,
 /// erratum 18(2) 150); accurate to ~2 K over 2856-6504 K near the Planckian locus.
 double CctMcCamy(const Chromaticity& xy);
+/// Correlated colour temperature by Robertson's method (Robertson 1968, JOSA 58(11) 1528-1535):
+/// linear interpolation between the 31 isotemperature lines of Wyszecki & Stiles (1982) Table
+/// 1(3.11) in the CIE 1960 (u, v) diagram; 1667 K to infinity. NaN outside the table's reach (far
+/// from the locus).
+double CctRobertson(const Chromaticity& xy);
 
 }  // namespace nave

@@ -14,15 +14,15 @@ const Spectrum& IlluminantD65() {
 }
 
 const Spectrum& IlluminantD50() {
-    // CIE 15:2004 §3.1: D50 is the daylight of nominal CCT 5000 K, computed at 5000 × 1.4388/1.4380 K
-    // since the change of c2 in the ITS-90.
+    // CIE 15:2004 §3.1: D50 is the daylight of nominal CCT 5000 K, computed at 5000 × 1.4388/1.4380
+    // K since the change of c2 in the ITS-90.
     static const Spectrum s = Spectrum::CieIlluminantD(5000.0 * 1.4388 / 1.4380);
     return s;
 }
 
 const Spectrum& IlluminantA() {
-    // CIE 15:2004 eq. (3.1): S_A(λ) = 100 (560/λ)^5 (e^(c2/(2848·560)) - 1) / (e^(c2/(2848 λ)) - 1),
-    // c2 = 1.435e7 nm K (the defining form; equivalent to 2856 K with c2 = 1.4388e7 nm K).
+    // CIE 15:2004 eq. (3.1): S_A(λ) = 100 (560/λ)^5 (e^(c2/(2848·560)) - 1) / (e^(c2/(2848 λ)) -
+    // 1), c2 = 1.435e7 nm K (the defining form; equivalent to 2856 K with c2 = 1.4388e7 nm K).
     static const Spectrum s = Spectrum::FromFunction([](double l) {
         constexpr double kC2 = 1.435e7;
         constexpr double kT = 2848.0;

@@ -12,11 +12,11 @@ namespace nave {
 /// CIE standard illuminant D65 (CIE 15:2004 Table T.1, 5 nm table interpolated linearly to 1 nm, as
 /// the CIE's 1 nm table is), 100 at 560 nm.
 const Spectrum& IlluminantD65();
-/// CIE illuminant D50: the daylight illuminant of CCT 5000 × 1.4388/1.4380 ≈ 5003 K (CIE 15:2004 §3.1),
-/// 100 at 560 nm.
+/// CIE illuminant D50: the daylight illuminant of CCT 5000 × 1.4388/1.4380 ≈ 5003 K (CIE 15:2004
+/// §3.1), 100 at 560 nm.
 const Spectrum& IlluminantD50();
-/// CIE standard illuminant A, defined by Planck's law at 2856 K with c2 = 1.4388e-2 m K, 100 at 560 nm
-/// (CIE 15:2004 eq. 3.1).
+/// CIE standard illuminant A, defined by Planck's law at 2856 K with c2 = 1.4388e-2 m K, 100 at 560
+/// nm (CIE 15:2004 eq. 3.1).
 const Spectrum& IlluminantA();
 /// The equal-energy illuminant E (1 everywhere).
 const Spectrum& IlluminantE();

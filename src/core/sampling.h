@@ -1,5 +1,6 @@
 #pragma once
-// Sampling of directions and discs for Monte Carlo rendering. Header-only; every warp lists its pdf.
+// Sampling of directions and discs for Monte Carlo rendering. Header-only; every warp lists its
+// pdf.
 
 #include <algorithm>
 #include <cmath>
@@ -21,8 +22,8 @@ struct Point2f {
 inline constexpr float kPi = std::numbers::pi_v<float>;
 inline constexpr float kInvPi = std::numbers::inv_pi_v<float>;
 
-/// Concentric map of the square to the unit disc (Shirley & Chiu 1997, "A low distortion map between
-/// disk and square"), area-preserving.
+/// Concentric map of the square to the unit disc (Shirley & Chiu 1997, "A low distortion map
+/// between disk and square"), area-preserving.
 inline Point2f SampleUniformDiskConcentric(Point2f u) {
     float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;
     if (ox == 0.f && oy == 0.f) return {0.f, 0.f};
@@ -54,14 +55,16 @@ inline Vec3f SampleUniformSphere(Point2f u) {
 }
 inline constexpr float UniformSpherePdf() { return 1.f / (4.f * kPi); }
 
-/// Uniform direction in the cone of half-angle acos(cos_theta_max) around +z; pdf 1/(2π(1 - cosθmax)).
-/// Used for the sun's disc.
+/// Uniform direction in the cone of half-angle acos(cos_theta_max) around +z; pdf 1/(2π(1 -
+/// cosθmax)). Used for the sun's disc.
 inline Vec3f SampleUniformCone(Point2f u, float cos_theta_max) {
     float cos_theta = (1.f - u.x) + u.x * cos_theta_max;
     float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
     float phi = u.y * 2.f * kPi;
     return {std::cos(phi) * sin_theta, std::sin(phi) * sin_theta, cos_theta};
 }
-inline float UniformConePdf(float cos_theta_max) { return 1.f / (2.f * kPi * (1.f - cos_theta_max)); }
+inline float UniformConePdf(float cos_theta_max) {
+    return 1.f / (2.f * kPi * (1.f - cos_theta_max));
+}
 
 }  // namespace nave

@@ -49,7 +49,8 @@ std::ostream& operator<<(std::ostream& os, const SampledSpectrum& s) {
     return os << "]";
 }
 
-// ---- Wavelength sampling ---------------------------------------------------------------------------
+// ---- Wavelength sampling
+// ---------------------------------------------------------------------------
 
 namespace {
 
@@ -129,7 +130,8 @@ bool SampledWavelengths::SecondaryTerminated() const {
     return true;
 }
 
-// ---- Spectrum ---------------------------------------------------------------------------------------
+// ---- Spectrum
+// ---------------------------------------------------------------------------------------
 
 Spectrum::Spectrum() = default;
 
@@ -156,8 +158,8 @@ StatusOr<Spectrum> Spectrum::FromPiecewiseLinear(const std::vector<double>& lamb
     return FromFunction([&](double l) {
         if (l <= lambdas_nm.front()) return values.front();
         if (l >= lambdas_nm.back()) return values.back();
-        size_t hi = size_t(std::upper_bound(lambdas_nm.begin(), lambdas_nm.end(), l) -
-                           lambdas_nm.begin());
+        size_t hi =
+            size_t(std::upper_bound(lambdas_nm.begin(), lambdas_nm.end(), l) - lambdas_nm.begin());
         size_t lo = hi - 1;
         double t = (l - lambdas_nm[lo]) / (lambdas_nm[hi] - lambdas_nm[lo]);
         return values[lo] + t * (values[hi] - values[lo]);
@@ -178,7 +180,8 @@ double PlanckRadiance(double lambda_nm, double t_kelvin) {
     constexpr double kC = 299792458.0;     // m/s
     constexpr double kKb = 1.380649e-23;   // J/K
     double l = lambda_nm * 1e-9;
-    double le = (2 * kH * kC * kC) / (l * l * l * l * l * (std::expm1((kH * kC) / (l * kKb * t_kelvin))));
+    double le =
+        (2 * kH * kC * kC) / (l * l * l * l * l * (std::expm1((kH * kC) / (l * kKb * t_kelvin))));
     return le * 1e-9;  // per metre of wavelength -> per nanometre
 }
 
@@ -233,14 +236,17 @@ Spectrum& Spectrum::operator+=(const Spectrum& s) {
     return *this;
 }
 
-// ---- CSV --------------------------------------------------------------------------------------------
+// ---- CSV
+// --------------------------------------------------------------------------------------------
 
 namespace {
 
 std::string_view Trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r' || s.front() == '"'))
+    while (!s.empty() &&
+           (s.front() == ' ' || s.front() == '\t' || s.front() == '\r' || s.front() == '"'))
         s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r' || s.back() == '"'))
+    while (!s.empty() &&
+           (s.back() == ' ' || s.back() == '\t' || s.back() == '\r' || s.back() == '"'))
         s.remove_suffix(1);
     return s;
 }
@@ -268,6 +274,8 @@ bool ParseDouble(std::string_view s, double* out) {
 
 StatusOr<SpectraTable> ParseSpectraCsv(std::string_view text, std::string_view source_name) {
     SpectraTable table;
+    // Spreadsheet exports often start with a UTF-8 byte-order mark.
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     size_t num_columns = 0;  // value columns, fixed by the header or the first data row
     int line_number = 0;
     bool seen_data = false;
@@ -278,7 +286,8 @@ StatusOr<SpectraTable> ParseSpectraCsv(std::string_view text, std::string_view s
         std::string_view line = text.substr(pos, end - pos);
         pos = end + 1;
         ++line_number;
-        if (size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+        if (size_t hash = line.find('#'); hash != std::string_view::npos)
+            line = line.substr(0, hash);
         line = Trim(line);
         if (line.empty()) continue;
         std::vector<std::string_view> fields = SplitFields(line);
@@ -307,12 +316,11 @@ StatusOr<SpectraTable> ParseSpectraCsv(std::string_view text, std::string_view s
             return InvalidArgumentError("{}:{}: expected {} columns, found {}", source_name,
                                         line_number, num_columns + 1, fields.size());
         if (!table.lambda_nm.empty() && !(lambda > table.lambda_nm.back()))
-            return InvalidArgumentError(
-                "{}:{}: wavelengths must increase, found {} nm after {} nm", source_name,
-                line_number, lambda, table.lambda_nm.back());
+            return InvalidArgumentError("{}:{}: wavelengths must increase, found {} nm after {} nm",
+                                        source_name, line_number, lambda, table.lambda_nm.back());
         if (lambda <= 0)
-            return InvalidArgumentError("{}:{}: wavelength must be positive, found {}",
-                                        source_name, line_number, lambda);
+            return InvalidArgumentError("{}:{}: wavelength must be positive, found {}", source_name,
+                                        line_number, lambda);
         if (table.columns.empty()) table.columns.resize(num_columns);
         table.lambda_nm.push_back(lambda);
         for (size_t c = 0; c < num_columns; ++c) {
@@ -325,7 +333,8 @@ StatusOr<SpectraTable> ParseSpectraCsv(std::string_view text, std::string_view s
         seen_data = true;
     }
     if (table.lambda_nm.empty())
-        return InvalidArgumentError("{}: no spectral data rows (wavelength_nm,value,...)", source_name);
+        return InvalidArgumentError("{}: no spectral data rows (wavelength_nm,value,...)",
+                                    source_name);
     if (table.names.empty())
         for (size_t c = 0; c < num_columns; ++c) table.names.push_back(std::to_string(c + 1));
     return table;

@@ -1,7 +1,7 @@
 #pragma once
 // Spectra for nave's spectral rendering: a few wavelengths carried by each path (SampledSpectrum,
-// SampledWavelengths) and densely tabulated spectra (Spectrum) for illuminants, reflectances, optical
-// constants. All wavelengths are in nanometres (vacuum).
+// SampledWavelengths) and densely tabulated spectra (Spectrum) for illuminants, reflectances,
+// optical constants. All wavelengths are in nanometres (vacuum).
 
 #include <algorithm>
 #include <array>
@@ -63,10 +63,18 @@ class SampledSpectrum {
         for (float& v : values_) v += a;
         return *this;
     }
-    SampledSpectrum operator+(const SampledSpectrum& s) const { return SampledSpectrum(*this) += s; }
-    SampledSpectrum operator-(const SampledSpectrum& s) const { return SampledSpectrum(*this) -= s; }
-    SampledSpectrum operator*(const SampledSpectrum& s) const { return SampledSpectrum(*this) *= s; }
-    SampledSpectrum operator/(const SampledSpectrum& s) const { return SampledSpectrum(*this) /= s; }
+    SampledSpectrum operator+(const SampledSpectrum& s) const {
+        return SampledSpectrum(*this) += s;
+    }
+    SampledSpectrum operator-(const SampledSpectrum& s) const {
+        return SampledSpectrum(*this) -= s;
+    }
+    SampledSpectrum operator*(const SampledSpectrum& s) const {
+        return SampledSpectrum(*this) *= s;
+    }
+    SampledSpectrum operator/(const SampledSpectrum& s) const {
+        return SampledSpectrum(*this) /= s;
+    }
     SampledSpectrum operator*(float a) const { return SampledSpectrum(*this) *= a; }
     SampledSpectrum operator/(float a) const { return SampledSpectrum(*this) /= a; }
     SampledSpectrum operator+(float a) const { return SampledSpectrum(*this) += a; }
@@ -160,9 +168,9 @@ class SampledWavelengths {
     std::array<float, kNumWavelengths> pdf_{};
 };
 
-/// A spectrum tabulated at every nanometre from kLambdaMinNm to kLambdaMaxNm (471 values), evaluated
-/// by linear interpolation; 0 outside the range. A value type (about 2 KB); build once per scene
-/// object and sample per path with Sample().
+/// A spectrum tabulated at every nanometre from kLambdaMinNm to kLambdaMaxNm (471 values),
+/// evaluated by linear interpolation; 0 outside the range. A value type (about 2 KB); build once
+/// per scene object and sample per path with Sample().
 class Spectrum {
   public:
     static constexpr int kNumSamples = int(kLambdaMaxNm - kLambdaMinNm) + 1;
@@ -227,7 +235,8 @@ class Spectrum {
 /// Planck's law: spectral radiance of a black body in W·sr⁻¹·m⁻²·nm⁻¹ (CODATA 2018 constants).
 double PlanckRadiance(double lambda_nm, double t_kelvin);
 
-/// A table of spectra read from CSV text: one wavelength column (nm) then one or more value columns.
+/// A table of spectra read from CSV text: one wavelength column (nm) then one or more value
+/// columns.
 struct SpectraTable {
     /// Names of the value columns (from the header row, else "1", "2", ...).
     std::vector<std::string> names;

@@ -116,7 +116,7 @@ class Engine {
     /// A straight pass through thin glass: the path continues in the same direction, and this is not a
     /// scattering event (depth, MIS state unchanged), as for shadow rays.
     static bool IsPassThrough(const SurfaceMaterial& m, const BsdfSample& bs) {
-        return m.kind == MaterialConfig::Kind::kThinDielectric && bs.IsTransmission();
+        return m.thin_glass() != nullptr && bs.IsTransmission();
     }
     void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
     SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
@@ -133,7 +133,7 @@ class Engine {
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
     bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
-        return m.kind == MaterialConfig::Kind::kThinDielectric;
+        return m.thin_glass() != nullptr;
     });
     std::unique_ptr<VisiblePoints> visible_;  // photon mode
 
@@ -172,7 +172,7 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
     uint32_t mat = m.material_ids[hit.triangle];
     static const SurfaceMaterial kBlack = [] {
         SurfaceMaterial s;
-        s.kind = MaterialConfig::Kind::kBlack;
+        s.black = true;
         return s;
     }();
     h.material = mat < scene_.materials.size() ? &scene_.materials[mat] : &kBlack;
@@ -212,9 +212,10 @@ bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float 
         if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
         SurfaceHit h = MakeSurfaceHit(brick, hit);
         const SurfaceMaterial& m = *h.material;
-        if (m.kind != MaterialConfig::Kind::kThinDielectric) return false;
+        const ThinGlassMaterial* glass = m.thin_glass();
+        if (glass == nullptr) return false;
         SampledSpectrum reflected, transmitted;
-        ThinDielectricBxdf(m.eta.Sample(r.lambda), m.transmittance.Sample(r.lambda))
+        ThinDielectricBxdf(glass->eta.Sample(r.lambda), glass->internal_transmittance.Sample(r.lambda))
             .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
         r.beta *= transmitted;
         if (r.beta.IsZero()) return false;

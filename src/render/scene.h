@@ -14,25 +14,32 @@
 #include "render/brick_source.h"
 #include "render/camera.h"
 #include "render/materials/bxdf.h"
+#include "render/materials/materials.h"
 #include "render/scene_config.h"
 
 namespace nave::render {
 
-/// A spectral material as the integrators use it. Builds a Bsdf per hit for the path's wavelengths.
+/// A spectral material as the integrators use it: the physics engineer's Material (render/materials/
+/// materials.h) plus what the scene adds: emission, the portal flag, and black (absorbs everything).
 struct SurfaceMaterial {
-    MaterialConfig::Kind kind = MaterialConfig::Kind::kDiffuse;
     std::string name;
-    Spectrum reflectance, eta, k, transmittance;
-    float roughness = 0;
+    Material material;           ///< physics: diffuse, conductor, dielectric, thin glass
+    bool black = false;          ///< no scattering at all
     bool emissive = false;
     Spectrum emission;           ///< radiance, W m^-2 sr^-1 nm^-1, both sides
-    bool portal = false;         ///< photons are aimed at it
-    bool dispersive = false;     ///< eta varies with wavelength: refraction keeps the hero wavelength only
+    bool portal = false;         ///< photons are aimed at it (render.photon_target = "portals")
 
     /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the secondary
     /// wavelengths of `lambda`.
-    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const;
-    /// Diffuse albedo at 550 nm, for the albedo AOV.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
+        if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
+        return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
+    }
+    /// The window pane, if this is thin glass (rays cross it without bending).
+    const ThinGlassMaterial* thin_glass() const {
+        return black ? nullptr : std::get_if<ThinGlassMaterial>(&material);
+    }
+    /// Diffuse albedo at 550 nm for the albedo AOV (1 for specular materials, 0 for black).
     float AlbedoForAov() const;
 };
 

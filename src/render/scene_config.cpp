@@ -374,6 +374,16 @@ Status ParseLight(TableReader& r, LightConfig* l) {
 
 Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     m->where = r.WhereTable();
+    if (r.Has("builtin")) {
+        // A named material of nave's physics library (limestone, glass_blue, gold, bk7...).
+        if (r.Has("type")) {
+            return InvalidArgumentError("{}: {}: give either 'builtin' or 'type', not both", m->where, r.Name(""));
+        }
+        NAVE_RETURN_IF_ERROR(r.String("builtin", &m->builtin));
+        NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
+        NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
+        return r.Finish();
+    }
     std::string type = "diffuse";
     const toml::node* tn = r.Take("type");
     if (tn != nullptr) {
@@ -393,8 +403,15 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     } else if (type == "dielectric" || type == "thin_dielectric") {
         m->kind = type == "dielectric" ? MaterialConfig::Kind::kDielectric : MaterialConfig::Kind::kThinDielectric;
         NAVE_RETURN_IF_ERROR(r.Spectrum("eta", &m->eta));
-        NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
+        if (m->kind == MaterialConfig::Kind::kThinDielectric) {
+            if (r.Has("transmittance") && r.Has("total_transmittance")) {
+                return InvalidArgumentError("{}: {}: give either transmittance (internal) or total_transmittance",
+                                            m->where, r.Name(""));
+            }
+            NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
+            NAVE_ASSIGN_OR_RETURN(m->total_transmittance, r.OptionalSpectrum("total_transmittance"));
+        }
     } else if (type == "black") {
         m->kind = MaterialConfig::Kind::kBlack;
     } else {

@@ -20,9 +20,8 @@ TEST(ColorTest, CieYIntegral) {
 
 // IEC 61966-2-1:1999 (amendment 1, 2003) eq. (F.8): the XYZ -> linear sRGB matrix to 4 decimals.
 TEST(ColorTest, SrgbMatrixFromPrimaries) {
-    const double expected[3][3] = {{3.2406, -1.5372, -0.4986},
-                                   {-0.9689, 1.8758, 0.0415},
-                                   {0.0557, -0.2040, 1.0570}};
+    const double expected[3][3] = {
+        {3.2406, -1.5372, -0.4986}, {-0.9689, 1.8758, 0.0415}, {0.0557, -0.2040, 1.0570}};
     const Mat3d& m = RgbColorSpace::Srgb().xyz_to_rgb();
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) EXPECT_NEAR(m(i, j), expected[i][j], 1e-3) << i << "," << j;
@@ -96,8 +95,36 @@ TEST(ColorTest, McCamyCct) {
     EXPECT_NEAR(CctMcCamy(IlluminantChromaticity(Spectrum::Blackbody(4000.0))), 4000.0, 15.0);
 }
 
-// Lindbloom's Bradford D65 -> D50 matrix (brucelindbloom.com, "Chromatic Adaptation"), computed with
-// whites (0.95047, 1, 1.08883) and (0.96422, 1, 0.82521); our whites come from xy, hence 2e-3.
+// Robertson (1968) with the Wyszecki & Stiles isotemperature lines: black bodies give back their
+// own temperature (0.2 %), illuminant A 2856 K, D65 6504 K; and the table's (u, v) lie on the
+// Planckian locus computed from nave's CMFs (a check of both tables).
+TEST(ColorTest, RobertsonCct) {
+    for (double t : {2000.0, 2856.0, 4000.0, 5000.0, 6500.0, 9000.0, 15000.0})
+        EXPECT_NEAR(CctRobertson(IlluminantChromaticity(Spectrum::Blackbody(t))) / t, 1.0, 2e-3)
+            << t;
+    EXPECT_NEAR(CctRobertson(IlluminantChromaticity(IlluminantA())), 2856.0, 4.0);
+    EXPECT_NEAR(CctRobertson(IlluminantChromaticity(IlluminantD65())), 6504.0, 10.0);
+    for (double mired : {100.0, 200.0, 300.0, 400.0, 500.0}) {
+        Chromaticity c = IlluminantChromaticity(Spectrum::Blackbody(1e6 / mired));
+        double den = -2 * c.x + 12 * c.y + 3;
+        double u = 4 * c.x / den, v = 6 * c.y / den;
+        double tu = mired == 100   ? 0.19032
+                    : mired == 200 ? 0.21142
+                    : mired == 300 ? 0.24010
+                    : mired == 400 ? 0.27218
+                                   : 0.30505;
+        double tv = mired == 100   ? 0.29326
+                    : mired == 200 ? 0.32312
+                    : mired == 300 ? 0.34308
+                    : mired == 400 ? 0.35407
+                                   : 0.35907;
+        EXPECT_NEAR(u, tu, 3e-4) << mired;
+        EXPECT_NEAR(v, tv, 3e-4) << mired;
+    }
+}
+
+// Lindbloom's Bradford D65 -> D50 matrix (brucelindbloom.com, "Chromatic Adaptation"), computed
+// with whites (0.95047, 1, 1.08883) and (0.96422, 1, 0.82521); our whites come from xy, hence 2e-3.
 TEST(ColorTest, BradfordD65ToD50) {
     Mat3d m = ChromaticAdaptationMatrix({0.3127, 0.3290}, {0.3457, 0.3585});
     const double expected[3][3] = {{1.0478112, 0.0228866, -0.0501270},
@@ -106,8 +133,8 @@ TEST(ColorTest, BradfordD65ToD50) {
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) EXPECT_NEAR(m(i, j), expected[i][j], 2e-3) << i << "," << j;
     // The source white maps exactly onto the destination white, for every method.
-    for (AdaptationMethod method :
-         {AdaptationMethod::kBradford, AdaptationMethod::kVonKries, AdaptationMethod::kXyzScaling}) {
+    for (AdaptationMethod method : {AdaptationMethod::kBradford, AdaptationMethod::kVonKries,
+                                    AdaptationMethod::kXyzScaling}) {
         Mat3d a = ChromaticAdaptationMatrix({0.4476, 0.4074}, {0.3127, 0.3290}, method);
         Vec3d w = a * ChromaticityToXYZ({0.4476, 0.4074});
         Vec3d d = ChromaticityToXYZ({0.3127, 0.3290});

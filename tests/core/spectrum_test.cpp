@@ -81,7 +81,8 @@ TEST(SampledWavelengthsTest, StratifiedRotationsAndPdf) {
     EXPECT_FLOAT_EQ(uni.Pdf()[2], 1.f / 300.f);
 }
 
-// The film's estimator of ∫ȳ·D65 / ∫ȳ with importance-sampled wavelengths converges to the exact sum.
+// The film's estimator of ∫ȳ·D65 / ∫ȳ with importance-sampled wavelengths converges to the exact
+// sum.
 TEST(SampledWavelengthsTest, EstimatorOfYOfD65Converges) {
     const Spectrum& d65 = IlluminantD65();
     double exact = SpectrumToXYZ(d65).y;
@@ -137,7 +138,8 @@ TEST(SpectrumTest, DaylightSeriesMatchesD65Table) {
 
 TEST(SpectraCsvTest, ParsesHeaderCommentsAndColumns) {
     StatusOr<SpectraTable> t = ParseSpectraCsv(
-        "# measured\nwavelength_nm, red ,blue\n400,0.1,0.9  # comment\n\n500;0.2;0.8\n600\t0.3\t0.7\n",
+        "# measured\nwavelength_nm, red ,blue\n400,0.1,0.9  # "
+        "comment\n\n500;0.2;0.8\n600\t0.3\t0.7\n",
         "x.csv");
     ASSERT_TRUE(t.ok()) << t.status().ToString();
     ASSERT_EQ(t->names.size(), 2u);
@@ -150,6 +152,17 @@ TEST(SpectraCsvTest, ParsesHeaderCommentsAndColumns) {
     EXPECT_EQ(t->ToSpectrum("green").status().code(), StatusCode::kNotFound);
 }
 
+TEST(SpectraCsvTest, ByteOrderMarkAndCrLf) {
+    StatusOr<SpectraTable> t = ParseSpectraCsv(
+        "\xEF\xBB\xBF"
+        "400,0.1\r\n500,0.2\r\n",
+        "excel.csv");
+    ASSERT_TRUE(t.ok()) << t.status().ToString();
+    EXPECT_EQ(t->lambda_nm.size(), 2u);
+    EXPECT_DOUBLE_EQ(t->columns[0][1], 0.2);
+    EXPECT_FALSE(ParseSpectraCsv("400,nan\n", "n.csv").ok());
+}
+
 TEST(SpectraCsvTest, ErrorsNameFileAndLine) {
     auto msg = [](std::string_view text) {
         StatusOr<SpectraTable> t = ParseSpectraCsv(text, "bad.csv");
@@ -158,10 +171,12 @@ TEST(SpectraCsvTest, ErrorsNameFileAndLine) {
     };
     EXPECT_EQ(msg("400,1\n500,1,2\n"), "bad.csv:2: expected 2 columns, found 3");
     EXPECT_EQ(msg("400,1\n500,x\n"), "bad.csv:2: column 2: expected a number, found 'x'");
-    EXPECT_EQ(msg("500,1\n400,1\n"), "bad.csv:2: wavelengths must increase, found 400 nm after 500 nm");
+    EXPECT_EQ(msg("500,1\n400,1\n"),
+              "bad.csv:2: wavelengths must increase, found 400 nm after 500 nm");
     EXPECT_EQ(msg("# nothing\n"), "bad.csv: no spectral data rows (wavelength_nm,value,...)");
     EXPECT_EQ(msg("nm,v\n400,1\nfoo,2\n"), "bad.csv:3: expected a wavelength in nm, found 'foo'");
-    EXPECT_EQ(msg("400\n"), "bad.csv:1: expected a wavelength and at least one value, found 1 column");
+    EXPECT_EQ(msg("400\n"),
+              "bad.csv:1: expected a wavelength and at least one value, found 1 column");
 }
 
 TEST(SpectraCsvTest, LoadFromFileAndMissingFile) {

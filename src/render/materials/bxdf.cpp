@@ -44,7 +44,8 @@ float FrDielectric(float cos_theta_i, float eta) {
 
 float FrComplex(float cos_theta_i, float eta, float k) {
     // Born & Wolf §14.2: the dielectric Fresnel equations hold with the complex index η̂ = η + iκ;
-    // cosθt = sqrt(1 - sin²θi / η̂²) is complex. Double precision: |r|² of good conductors is close to 1.
+    // cosθt = sqrt(1 - sin²θi / η̂²) is complex. Double precision: |r|² of good conductors is close
+    // to 1.
     using C = std::complex<double>;
     double cos_i = std::clamp(double(cos_theta_i), 0.0, 1.0);
     C e(eta, k);
@@ -62,7 +63,8 @@ SampledSpectrum FrComplex(float cos_theta_i, const SampledSpectrum& eta, const S
     return r;
 }
 
-// ---- Trowbridge-Reitz -------------------------------------------------------------------------------
+// ---- Trowbridge-Reitz
+// -------------------------------------------------------------------------------
 
 float TrowbridgeReitz::D(const Vec3f& wm) const {
     float tan2 = Tan2Theta(wm);
@@ -113,7 +115,8 @@ Vec3f TrowbridgeReitz::Sample_wm(const Vec3f& w, Point2f u) const {
     return Normalize(ne);
 }
 
-// ---- Diffuse ----------------------------------------------------------------------------------------
+// ---- Diffuse
+// ----------------------------------------------------------------------------------------
 
 SampledSpectrum DiffuseBxdf::Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
                                   TransportMode) const {
@@ -137,7 +140,8 @@ float DiffuseBxdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelength
     return CosineHemispherePdf(AbsCosTheta(wi));
 }
 
-// ---- Conductor --------------------------------------------------------------------------------------
+// ---- Conductor
+// --------------------------------------------------------------------------------------
 
 SampledSpectrum ConductorBxdf::Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
                                     TransportMode) const {
@@ -162,7 +166,8 @@ std::optional<BsdfSample> ConductorBxdf::Sample(const Vec3f& wo, float, Point2f 
         return BsdfSample{f, wi, 1.f, kBxdfReflection | kBxdfSpecular, 1.f};
     }
     if (wo.z == 0.f) return std::nullopt;
-    // Sample in the upper hemisphere and mirror back, so a path arriving from below sees the same lobe.
+    // Sample in the upper hemisphere and mirror back, so a path arriving from below sees the same
+    // lobe.
     Vec3f wo_up = wo.z < 0.f ? -wo : wo;
     Vec3f wm = distrib_.Sample_wm(wo_up, u);
     Vec3f wi = Reflect(wo_up, wm);
@@ -189,40 +194,110 @@ float ConductorBxdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWaveleng
     return distrib_.Pdf(wo_up, wm) / (4.f * std::abs(Dot(wo_up, wm)));
 }
 
-// ---- Smooth dielectric ------------------------------------------------------------------------------
+// ---- Dielectric
+// -------------------------------------------------------------------------------------
 
-SampledSpectrum DielectricBxdf::Eval(const Vec3f&, const Vec3f&, const SampledWavelengths&,
-                                     TransportMode) const {
-    return {};  // only delta lobes
+bool DielectricBxdf::HalfVector(const Vec3f& wo, const Vec3f& wi, Vec3f* wm, float* etap,
+                                bool* reflect) const {
+    float cos_o = CosTheta(wo), cos_i = CosTheta(wi);
+    if (cos_o == 0.f || cos_i == 0.f) return false;
+    *reflect = cos_o * cos_i > 0.f;
+    *etap = *reflect ? 1.f : (cos_o > 0.f ? eta_ : 1.f / eta_);
+    // Walter et al. 2007 eq. (16): the generalized half vector h ∝ -(η_i ωi + η_o ωo), here scaled
+    // so that it is ωi η' + ωo.
+    Vec3f h = wi * *etap + wo;
+    if (Dot(h, h) == 0.f) return false;
+    h = Normalize(h);
+    if (h.z < 0.f) h = -h;
+    // Microfacets seen from behind by either direction carry no light.
+    if (Dot(h, wi) * cos_i < 0.f || Dot(h, wo) * cos_o < 0.f) return false;
+    *wm = h;
+    return true;
 }
 
-float DielectricBxdf::Pdf(const Vec3f&, const Vec3f&, const SampledWavelengths&,
+SampledSpectrum DielectricBxdf::Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
+                                     TransportMode mode) const {
+    if (eta_ == 1.f || distrib_.EffectivelySmooth()) return {};  // only delta lobes
+    Vec3f wm;
+    float etap;
+    bool reflect;
+    if (!HalfVector(wo, wi, &wm, &etap, &reflect)) return {};
+    float f = FrDielectric(Dot(wo, wm), eta_);
+    float cos_o = CosTheta(wo), cos_i = CosTheta(wi);
+    if (reflect)
+        return SampledSpectrum(distrib_.D(wm) * distrib_.G(wo, wi) * f /
+                               std::abs(4.f * cos_i * cos_o));
+    // Walter et al. 2007 eq. (21).
+    float denom = Dot(wi, wm) + Dot(wo, wm) / etap;
+    denom = denom * denom * cos_i * cos_o;
+    float ft = distrib_.D(wm) * (1.f - f) * distrib_.G(wo, wi) *
+               std::abs(Dot(wi, wm) * Dot(wo, wm) / denom);
+    if (mode == TransportMode::kRadiance) ft /= etap * etap;
+    return SampledSpectrum(ft);
+}
+
+float DielectricBxdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
                           TransportMode) const {
-    return 0.f;
+    if (eta_ == 1.f || distrib_.EffectivelySmooth()) return 0.f;
+    Vec3f wm;
+    float etap;
+    bool reflect;
+    if (!HalfVector(wo, wi, &wm, &etap, &reflect)) return 0.f;
+    float r = FrDielectric(Dot(wo, wm), eta_), t = 1.f - r;
+    if (reflect) return distrib_.Pdf(wo, wm) / (4.f * std::abs(Dot(wo, wm))) * r / (r + t);
+    // Jacobian of the refracted half vector, Walter et al. 2007 eq. (17).
+    float denom = Dot(wi, wm) + Dot(wo, wm) / etap;
+    float dwm_dwi = std::abs(Dot(wi, wm)) / (denom * denom);
+    return distrib_.Pdf(wo, wm) * dwm_dwi * t / (r + t);
 }
 
-std::optional<BsdfSample> DielectricBxdf::Sample(const Vec3f& wo, float uc, Point2f,
-                                                 const SampledWavelengths&,
+std::optional<BsdfSample> DielectricBxdf::Sample(const Vec3f& wo, float uc, Point2f u,
+                                                 const SampledWavelengths& lambda,
                                                  TransportMode mode) const {
-    float r = FrDielectric(CosTheta(wo), eta_);
-    float t = 1.f - r;
-    // Choose the lobe in proportion to its weight: the estimator f|cos|/pdf is then exactly 1 (or
-    // 1/η² for radiance through refraction), which keeps R + T = 1 without variance.
+    if (eta_ == 1.f || distrib_.EffectivelySmooth()) {
+        float r = FrDielectric(CosTheta(wo), eta_);
+        float t = 1.f - r;
+        // Choose the lobe in proportion to its weight: the estimator f|cos|/pdf is then exactly 1
+        // (or 1/η² for radiance through refraction), which keeps R + T = 1 without variance.
+        if (uc < r / (r + t)) {
+            Vec3f wi(-wo.x, -wo.y, wo.z);
+            SampledSpectrum f(r / AbsCosTheta(wi));
+            return BsdfSample{f, wi, r / (r + t), kBxdfReflection | kBxdfSpecular, 1.f};
+        }
+        Vec3f wi;
+        float etap = 1.f;
+        if (!Refract(wo, Vec3f(0, 0, 1), eta_, &etap, &wi)) return std::nullopt;
+        SampledSpectrum f(t / AbsCosTheta(wi));
+        // Radiance is compressed into a smaller solid angle on entering a denser medium (Veach 1997
+        // §5.2).
+        if (mode == TransportMode::kRadiance) f /= etap * etap;
+        return BsdfSample{f, wi, t / (r + t), kBxdfTransmission | kBxdfSpecular, etap};
+    }
+    // Rough: sample a visible microfacet normal, then reflect or refract through it.
+    if (wo.z == 0.f) return std::nullopt;
+    Vec3f wm = distrib_.Sample_wm(wo, u);
+    float r = FrDielectric(Dot(wo, wm), eta_), t = 1.f - r;
     if (uc < r / (r + t)) {
-        Vec3f wi(-wo.x, -wo.y, wo.z);
-        SampledSpectrum f(r / AbsCosTheta(wi));
-        return BsdfSample{f, wi, r / (r + t), kBxdfReflection | kBxdfSpecular, 1.f};
+        Vec3f wi = Reflect(wo, wm);
+        if (!SameHemisphere(wo, wi)) return std::nullopt;
+        float pdf = distrib_.Pdf(wo, wm) / (4.f * std::abs(Dot(wo, wm))) * r / (r + t);
+        SampledSpectrum f = Eval(wo, wi, lambda, mode);
+        if (pdf == 0.f) return std::nullopt;
+        return BsdfSample{f, wi, pdf, kBxdfReflection | kBxdfGlossy, 1.f};
     }
     Vec3f wi;
     float etap = 1.f;
-    if (!Refract(wo, Vec3f(0, 0, 1), eta_, &etap, &wi)) return std::nullopt;
-    SampledSpectrum f(t / AbsCosTheta(wi));
-    // Radiance is compressed into a smaller solid angle on entering a denser medium (Veach 1997 §5.2).
-    if (mode == TransportMode::kRadiance) f /= etap * etap;
-    return BsdfSample{f, wi, t / (r + t), kBxdfTransmission | kBxdfSpecular, etap};
+    if (!Refract(wo, wm, eta_, &etap, &wi) || SameHemisphere(wo, wi) || wi.z == 0.f)
+        return std::nullopt;
+    wi = Normalize(wi);
+    float pdf = Pdf(wo, wi, lambda, mode);
+    SampledSpectrum f = Eval(wo, wi, lambda, mode);
+    if (pdf == 0.f) return std::nullopt;
+    return BsdfSample{f, wi, pdf, kBxdfTransmission | kBxdfGlossy, etap};
 }
 
-// ---- Thin dielectric --------------------------------------------------------------------------------
+// ---- Thin dielectric
+// --------------------------------------------------------------------------------
 
 void ThinDielectricBxdf::ReflectanceTransmittance(float cos_theta, SampledSpectrum* r_tot,
                                                   SampledSpectrum* t_tot) const {
@@ -266,8 +341,8 @@ std::optional<BsdfSample> ThinDielectricBxdf::Sample(const Vec3f& wo, float uc, 
     if (pr + pt == 0.f) return std::nullopt;
     if (uc < pr / (pr + pt)) {
         Vec3f wi(-wo.x, -wo.y, wo.z);
-        return BsdfSample{r / AbsCosTheta(wi), wi, pr / (pr + pt),
-                          kBxdfReflection | kBxdfSpecular, 1.f};
+        return BsdfSample{r / AbsCosTheta(wi), wi, pr / (pr + pt), kBxdfReflection | kBxdfSpecular,
+                          1.f};
     }
     // Both interfaces are parallel: the ray leaves in its own direction, with no net 1/η² scaling.
     Vec3f wi = -wo;

@@ -1,12 +1,12 @@
 #pragma once
-// BxDFs: the scattering functions nave builds at each hit, as small value types (no heap), evaluated in
-// a local frame where the shading normal is +z. Materials (materials.h) own the spectra and build a Bxdf
-// per hit for the path's wavelengths; Bsdf adds the world <-> local frame.
+// BxDFs: the scattering functions nave builds at each hit, as small value types (no heap),
+// evaluated in a local frame where the shading normal is +z. Materials (materials.h) own the
+// spectra and build a Bxdf per hit for the path's wavelengths; Bsdf adds the world <-> local frame.
 //
 // Conventions (as pbrt-v4): wo and wi point away from the surface, both unit length. Eval returns
-// f(wo, wi) without the cosine factor. Sample returns f, wi and the pdf of wi (for specular lobes the
-// probability of choosing the lobe, and f includes the delta's 1/|cosθi|), so that f |cosθi| / pdf is
-// the path weight in every case. Pdf and Eval of specular lobes are 0.
+// f(wo, wi) without the cosine factor. Sample returns f, wi and the pdf of wi (for specular lobes
+// the probability of choosing the lobe, and f includes the delta's 1/|cosθi|), so that f |cosθi| /
+// pdf is the path weight in every case. Pdf and Eval of specular lobes are 0.
 
 #include <algorithm>
 #include <cmath>
@@ -56,7 +56,8 @@ struct BsdfSample {
     bool IsGlossy() const { return flags & kBxdfGlossy; }
 };
 
-// ---- Local-frame trigonometry (normal = +z) ---------------------------------------------------------
+// ---- Local-frame trigonometry (normal = +z)
+// ---------------------------------------------------------
 
 inline float CosTheta(const Vec3f& w) { return w.z; }
 inline float AbsCosTheta(const Vec3f& w) { return std::abs(w.z); }
@@ -79,7 +80,8 @@ inline Vec3f Reflect(const Vec3f& wo, const Vec3f& n) { return -wo + n * (2.f * 
 /// Returns false on total internal reflection. *etap receives the relative index actually crossed.
 bool Refract(const Vec3f& wi, Vec3f n, float eta, float* etap, Vec3f* wt);
 
-// ---- Fresnel ----------------------------------------------------------------------------------------
+// ---- Fresnel
+// ----------------------------------------------------------------------------------------
 
 /// Unpolarised Fresnel reflectance of a dielectric interface for relative index eta = η_t/η_i and
 /// cosθi (negative: the ray arrives from the η_t side, and eta is inverted). 1 under total internal
@@ -96,7 +98,8 @@ FresnelPolarized FrDielectricPolarized(float cos_theta_i, float eta);
 float FrComplex(float cos_theta_i, float eta, float k);
 SampledSpectrum FrComplex(float cos_theta_i, const SampledSpectrum& eta, const SampledSpectrum& k);
 
-// ---- Microfacets ------------------------------------------------------------------------------------
+// ---- Microfacets
+// ------------------------------------------------------------------------------------
 
 /// Perceptual roughness in [0, 1] -> GGX α = roughness² (Burley 2012, "Physically-based shading at
 /// Disney", §5.4).
@@ -105,13 +108,15 @@ inline float RoughnessToAlpha(float roughness) { return roughness * roughness; }
 /// The anisotropic Trowbridge-Reitz (GGX) distribution of microfacet normals (Trowbridge & Reitz
 /// 1975; Walter et al. 2007), with Smith's height-correlated masking-shadowing (Heitz 2014,
 /// "Understanding the masking-shadowing function in microfacet-based BRDFs", JCGT 3(2)) and
-/// visible-normal sampling (Heitz 2018, "Sampling the GGX distribution of visible normals", JCGT 7(4)).
+/// visible-normal sampling (Heitz 2018, "Sampling the GGX distribution of visible normals", JCGT
+/// 7(4)).
 class TrowbridgeReitz {
   public:
     TrowbridgeReitz() = default;
     TrowbridgeReitz(float alpha_x, float alpha_y) : alpha_x_(alpha_x), alpha_y_(alpha_y) {}
 
-    /// Below this α the surface is treated as a perfect mirror (a delta lobe) to avoid precision loss.
+    /// Below this α the surface is treated as a perfect mirror (a delta lobe) to avoid precision
+    /// loss.
     bool EffectivelySmooth() const { return std::max(alpha_x_, alpha_y_) < 1e-3f; }
     /// D(ωm): the density of normals per unit projected area (Heitz 2014 eq. 83 anisotropic form).
     float D(const Vec3f& wm) const;
@@ -119,7 +124,9 @@ class TrowbridgeReitz {
     float Lambda(const Vec3f& w) const;
     float G1(const Vec3f& w) const { return 1.f / (1.f + Lambda(w)); }
     /// Height-correlated masking-shadowing G2 (Heitz 2014 eq. 99).
-    float G(const Vec3f& wo, const Vec3f& wi) const { return 1.f / (1.f + Lambda(wo) + Lambda(wi)); }
+    float G(const Vec3f& wo, const Vec3f& wi) const {
+        return 1.f / (1.f + Lambda(wo) + Lambda(wi));
+    }
     /// The distribution of visible normals D_ω(ωm) = G1(ω) max(0, ω·ωm) D(ωm) / cosθ (Heitz 2018
     /// eq. 1); the pdf of Sample_wm.
     float D(const Vec3f& w, const Vec3f& wm) const;
@@ -134,7 +141,8 @@ class TrowbridgeReitz {
     float alpha_x_ = 0, alpha_y_ = 0;
 };
 
-// ---- BxDFs ------------------------------------------------------------------------------------------
+// ---- BxDFs
+// ------------------------------------------------------------------------------------------
 
 /// Lambertian reflection with spectral albedo R: f = R/π, cosine-weighted sampling.
 class DiffuseBxdf {
@@ -155,10 +163,10 @@ class DiffuseBxdf {
     SampledSpectrum r_;
 };
 
-/// A metal: complex index η + iκ per wavelength with the exact conductor Fresnel equations; a perfect
-/// mirror when the distribution is effectively smooth, else a Trowbridge-Reitz microfacet BRDF
-/// f = D(ωm) F(ωo·ωm) G(ωo, ωi) / (4 cosθo cosθi) (Walter et al. 2007 eq. 20) sampled with visible
-/// normals.
+/// A metal: complex index η + iκ per wavelength with the exact conductor Fresnel equations; a
+/// perfect mirror when the distribution is effectively smooth, else a Trowbridge-Reitz microfacet
+/// BRDF f = D(ωm) F(ωo·ωm) G(ωo, ωi) / (4 cosθo cosθi) (Walter et al. 2007 eq. 20) sampled with
+/// visible normals.
 class ConductorBxdf {
   public:
     ConductorBxdf() = default;
@@ -182,15 +190,20 @@ class ConductorBxdf {
     SampledSpectrum eta_, k_;
 };
 
-/// A smooth interface between dielectrics of relative index eta (inside over outside; the normal points
-/// outside). Fresnel reflection and refraction, chosen in proportion to R and T = 1 - R, so that
-/// R + T = 1 exactly. Dispersion: the material passes the index at the hero wavelength and terminates
-/// the secondary wavelengths (see DielectricMaterial). Absorption inside (Beer-Lambert) is a property
-/// of the volume the refracted path crosses, not of the interface: see DielectricMaterial.
+/// An interface between dielectrics of relative index eta (inside over outside; the normal points
+/// outside). Smooth (a delta lobe pair) when the distribution is effectively smooth: Fresnel
+/// reflection and refraction chosen in proportion to R and T = 1 - R, so that R + T = 1 exactly.
+/// Rough otherwise: the Trowbridge-Reitz microfacet BTDF of Walter, Marschner, Li & Torrance 2007
+/// ("Microfacet models for refraction through rough surfaces", eqs. 20-21) with visible-normal
+/// sampling (Heitz 2018), e.g. for uneven medieval glass. Dispersion: the material passes the index
+/// at the hero wavelength and terminates the secondary wavelengths (see DielectricMaterial).
+/// Absorption inside (Beer-Lambert) is a property of the volume the refracted path crosses, not of
+/// the interface: see DielectricMaterial.
 class DielectricBxdf {
   public:
     DielectricBxdf() = default;
-    explicit DielectricBxdf(float eta) : eta_(eta) {}
+    explicit DielectricBxdf(float eta, const TrowbridgeReitz& distrib = TrowbridgeReitz())
+        : eta_(eta), distrib_(distrib) {}
 
     SampledSpectrum Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda,
                          TransportMode mode = TransportMode::kRadiance) const;
@@ -200,21 +213,29 @@ class DielectricBxdf {
     float Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda,
               TransportMode mode = TransportMode::kRadiance) const;
     uint8_t Flags() const {
-        return eta_ == 1.f ? kBxdfTransmission | kBxdfSpecular
-                           : kBxdfReflection | kBxdfTransmission | kBxdfSpecular;
+        uint8_t kind = distrib_.EffectivelySmooth() ? kBxdfSpecular : kBxdfGlossy;
+        return eta_ == 1.f ? kBxdfTransmission | kind : kBxdfReflection | kBxdfTransmission | kind;
     }
     float eta() const { return eta_; }
+    const TrowbridgeReitz& distribution() const { return distrib_; }
 
   private:
+    /// The generalized half vector of (wo, wi) facing +z, the relative index across and whether it
+    /// is a reflection; false if the pair has no valid microfacet.
+    bool HalfVector(const Vec3f& wo, const Vec3f& wi, Vec3f* wm, float* etap, bool* reflect) const;
+
     float eta_ = 1.5f;
+    TrowbridgeReitz distrib_;
 };
 
-/// A thin pane of glass (window): two parallel interfaces of index eta(λ) with an absorbing interior of
-/// internal transmittance tau(λ) at normal incidence (one pass). Light leaves either mirrored or straight
-/// through (the pane is thin: no lateral shift). The infinite series of internal reflections is summed
-/// in closed form (Stokes 1862; e.g. Hecht, Optics, 5th ed., §9.7; pbrt-v4 §9.5.2 without absorption):
+/// A thin pane of glass (window): two parallel interfaces of index eta(λ) with an absorbing
+/// interior of internal transmittance tau(λ) at normal incidence (one pass). Light leaves either
+/// mirrored or straight through (the pane is thin: no lateral shift). The infinite series of
+/// internal reflections is summed in closed form (Stokes 1862; e.g. Hecht, Optics, 5th ed., §9.7;
+/// pbrt-v4 §9.5.2 without absorption):
 ///   R_tot = R + T² R τ² / (1 - R² τ²),   T_tot = T² τ / (1 - R² τ²),
-/// with R = Fresnel at the angle of incidence, T = 1 - R and τ = tau^(1/cosθt) for the slanted path.
+/// with R = Fresnel at the angle of incidence, T = 1 - R and τ = tau^(1/cosθt) for the slanted
+/// path.
 class ThinDielectricBxdf {
   public:
     ThinDielectricBxdf() = default;

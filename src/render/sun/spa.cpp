@@ -32,7 +32,8 @@ int DaysInMonth(int year, int month) {
     static constexpr int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
     if (month != 2) return kDays[month - 1];
     // Gregorian leap rule from 1583 on, Julian before (every 4th year), matching JulianDay.
-    bool leap = year > 1582 ? (year % 4 == 0 && (year % 100 != 0 || year % 400 == 0)) : (year % 4 == 0);
+    bool leap =
+        year > 1582 ? (year % 4 == 0 && (year % 100 != 0 || year % 400 == 0)) : (year % 4 == 0);
     return leap ? 29 : 28;
 }
 
@@ -59,7 +60,8 @@ StatusOr<CivilTime> ParseIso8601(std::string_view text) {
         return bad("bad month or day");
     s.remove_prefix(5);
     if (t.month < 1 || t.month > 12) return bad("month out of range 1-12");
-    if (t.day < 1 || t.day > DaysInMonth(t.year, t.month)) return bad("day out of range for the month");
+    if (t.day < 1 || t.day > DaysInMonth(t.year, t.month))
+        return bad("day out of range for the month");
     if (t.year == 1582 && t.month == 10 && t.day > 4 && t.day < 15)
         return bad("1582-10-05..14 do not exist (Julian to Gregorian change)");
     if (s.empty() || (s[0] != 'T' && s[0] != 't' && s[0] != ' ')) return bad("no time of day");
@@ -72,7 +74,9 @@ StatusOr<CivilTime> ParseIso8601(std::string_view text) {
     if (!s.empty() && s[0] == ':') {
         s.remove_prefix(1);
         size_t end = 0;
-        while (end < s.size() && (std::isdigit(static_cast<unsigned char>(s[end])) || s[end] == '.')) ++end;
+        while (end < s.size() &&
+               (std::isdigit(static_cast<unsigned char>(s[end])) || s[end] == '.'))
+            ++end;
         auto [p, ec] = std::from_chars(s.data(), s.data() + end, t.second);
         if (ec != std::errc() || p != s.data() + end || end == 0) return bad("bad seconds");
         s.remove_prefix(end);
@@ -80,8 +84,9 @@ StatusOr<CivilTime> ParseIso8601(std::string_view text) {
     if (t.hour > 24 || t.minute > 59 || t.second < 0 || t.second >= 61)
         return bad("time of day out of range");
     // Zone.
-    if (s.empty()) return InvalidArgumentError(
-        "time '{}' has no time zone (add Z for UTC or an offset such as -07:00)", text);
+    if (s.empty())
+        return InvalidArgumentError(
+            "time '{}' has no time zone (add Z for UTC or an offset such as -07:00)", text);
     if (s == "Z" || s == "z") {
         t.utc_offset_hours = 0;
     } else if (s[0] == '+' || s[0] == '-') {
@@ -89,9 +94,11 @@ StatusOr<CivilTime> ParseIso8601(std::string_view text) {
         s.remove_prefix(1);
         int hh = 0, mm = 0;
         if (s.size() == 5 && s[2] == ':') {
-            if (!ParseInt(s.substr(0, 2), &hh) || !ParseInt(s.substr(3, 2), &mm)) return bad("bad zone");
+            if (!ParseInt(s.substr(0, 2), &hh) || !ParseInt(s.substr(3, 2), &mm))
+                return bad("bad zone");
         } else if (s.size() == 4) {
-            if (!ParseInt(s.substr(0, 2), &hh) || !ParseInt(s.substr(2, 2), &mm)) return bad("bad zone");
+            if (!ParseInt(s.substr(0, 2), &hh) || !ParseInt(s.substr(2, 2), &mm))
+                return bad("bad zone");
         } else if (s.size() == 2) {
             if (!ParseInt(s, &hh)) return bad("bad zone");
         } else {
@@ -110,8 +117,80 @@ std::string FormatIso8601(const CivilTime& t) {
     std::string zone = off_min == 0 ? "Z"
                                     : fmt::format("{}{:02d}:{:02d}", off_min < 0 ? '-' : '+',
                                                   std::abs(off_min) / 60, std::abs(off_min) % 60);
-    return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{:06.3f}{}", t.year, t.month, t.day, t.hour,
-                       t.minute, t.second, zone);
+    return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{:06.3f}{}", t.year, t.month, t.day,
+                       t.hour, t.minute, t.second, zone);
+}
+
+double EstimateDeltaT(double y) {
+    // Espenak & Meeus (2006) §2.6, one polynomial per period.
+    auto long_term = [](double year) {
+        double u = (year - 1820.0) / 100.0;
+        return -20.0 + 32.0 * u * u;
+    };
+    if (y < -500) return long_term(y);
+    if (y < 500) {
+        double u = y / 100.0;
+        return 10583.6 +
+               u * (-1014.41 +
+                    u * (33.78311 + u * (-5.952053 +
+                                         u * (-0.1798452 + u * (0.022174192 + u * 0.0090316521)))));
+    }
+    if (y < 1600) {
+        double u = (y - 1000.0) / 100.0;
+        return 1574.2 +
+               u * (-556.01 +
+                    u * (71.23472 + u * (0.319781 + u * (-0.8503463 +
+                                                         u * (-0.005050998 + u * 0.0083572073)))));
+    }
+    if (y < 1700) {
+        double t = y - 1600.0;
+        return 120.0 - 0.9808 * t - 0.01532 * t * t + t * t * t / 7129.0;
+    }
+    if (y < 1800) {
+        double t = y - 1700.0;
+        return 8.83 + t * (0.1603 + t * (-0.0059285 + t * (0.00013336 - t / 1174000.0)));
+    }
+    if (y < 1860) {
+        double t = y - 1800.0;
+        return 13.72 +
+               t * (-0.332447 +
+                    t * (0.0068612 +
+                         t * (0.0041116 +
+                              t * (-0.00037436 + t * (0.0000121272 +
+                                                      t * (-0.0000001699 + t * 0.000000000875))))));
+    }
+    if (y < 1900) {
+        double t = y - 1860.0;
+        return 7.62 + t * (0.5737 +
+                           t * (-0.251754 + t * (0.01680668 + t * (-0.0004473624 + t / 233174.0))));
+    }
+    if (y < 1920) {
+        double t = y - 1900.0;
+        return -2.79 + t * (1.494119 + t * (-0.0598939 + t * (0.0061966 - t * 0.000197)));
+    }
+    if (y < 1941) {
+        double t = y - 1920.0;
+        return 21.20 + t * (0.84493 + t * (-0.076100 + t * 0.0020936));
+    }
+    if (y < 1961) {
+        double t = y - 1950.0;
+        return 29.07 + 0.407 * t - t * t / 233.0 + t * t * t / 2547.0;
+    }
+    if (y < 1986) {
+        double t = y - 1975.0;
+        return 45.45 + 1.067 * t - t * t / 260.0 - t * t * t / 718.0;
+    }
+    if (y < 2005) {
+        double t = y - 2000.0;
+        return 63.86 + t * (0.3345 + t * (-0.060374 +
+                                          t * (0.0017275 + t * (0.000651814 + t * 0.00002373599))));
+    }
+    if (y < 2050) {
+        double t = y - 2000.0;
+        return 62.92 + 0.32217 * t + 0.005589 * t * t;
+    }
+    if (y < 2150) return long_term(y) - 0.5628 * (2150.0 - y);
+    return long_term(y);
 }
 
 double JulianDay(int year, int month, double day) {
@@ -120,7 +199,8 @@ double JulianDay(int year, int month, double day) {
         year -= 1;
         month += 12;
     }
-    double jd = std::floor(365.25 * (year + 4716.0)) + std::floor(30.6001 * (month + 1)) + day - 1524.5;
+    double jd =
+        std::floor(365.25 * (year + 4716.0)) + std::floor(30.6001 * (month + 1)) + day - 1524.5;
     if (jd > 2299160.0) {  // 1582-10-15 and later: Gregorian
         double a = std::floor(year / 100.0);
         jd += 2.0 - a + std::floor(a / 4.0);
@@ -151,10 +231,13 @@ StatusOr<SpaResult> ComputeSolarPosition(const SpaInput& in) {
     const CivilTime& t = in.time;
     if (t.year < -2000 || t.year > 6000)
         return InvalidArgumentError("year {} out of the SPA's range [-2000, 6000]", t.year);
-    if (t.month < 1 || t.month > 12) return InvalidArgumentError("month {} out of range [1, 12]", t.month);
+    if (t.month < 1 || t.month > 12)
+        return InvalidArgumentError("month {} out of range [1, 12]", t.month);
     if (t.day < 1 || t.day > 31) return InvalidArgumentError("day {} out of range [1, 31]", t.day);
-    if (t.hour < 0 || t.hour > 24 || t.minute < 0 || t.minute > 59 || t.second < 0 || t.second >= 61)
-        return InvalidArgumentError("time {:02d}:{:02d}:{} out of range", t.hour, t.minute, t.second);
+    if (t.hour < 0 || t.hour > 24 || t.minute < 0 || t.minute > 59 || t.second < 0 ||
+        t.second >= 61)
+        return InvalidArgumentError("time {:02d}:{:02d}:{} out of range", t.hour, t.minute,
+                                    t.second);
     if (std::abs(t.utc_offset_hours) > 18)
         return InvalidArgumentError("UTC offset {} h out of range [-18, 18]", t.utc_offset_hours);
     if (!(std::abs(in.latitude_deg) <= 90))
@@ -166,13 +249,15 @@ StatusOr<SpaResult> ComputeSolarPosition(const SpaInput& in) {
     if (!(in.pressure_hpa >= 0 && in.pressure_hpa <= 5000))
         return InvalidArgumentError("pressure {} hPa out of range [0, 5000]", in.pressure_hpa);
     if (!(in.temperature_c > -273.15 && in.temperature_c <= 6000))
-        return InvalidArgumentError("temperature {} °C out of range (-273.15, 6000]", in.temperature_c);
+        return InvalidArgumentError("temperature {} °C out of range (-273.15, 6000]",
+                                    in.temperature_c);
     if (!(std::abs(in.delta_t_s) <= 8000))
         return InvalidArgumentError("delta T {} s out of range [-8000, 8000]", in.delta_t_s);
 
     SpaResult r;
     // 3.1 Julian day from UT = local time - offset.
-    double day_fraction = (t.hour + t.minute / 60.0 + t.second / 3600.0 - t.utc_offset_hours) / 24.0;
+    double day_fraction =
+        (t.hour + t.minute / 60.0 + t.second / 3600.0 - t.utc_offset_hours) / 24.0;
     r.jd = JulianDay(t.year, t.month, t.day + day_fraction);
     r.jde = r.jd + in.delta_t_s / 86400.0;  // eq. (5)
     r.jc = (r.jd - 2451545.0) / 36525.0;    // eq. (6)
@@ -210,9 +295,15 @@ StatusOr<SpaResult> ComputeSolarPosition(const SpaInput& in) {
 
     // 3.5 True obliquity of the ecliptic (eq. 24-25).
     double u = r.jme / 10.0;
-    double eps0 = 84381.448 +
-                  u * (-4680.93 + u * (-1.55 + u * (1999.25 + u * (-51.38 + u * (-249.67 + u * (-39.05 +
-                  u * (7.12 + u * (27.87 + u * (5.79 + u * 2.45)))))))));
+    double eps0 =
+        84381.448 +
+        u * (-4680.93 +
+             u * (-1.55 +
+                  u * (1999.25 +
+                       u * (-51.38 +
+                            u * (-249.67 +
+                                 u * (-39.05 +
+                                      u * (7.12 + u * (27.87 + u * (5.79 + u * 2.45)))))))));
     r.epsilon_deg = eps0 / 3600.0 + r.delta_epsilon_deg;
 
     // 3.6-3.7 Aberration and apparent sun longitude (eq. 26-27).
@@ -226,9 +317,10 @@ StatusOr<SpaResult> ComputeSolarPosition(const SpaInput& in) {
 
     // 3.9-3.10 Geocentric right ascension and declination (eq. 31-32).
     double lam = Rad(r.lambda_deg), eps = Rad(r.epsilon_deg), bet = Rad(beta);
-    r.alpha_deg = LimitDegrees(
-        Deg(std::atan2(std::sin(lam) * std::cos(eps) - std::tan(bet) * std::sin(eps), std::cos(lam))));
-    r.delta_deg = Deg(std::asin(std::sin(bet) * std::cos(eps) + std::cos(bet) * std::sin(eps) * std::sin(lam)));
+    r.alpha_deg = LimitDegrees(Deg(
+        std::atan2(std::sin(lam) * std::cos(eps) - std::tan(bet) * std::sin(eps), std::cos(lam))));
+    r.delta_deg = Deg(
+        std::asin(std::sin(bet) * std::cos(eps) + std::cos(bet) * std::sin(eps) * std::sin(lam)));
 
     // 3.11 Observer local hour angle (eq. 33).
     r.h_deg = LimitDegrees(r.nu_deg + in.longitude_deg - r.alpha_deg);
@@ -250,17 +342,19 @@ StatusOr<SpaResult> ComputeSolarPosition(const SpaInput& in) {
 
     // 3.14 Topocentric zenith angle (eq. 41-44) with refraction (Bennett-type formula, eq. 42).
     double hp = Rad(r.h_prime_deg);
-    r.e0_deg = Deg(std::asin(std::sin(phi) * std::sin(delta_p) + std::cos(phi) * std::cos(delta_p) * std::cos(hp)));
+    r.e0_deg = Deg(std::asin(std::sin(phi) * std::sin(delta_p) +
+                             std::cos(phi) * std::cos(delta_p) * std::cos(hp)));
     constexpr double kSunRadiusDeg = 0.26667;
     if (r.e0_deg >= -1.0 * (kSunRadiusDeg + in.atmos_refract_deg)) {
-        r.refraction_deg = (in.pressure_hpa / 1010.0) * (283.0 / (273.0 + in.temperature_c)) * 1.02 /
-                           (60.0 * std::tan(Rad(r.e0_deg + 10.3 / (r.e0_deg + 5.11))));
+        r.refraction_deg = (in.pressure_hpa / 1010.0) * (283.0 / (273.0 + in.temperature_c)) *
+                           1.02 / (60.0 * std::tan(Rad(r.e0_deg + 10.3 / (r.e0_deg + 5.11))));
     }
     r.elevation_deg = r.e0_deg + r.refraction_deg;
     r.zenith_deg = 90.0 - r.elevation_deg;
 
     // 3.15 Topocentric azimuth (eq. 45-46): astronomers' Γ from south, then from north eastward.
-    double gamma = Deg(std::atan2(std::sin(hp), std::cos(hp) * std::sin(phi) - std::tan(delta_p) * std::cos(phi)));
+    double gamma = Deg(
+        std::atan2(std::sin(hp), std::cos(hp) * std::sin(phi) - std::tan(delta_p) * std::cos(phi)));
     r.azimuth_deg = LimitDegrees(gamma + 180.0);
     return r;
 }

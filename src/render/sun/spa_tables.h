@@ -1,8 +1,8 @@
 #pragma once
-// Periodic terms of the NREL Solar Position Algorithm: Reda & Andreas, "Solar position algorithm for solar
-// radiation applications", NREL/TP-560-34302 (2003, rev. 2008), Solar Energy 76(5) 577-589 (2004),
-// Table A4.2 (Earth periodic terms, from VSOP87 via Meeus) and Table A4.3 (nutation in longitude and
-// obliquity, from Meeus, Astronomical Algorithms, Table 22.A).
+// Periodic terms of the NREL Solar Position Algorithm: Reda & Andreas, "Solar position algorithm
+// for solar radiation applications", NREL/TP-560-34302 (2003, rev. 2008), Solar Energy 76(5)
+// 577-589 (2004), Table A4.2 (Earth periodic terms, from VSOP87 via Meeus) and Table A4.3 (nutation
+// in longitude and obliquity, from Meeus, Astronomical Algorithms, Table 22.A).
 
 namespace nave::spa {
 

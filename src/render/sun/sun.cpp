@@ -44,7 +44,8 @@ double IlluminanceLux(const Spectrum& irradiance) {
     // photopic curve V(λ) is the CIE 1931 ȳ.
     const Spectrum& y = CieY();
     double sum = 0;
-    for (int i = 0; i < Spectrum::kNumSamples; ++i) sum += double(y.sample(i)) * irradiance.sample(i);
+    for (int i = 0; i < Spectrum::kNumSamples; ++i)
+        sum += double(y.sample(i)) * irradiance.sample(i);
     return 683.002 * sum;
 }
 
@@ -71,7 +72,8 @@ StatusOr<Sun> ComputeSun(const SunInput& in) {
     if (!(atm.ozone_atm_cm >= 0 && atm.ozone_atm_cm <= 1.0))
         return InvalidArgumentError("ozone column {} atm-cm out of range [0, 1]", atm.ozone_atm_cm);
     if (!(atm.water_vapour_cm >= 0 && atm.water_vapour_cm <= 10.0))
-        return InvalidArgumentError("precipitable water {} cm out of range [0, 10]", atm.water_vapour_cm);
+        return InvalidArgumentError("precipitable water {} cm out of range [0, 10]",
+                                    atm.water_vapour_cm);
     SpaInput spa;
     spa.time = in.time;
     spa.delta_t_s = in.delta_t_s;
@@ -86,8 +88,8 @@ StatusOr<Sun> ComputeSun(const SunInput& in) {
     sun.position = pos;
     // Azimuth from north, clockwise; world +X east, +Y north, +Z up.
     double el = Rad(pos.elevation_deg), az = Rad(pos.azimuth_deg);
-    sun.direction = Normalize(Vec3f(float(std::cos(el) * std::sin(az)), float(std::cos(el) * std::cos(az)),
-                                    float(std::sin(el))));
+    sun.direction = Normalize(Vec3f(float(std::cos(el) * std::sin(az)),
+                                    float(std::cos(el) * std::cos(az)), float(std::sin(el))));
     sun.distance_au = pos.r_au;
     // Apparent radius: IAU 2015 nominal solar radius 695700 km; 1 AU = 149597870.7 km (IAU 2012).
     sun.angular_radius_rad = std::asin(695700.0 / (pos.r_au * 149597870.7));
@@ -100,8 +102,8 @@ StatusOr<Sun> ComputeSun(const SunInput& in) {
         double m = RelativeAirMassKastenYoung(pos.zenith_deg);
         sun.air_mass = m;
         double m_p = m * atm.pressure_hpa / 1013.25;
-        // Ozone sits at ~22 km: its air mass differs from the total near the horizon (Iqbal 1983 eq.
-        // 5.3.3 after Robinson 1966: m_oz = (1 + h/R) / sqrt(cos²z + 2h/R), h/R = 22/6370).
+        // Ozone sits at ~22 km: its air mass differs from the total near the horizon (Iqbal 1983
+        // eq. 5.3.3 after Robinson 1966: m_oz = (1 + h/R) / sqrt(cos²z + 2h/R), h/R = 22/6370).
         double cz = std::cos(Rad(pos.zenith_deg));
         double m_oz = (1.0 + 22.0 / 6370.0) / std::sqrt(cz * cz + 2.0 * 22.0 / 6370.0);
         double beta = AngstromBetaFromTurbidity(atm.turbidity);
@@ -117,7 +119,8 @@ StatusOr<Sun> ComputeSun(const SunInput& in) {
             double tau_r = RayleighOpticalDepth(l, atm.pressure_hpa);
             double tau_a = beta * std::pow(l / 1000.0, -atm.angstrom_alpha);
             double tau_o = k_o.sample(i) * atm.ozone_atm_cm;
-            // Leckner (1978) eqs. (2.36)-(2.37) for the O2 A band and water vapour (Iqbal 1983 eq. 6.12.7-8).
+            // Leckner (1978) eqs. (2.36)-(2.37) for the O2 A band and water vapour (Iqbal 1983
+            // eq. 6.12.7-8).
             double kg = k_g.sample(i), kw = k_w.sample(i);
             double t_g = std::exp(-1.41 * kg * m_p / std::pow(1.0 + 118.93 * kg * m_p, 0.45));
             double t_w = std::exp(-0.2385 * kw * w * m / std::pow(1.0 + 20.07 * kw * w * m, 0.45));

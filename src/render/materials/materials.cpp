@@ -1,0 +1,109 @@
+#include "render/materials/materials.h"
+
+#include <cmath>
+
+#include "core/spectrum_data.h"
+#include "render/materials/ior.h"
+
+namespace nave {
+
+Bxdf GetBxdf(const Material& m, SampledWavelengths& lambda) {
+    return std::visit([&](const auto& mat) { return mat.GetBxdf(lambda); }, m);
+}
+
+float ThinGlassMaterial::InternalFromTotalTransmittance(float total_t, float eta) {
+    double r = FrDielectric(1.f, eta);
+    double t = std::clamp(double(total_t), 0.0, 1.0);
+    double one_r2 = (1.0 - r) * (1.0 - r);
+    // The largest total transmittance a lossless pane can have is (1 - R) / (1 + R).
+    if (t >= (1.0 - r) / (1.0 + r)) return 1.f;
+    if (r == 0.0) return float(t);
+    // Solve R² T τ² + (1 - R)² τ - T = 0 for the positive root (from T = (1-R)² τ / (1 - R² τ²)).
+    double a = r * r * t;
+    if (a == 0.0) return 0.f;
+    double tau = (-one_r2 + std::sqrt(one_r2 * one_r2 + 4.0 * a * t)) / (2.0 * a);
+    return float(std::clamp(tau, 0.0, 1.0));
+}
+
+ThinGlassMaterial ThinGlassMaterial::FromTotalTransmittance(const Spectrum& eta,
+                                                            const Spectrum& total_transmittance) {
+    ThinGlassMaterial m;
+    m.eta = eta;
+    m.internal_transmittance = Spectrum::FromFunction([&](double l) {
+        float lf = float(l);
+        return InternalFromTotalTransmittance(total_transmittance.Evaluate(lf), eta.Evaluate(lf));
+    });
+    return m;
+}
+
+namespace {
+
+const char* const kNames[] = {"limestone",
+                              "limestone_dark",
+                              "floor_tile_light",
+                              "floor_tile_dark",
+                              "glass_clear",
+                              "glass_blue",
+                              "glass_red",
+                              "glass_yellow",
+                              "glass_green",
+                              "lead",
+                              "wood",
+                              "roof_slate",
+                              "gold",
+                              "silver",
+                              "copper",
+                              "aluminium",
+                              "bk7",
+                              "window_glass"};
+
+ConductorMaterial Metal(std::string_view symbol, float alpha) {
+    StatusOr<ComplexIndex> ci = NamedMetal(symbol);
+    NAVE_CHECK(ci.ok()) << ci.status().ToString();
+    ConductorMaterial m;
+    m.eta = ci->eta;
+    m.k = ci->k;
+    m.alpha_x = m.alpha_y = alpha;
+    return m;
+}
+
+}  // namespace
+
+std::vector<std::string> BuiltinMaterialNames() { return {std::begin(kNames), std::end(kNames)}; }
+
+StatusOr<Material> BuiltinMaterial(std::string_view name) {
+    const SpectraTable& building = EmbeddedSpectraTable("stone_approx.csv");
+    for (std::string_view n : {"limestone", "limestone_dark", "floor_tile_light", "floor_tile_dark",
+                               "wood", "roof_slate"}) {
+        if (name == n) {
+            NAVE_ASSIGN_OR_RETURN(Spectrum albedo, building.ToSpectrum(n));
+            return Material(DiffuseMaterial{albedo});
+        }
+    }
+    if (name.rfind("glass_", 0) == 0) {
+        const SpectraTable& glass = EmbeddedSpectraTable("stained_glass_approx.csv");
+        StatusOr<Spectrum> t = glass.ToSpectrum(name);
+        if (t.ok()) return Material(ThinGlassMaterial::FromTotalTransmittance(SodaLimeIndex(), *t));
+    }
+    // Came lead: oxidised, so a rough conductor rather than a mirror.
+    if (name == "lead") return Material(Metal("Pb", 0.35f));
+    if (name == "gold") return Material(Metal("Au", 0.f));
+    if (name == "silver") return Material(Metal("Ag", 0.f));
+    if (name == "copper") return Material(Metal("Cu", 0.f));
+    if (name == "aluminium") return Material(Metal("Al", 0.f));
+    if (name == "bk7") return Material(DielectricMaterial{Bk7Index(), Spectrum::Constant(0.f)});
+    if (name == "window_glass") {
+        ThinGlassMaterial m;
+        m.eta = SodaLimeIndex();
+        // One 4 mm pass through clear soda-lime glass.
+        m.internal_transmittance = Spectrum::FromFunction([](double l) {
+            return std::exp(-SodaLimeAbsorptionPerMetre().Evaluate(float(l)) * 0.004);
+        });
+        return Material(m);
+    }
+    std::string all;
+    for (const char* n : kNames) all += (all.empty() ? "" : ", ") + std::string(n);
+    return NotFoundError("no built-in material '{}' (known: {})", name, all);
+}
+
+}  // namespace nave
