@@ -186,7 +186,7 @@ void Engine::Escape(const RayRecord& r) {
         // The sky is also next-event estimated (uniform directions): weight the BSDF-sampled escape.
         float w = 1;
         if (r.depth > 0 && !(r.flags & kSpecularBounce)) w = PowerHeuristic(r.prev_pdf, UniformSpherePdf());
-        L += scene_.sky_radiance.Sample(r.lambda) * w;
+        L += scene_.SkyRadiance(r.dir, r.lambda) * w;
     }
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
@@ -310,7 +310,7 @@ void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, c
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = kInfinity;
-    s.beta = r.beta * f * scene_.sky_radiance.Sample(r.lambda) * (w / light_pdf);
+    s.beta = r.beta * f * scene_.SkyRadiance(wi, r.lambda) * (w / light_pdf);
     if (s.beta.IsZero()) return;
     Spawn(s, b, &brick, out, c);
 }
@@ -641,7 +641,20 @@ Status Engine::BuildEmitters() {
         Emitter e;
         e.kind = Emitter::Kind::kSky;
         emitters_.push_back(e);
-        weights.push_back(MeanVisible(scene_.sky_radiance) * 4 * kPiF * disk_area);
+        // Mean radiance over the sphere of directions (a fixed 256-direction Fibonacci set for a sky model).
+        double mean = 0;
+        if (scene_.preetham) {
+            const int n = 256;
+            for (int i = 0; i < n; ++i) {
+                float z = 1 - 2 * (float(i) + 0.5f) / float(n), phi = 2.39996323f * float(i);
+                float rxy = std::sqrt(std::max(0.f, 1 - z * z));
+                mean += MeanVisible(scene_.preetham->RadianceSpectrum(Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
+            }
+            mean = mean / n * scene_.sky_scale;
+        } else {
+            mean = MeanVisible(scene_.sky_radiance);
+        }
+        weights.push_back(mean * 4 * kPiF * disk_area);
     }
     emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
     weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
@@ -732,7 +745,7 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                 Vec3f to = SampleUniformSphere(u2);
                 r.origin = disc_origin(to);
                 r.dir = -to;
-                r.beta = scene_.sky_radiance.Sample(lambda) * (4 * kPiF * disk_area);
+                r.beta = scene_.SkyRadiance(to, lambda) * (4 * kPiF * disk_area);
                 // Direct skylight is next-event estimated at the visible points: sky photons deposit only
                 // after a bounce.
             } else {

@@ -173,6 +173,11 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
     if (config.sky.kind == SkyConfig::Kind::kUniform) {
         scene.sky = true;
         scene.sky_radiance = ToSpectrum(config.sky.radiance);
+    } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
+        scene.sky = true;
+        double turbidity = std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
+        scene.preetham = std::make_shared<PreethamSky>(scene.lights[size_t(scene.sun)].to_light, float(turbidity));
+        scene.sky_scale = config.sky.scale;
     }
     return scene;
 }

@@ -16,6 +16,7 @@
 #include "render/materials/bxdf.h"
 #include "render/materials/materials.h"
 #include "render/scene_config.h"
+#include "render/sun/sky.h"
 
 namespace nave::render {
 
@@ -63,7 +64,14 @@ struct RenderScene {
     std::vector<Light> lights;
     int sun = -1;                            ///< index of the sun in `lights`, or -1
     bool sky = false;
-    Spectrum sky_radiance;
+    Spectrum sky_radiance;                   ///< uniform sky
+    std::shared_ptr<const PreethamSky> preetham;  ///< physical sky (physics: render/sun/sky.h), or null
+    float sky_scale = 1;
+    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths.
+    SampledSpectrum SkyRadiance(const Vec3f& w, const SampledWavelengths& lambda) const {
+        if (preetham) return preetham->Radiance(w, lambda) * sky_scale;
+        return sky_radiance.Sample(lambda);
+    }
     RenderSettings settings;
     OutputConfig output;
     std::string sun_description;             ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary

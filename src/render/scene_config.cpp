@@ -331,10 +331,18 @@ Status ParseSky(TableReader& r, SkyConfig* s) {
         s->kind = SkyConfig::Kind::kUniform;
         s->radiance = SpectrumSpec::Constant(1.f);
         NAVE_RETURN_IF_ERROR(r.Spectrum("radiance", &s->radiance));
+    } else if (type == "preetham") {
+        s->kind = SkyConfig::Kind::kPreetham;
+        double t = 0;
+        if (r.Has("turbidity")) {
+            NAVE_RETURN_IF_ERROR(r.Double("turbidity", &t, 1.7, 10));
+            s->turbidity = t;
+        }
+        NAVE_RETURN_IF_ERROR(r.Float("scale", &s->scale, 0, 1e9));
     } else if (type == "none") {
         s->kind = SkyConfig::Kind::kNone;
     } else {
-        return r.RangeError("type", *tn, fmt::format("'{}' is not a sky type (expected uniform or none)", type));
+        return r.RangeError("type", *tn, fmt::format("'{}' is not a sky type (expected uniform, preetham or none)", type));
     }
     return r.Finish();
 }
@@ -558,6 +566,9 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
     if (render != nullptr) {
         TableReader t(*render, "render", name);
         NAVE_RETURN_IF_ERROR(ParseRender(t, &config.render));
+    }
+    if (config.sky.kind == SkyConfig::Kind::kPreetham && !config.sun.enabled) {
+        return InvalidArgumentError("{}: sky.type = \"preetham\" needs an enabled [sun] (the sky follows it)", name);
     }
     NAVE_ASSIGN_OR_RETURN(const toml::table* output, r.Table("output"));
     if (output != nullptr) {

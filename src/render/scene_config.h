@@ -62,9 +62,11 @@ struct SunConfig {
 };
 
 struct SkyConfig {
-    enum class Kind { kNone, kUniform };
+    enum class Kind { kNone, kUniform, kPreetham };
     Kind kind = Kind::kNone;
     SpectrumSpec radiance;           ///< kUniform: radiance of every direction above and below
+    std::optional<double> turbidity; ///< kPreetham: default the sun's turbidity
+    float scale = 1.f;               ///< kPreetham: multiplies the model's radiance
 };
 
 struct LightConfig {
