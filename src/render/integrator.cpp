@@ -147,6 +147,12 @@ class Engine {
         int portal = -1;      // kLight (sun, directional): index in portals_ when aiming at windows
     };
     std::vector<PortalProjection> portals_;
+    // Sky photons aimed at the portals: every portal triangle in one Embree scene, to count the portals a
+    // photon's line crosses (the balance-heuristic weight), and the area CDF to pick start points.
+    std::unique_ptr<ResidentBrick> portal_scene_;
+    std::vector<std::array<Vec3f, 3>> portal_triangles_;
+    std::vector<double> portal_area_cdf_;
+    double portal_area_ = 0;
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     Vec3f scene_center_;
@@ -637,6 +643,22 @@ Status Engine::BuildEmitters() {
         emitters_.push_back(e);
         weights.push_back(w);
     }
+    if (scene_.sky && want_portals && !portal_triangles.empty()) {
+        store::BrickMesh mesh;
+        portal_area_cdf_.push_back(0);
+        for (const auto& t : portal_triangles) {
+            uint32_t base = uint32_t(mesh.positions.size());
+            mesh.positions.insert(mesh.positions.end(), {t[0], t[1], t[2]});
+            mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+            mesh.material_ids.push_back(0);
+            portal_area_ += 0.5 * double(Length(Cross(t[1] - t[0], t[2] - t[0])));
+            portal_area_cdf_.push_back(portal_area_);
+        }
+        for (double& c : portal_area_cdf_) c /= portal_area_;
+        portal_triangles_ = portal_triangles;
+        NAVE_ASSIGN_OR_RETURN(portal_scene_,
+                              ResidentBrick::Build(scene_.source->device(), 0, bounds, std::move(mesh)));
+    }
     if (scene_.sky) {
         Emitter e;
         e.kind = Emitter::Kind::kSky;
@@ -654,7 +676,8 @@ Status Engine::BuildEmitters() {
         } else {
             mean = MeanVisible(scene_.sky_radiance);
         }
-        weights.push_back(mean * 4 * kPiF * disk_area);
+        // Through portals: lines cross them with measure 2 pi A_portals (both sides), through the bounds 4 pi A_disc.
+        weights.push_back(mean * (portal_scene_ ? 2 * kPiF * portal_area_ : 4 * kPiF * disk_area));
     }
     emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
     weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
@@ -741,6 +764,27 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                         break;
                     }
                 }
+            } else if (e.kind == Emitter::Kind::kSky && portal_scene_) {
+                // A point uniform on the portals' area, a cosine-weighted direction on a random side: the
+                // line's density is count / (2 pi A) in the measure dA_perp dw, count = portals the line
+                // crosses (Veach's balance heuristic over the portals), so the power is L 2 pi A / count.
+                size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(),
+                                                   double(rng.Uniform(6))) - (portal_area_cdf_.begin() + 1));
+                const auto& t = portal_triangles_[std::min(i, portal_triangles_.size() - 1)];
+                float su = std::sqrt(u1.x);
+                Vec3f p = t[0] * (1 - su) + t[1] * (su * (1 - u1.y)) + t[2] * (su * u1.y);
+                Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
+                if (rng.Uniform(5) < 0.5f) n = -n;
+                Vec3f d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                r.origin = p - d * (2 * scene_radius_);
+                r.dir = d;
+                int count = 0;
+                BrickHit hit;
+                for (float t0 = 0; count < 64 && portal_scene_->Intersect(r.origin, d, t0, 4 * scene_radius_, &hit);) {
+                    ++count;
+                    t0 = hit.t + 1e-6f * (1.f + hit.t);
+                }
+                r.beta = scene_.SkyRadiance(-d, lambda) * float(2 * kPiF * portal_area_ / std::max(1, count));
             } else if (e.kind == Emitter::Kind::kSky) {
                 Vec3f to = SampleUniformSphere(u2);
                 r.origin = disc_origin(to);
