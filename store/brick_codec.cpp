@@ -1,7 +1,11 @@
 #include "store/brick_codec.h"
 
+#include <draco/compression/decode.h>
+#include <draco/compression/expert_encode.h>
+#include <draco/core/decoder_buffer.h>
+#include <draco/core/encoder_buffer.h>
+#include <draco/mesh/mesh.h>
 #include <fmt/ostream.h>
-
 #include <lz4.h>
 
 #include <algorithm>
@@ -11,23 +15,19 @@
 #include <numeric>
 #include <unordered_map>
 
-#include <draco/compression/decode.h>
-#include <draco/compression/expert_encode.h>
-#include <draco/core/decoder_buffer.h>
-#include <draco/core/encoder_buffer.h>
-#include <draco/mesh/mesh.h>
-
 namespace nave::store::codec {
 namespace {
 
 // The position is an integer attribute without Draco quantization: Draco predicts and entropy-codes
-// integers losslessly, so decoding gives back exactly the grid indices (docs/store-format.md, "Grid").
+// integers losslessly, so decoding gives back exactly the grid indices (docs/store-format.md,
+// "Grid").
 constexpr draco::GeometryAttribute::Type kPositionType = draco::GeometryAttribute::POSITION;
 constexpr draco::GeometryAttribute::Type kNormalType = draco::GeometryAttribute::NORMAL;
 constexpr draco::GeometryAttribute::Type kUvType = draco::GeometryAttribute::TEX_COORD;
-// Material ids ride as a per-point integer attribute whose value is equal on the three corners of every
-// face. Draco keeps attribute values attached to corners through its edgebreaker face reordering, so a
-// face's material is the value at any of its corners (Draco splits a vertex shared by two materials).
+// Material ids ride as a per-point integer attribute whose value is equal on the three corners of
+// every face. Draco keeps attribute values attached to corners through its edgebreaker face
+// reordering, so a face's material is the value at any of its corners (Draco splits a vertex shared
+// by two materials).
 constexpr draco::GeometryAttribute::Type kMaterialType = draco::GeometryAttribute::GENERIC;
 
 Vec3f Normalized(const Vec3f& n) {
@@ -35,8 +35,9 @@ Vec3f Normalized(const Vec3f& n) {
     return {float(n.x / len), float(n.y / len), float(n.z / len)};
 }
 
-std::unique_ptr<draco::PointAttribute> NewAttribute(draco::GeometryAttribute::Type type, int components,
-                                                    draco::DataType data_type, size_t values) {
+std::unique_ptr<draco::PointAttribute> NewAttribute(draco::GeometryAttribute::Type type,
+                                                    int components, draco::DataType data_type,
+                                                    size_t values) {
     auto att = std::make_unique<draco::PointAttribute>();
     att->Init(type, int8_t(components), data_type, false, values);
     return att;
@@ -44,7 +45,8 @@ std::unique_ptr<draco::PointAttribute> NewAttribute(draco::GeometryAttribute::Ty
 
 }  // namespace
 
-uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals, bool has_uvs) {
+uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
+                      bool has_uvs) {
     return vertex_count * (sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) +
                            (has_uvs ? sizeof(std::array<float, 2>) : 0)) +
            triangle_count * (3 * sizeof(uint32_t) + sizeof(uint32_t));
@@ -53,15 +55,18 @@ uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_n
 StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
                                         const EncodeOptions& options) {
     if (!(grid.step > 0) || !std::isfinite(grid.step) || !IsFinite(grid.origin)) {
-        return InvalidArgumentError("invalid grid: origin {}, step {} (the step must be finite and > 0)",
-                                    fmt::streamed(grid.origin), grid.step);
+        return InvalidArgumentError(
+            "invalid grid: origin {}, step {} (the step must be finite and > 0)",
+            fmt::streamed(grid.origin), grid.step);
     }
     if (options.draco_speed < 0 || options.draco_speed > 10) {
         return InvalidArgumentError("draco speed {} out of range [0, 10]", options.draco_speed);
     }
-    if (options.normal_bits < 2 || options.normal_bits > 30 || options.uv_bits < 1 || options.uv_bits > 30) {
-        return InvalidArgumentError("normal bits {} (expected 2..30) or uv bits {} (expected 1..30) out of range",
-                                    options.normal_bits, options.uv_bits);
+    if (options.normal_bits < 2 || options.normal_bits > 30 || options.uv_bits < 1 ||
+        options.uv_bits > 30) {
+        return InvalidArgumentError(
+            "normal bits {} (expected 2..30) or uv bits {} (expected 1..30) out of range",
+            options.normal_bits, options.uv_bits);
     }
     const size_t vertex_count = mesh.VertexCount();
     const size_t triangle_count = mesh.TriangleCount();
@@ -75,7 +80,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
             const double t = (double(p[a]) - grid.origin[a]) / grid.step;
             if (!(std::fabs(t) < kLimit)) {
                 return InvalidArgumentError(
-                    "vertex {} at {} lies outside the grid's int32 range (origin {}, step {}): choose a larger "
+                    "vertex {} at {} lies outside the grid's int32 range (origin {}, step {}): "
+                    "choose a larger "
                     "step or an origin nearer the model",
                     v, fmt::streamed(p), fmt::streamed(grid.origin), grid.step);
             }
@@ -83,8 +89,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         q[v] = grid.Quantize(p);
     }
 
-    // 2. One Draco position value per distinct grid point, so that vertices the input split (for normal or
-    // UV seams) stay connected for edgebreaker.
+    // 2. One Draco position value per distinct grid point, so that vertices the input split (for
+    // normal or UV seams) stay connected for edgebreaker.
     std::vector<uint32_t> order(vertex_count);
     std::iota(order.begin(), order.end(), 0u);
     auto less = [&](uint32_t a, uint32_t b) {
@@ -101,15 +107,16 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         position_value[order[i]] = uint32_t(unique_positions.size() - 1);
     }
 
-    // 3. Drop triangles that collapse on the grid (two corners on one grid point): they have no area, no ray
-    // can hit them, and Draco's connectivity coder does not keep them.
+    // 3. Drop triangles that collapse on the grid (two corners on one grid point): they have no
+    // area, no ray can hit them, and Draco's connectivity coder does not keep them.
     EncodedMesh out;
     out.has_normals = mesh.HasNormals();
     out.has_uvs = mesh.HasUvs();
     std::vector<uint32_t> kept;
     kept.reserve(triangle_count);
     for (size_t t = 0; t < triangle_count; ++t) {
-        const uint32_t a = position_value[mesh.indices[3 * t]], b = position_value[mesh.indices[3 * t + 1]],
+        const uint32_t a = position_value[mesh.indices[3 * t]],
+                       b = position_value[mesh.indices[3 * t + 1]],
                        c = position_value[mesh.indices[3 * t + 2]];
         if (a == b || b == c || a == c) continue;
         kept.push_back(uint32_t(t));
@@ -117,12 +124,12 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     }
     out.dropped_triangle_count = triangle_count - kept.size();
     if (out.max_material_id > uint32_t(std::numeric_limits<int32_t>::max())) {
-        return InvalidArgumentError("material id {} exceeds the largest storable id {}", out.max_material_id,
-                                    std::numeric_limits<int32_t>::max());
+        return InvalidArgumentError("material id {} exceeds the largest storable id {}",
+                                    out.max_material_id, std::numeric_limits<int32_t>::max());
     }
 
-    // 4. Points: one per (vertex, material) pair in use. Most vertices have one material; the rare ones on a
-    // material border get extra points through a small map.
+    // 4. Points: one per (vertex, material) pair in use. Most vertices have one material; the rare
+    // ones on a material border get extra points through a small map.
     constexpr uint32_t kUnset = 0xffffffffu;
     std::vector<uint32_t> point_of_vertex(vertex_count, kUnset);
     std::vector<uint32_t> material_of_vertex(vertex_count, 0);
@@ -149,8 +156,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
             } else if (material_of_vertex[v] == material) {
                 point = point_of_vertex[v];
             } else {
-                auto [it, inserted] =
-                    extra_points.try_emplace((uint64_t(v) << 32) | material, uint32_t(point_vertex.size()));
+                auto [it, inserted] = extra_points.try_emplace((uint64_t(v) << 32) | material,
+                                                               uint32_t(point_vertex.size()));
                 if (inserted) {
                     point_vertex.push_back(v);
                     point_material.push_back(material);
@@ -167,7 +174,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     for (int a = 0; a < 3; ++a) {
         if (point_count > 0 && int64_t(hi[a]) - int64_t(lo[a]) >= kMaxBrickSpanSteps) {
             return InvalidArgumentError(
-                "the brick spans {} grid steps along axis {}, more than the {} a brick may span: use a larger "
+                "the brick spans {} grid steps along axis {}, more than the {} a brick may span: "
+                "use a larger "
                 "grid step or smaller bricks",
                 int64_t(hi[a]) - int64_t(lo[a]), "xyz"[a], kMaxBrickSpanSteps);
         }
@@ -205,7 +213,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         if (out.has_uvs) {
             auto att = NewAttribute(kUvType, 2, draco::DT_FLOAT32, point_count);
             for (size_t p = 0; p < point_count; ++p) {
-                att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), mesh.uvs[point_vertex[p]].data());
+                att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)),
+                                       mesh.uvs[point_vertex[p]].data());
             }
             uv_id = dm.AddAttribute(std::move(att));
         }
@@ -230,17 +239,19 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         draco::EncoderBuffer buffer;
         const draco::Status status = encoder.EncodeToBuffer(&buffer);
         if (!status.ok()) {
-            return InternalError("Draco could not encode a brick of {} triangles and {} vertices: {}", kept.size(),
-                                 point_count, status.error_msg_string());
+            return InternalError(
+                "Draco could not encode a brick of {} triangles and {} vertices: {}", kept.size(),
+                point_count, status.error_msg_string());
         }
         out.bytes.append(buffer.data(), buffer.size());
     }
 
-    // 6. Decode once: the store must never hold a brick that does not decode to what was given, and the
-    // decoded vertex count (Draco splits vertices at attribute seams and non-manifold edges) is only known
-    // after decoding.
-    NAVE_ASSIGN_OR_RETURN(BrickMesh decoded,
-                          DecodeMeshSection(out.bytes, grid, uint64_t(out.max_material_id) + 1, "encoded brick"));
+    // 6. Decode once: the store must never hold a brick that does not decode to what was given, and
+    // the decoded vertex count (Draco splits vertices at attribute seams and non-manifold edges) is
+    // only known after decoding.
+    NAVE_ASSIGN_OR_RETURN(
+        BrickMesh decoded,
+        DecodeMeshSection(out.bytes, grid, uint64_t(out.max_material_id) + 1, "encoded brick"));
     if (decoded.TriangleCount() != kept.size()) {
         return InternalError("Draco round trip lost triangles: encoded {}, decoded {}", kept.size(),
                              decoded.TriangleCount());
@@ -251,33 +262,37 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     std::sort(materials_in.begin(), materials_in.end());
     std::sort(materials_out.begin(), materials_out.end());
     if (materials_in != materials_out) {
-        return InternalError("Draco round trip changed the triangles' material ids ({} triangles)", kept.size());
+        return InternalError("Draco round trip changed the triangles' material ids ({} triangles)",
+                             kept.size());
     }
     out.triangle_count = decoded.TriangleCount();
     out.vertex_count = decoded.VertexCount();
-    out.decoded_bytes = DecodedBytes(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
+    out.decoded_bytes =
+        DecodedBytes(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
     for (const Vec3f& p : decoded.positions) out.geometry_bounds.Extend(p);
     return out;
 }
 
-StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& grid, uint64_t material_count,
-                                      const std::string& what) {
+StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& grid,
+                                      uint64_t material_count, const std::string& what) {
     if (bytes.size() < kMeshPrefixBytes) {
-        return DataLossError("{}: mesh section of {} bytes is shorter than its {}-byte prefix", what, bytes.size(),
-                             kMeshPrefixBytes);
+        return DataLossError("{}: mesh section of {} bytes is shorter than its {}-byte prefix",
+                             what, bytes.size(), kMeshPrefixBytes);
     }
     int32_t prefix[4];
     std::memcpy(prefix, bytes.data(), kMeshPrefixBytes);
     const Vec3i base{prefix[0], prefix[1], prefix[2]};
     BrickMesh out;
-    if (bytes.size() == kMeshPrefixBytes) return out;  // a brick whose triangles all collapsed on the grid
+    if (bytes.size() == kMeshPrefixBytes)
+        return out;  // a brick whose triangles all collapsed on the grid
 
     draco::DecoderBuffer buffer;
     buffer.Init(bytes.data() + kMeshPrefixBytes, bytes.size() - kMeshPrefixBytes);
     draco::Decoder decoder;
     auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
     if (!decoded.ok()) {
-        return DataLossError("{}: Draco cannot decode the mesh: {}", what, decoded.status().error_msg_string());
+        return DataLossError("{}: Draco cannot decode the mesh: {}", what,
+                             decoded.status().error_msg_string());
     }
     const std::unique_ptr<draco::Mesh> dm = std::move(decoded).value();
     const draco::PointAttribute* pos = dm->GetNamedAttribute(kPositionType);
@@ -287,11 +302,13 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     if (pos == nullptr || pos->data_type() != draco::DT_INT32 || pos->num_components() != 3) {
         return DataLossError("{}: the Draco mesh has no int32 x 3 position attribute", what);
     }
-    if (material == nullptr || material->data_type() != draco::DT_INT32 || material->num_components() != 1) {
+    if (material == nullptr || material->data_type() != draco::DT_INT32 ||
+        material->num_components() != 1) {
         return DataLossError("{}: the Draco mesh has no int32 material attribute", what);
     }
     if (normal != nullptr && normal->num_components() != 3) {
-        return DataLossError("{}: normals have {} components (expected 3)", what, int(normal->num_components()));
+        return DataLossError("{}: normals have {} components (expected 3)", what,
+                             int(normal->num_components()));
     }
     if (uv != nullptr && uv->num_components() != 2) {
         return DataLossError("{}: texture coordinates have {} components (expected 2)", what,
@@ -321,7 +338,8 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         if (uv != nullptr) {
             float t[2] = {0, 0};
             if (!uv->ConvertValue<float, 2>(uv->mapped_index(pi), t)) {
-                return DataLossError("{}: cannot read the texture coordinates of vertex {}", what, p);
+                return DataLossError("{}: cannot read the texture coordinates of vertex {}", what,
+                                     p);
             }
             out.uvs[p] = {t[0], t[1]};
         }
@@ -331,15 +349,16 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         for (int c = 0; c < 3; ++c) {
             const uint32_t p = face[c].value();
             if (p >= point_count) {
-                return DataLossError("{}: triangle {} names vertex {} of {}", what, f, p, point_count);
+                return DataLossError("{}: triangle {} names vertex {} of {}", what, f, p,
+                                     point_count);
             }
             out.indices[3 * size_t(f) + c] = p;
         }
         int32_t m = 0;
         material->GetMappedValue(face[0], &m);
         if (m < 0 || uint64_t(m) >= material_count) {
-            return DataLossError("{}: triangle {} has material {} but the store has {} materials", what, f, m,
-                                 material_count);
+            return DataLossError("{}: triangle {} has material {} but the store has {} materials",
+                                 what, f, m, material_count);
         }
         out.material_ids[f] = uint32_t(m);
     }
@@ -347,7 +366,8 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
 }
 
 std::string CompressSideSection(std::string_view raw) {
-    NAVE_CHECK_LT(raw.size(), size_t(LZ4_MAX_INPUT_SIZE)) << "side section too large for one LZ4 block";
+    NAVE_CHECK_LT(raw.size(), size_t(LZ4_MAX_INPUT_SIZE))
+        << "side section too large for one LZ4 block";
     const int bound = LZ4_compressBound(int(raw.size()));
     std::string out(8 + size_t(bound), '\0');
     const uint64_t raw_size = raw.size();
@@ -360,21 +380,24 @@ std::string CompressSideSection(std::string_view raw) {
 
 StatusOr<std::string> DecompressSideSection(std::string_view bytes, const std::string& what) {
     if (bytes.size() < 8) {
-        return DataLossError("{}: side section of {} bytes is shorter than its 8-byte size field", what,
-                             bytes.size());
+        return DataLossError("{}: side section of {} bytes is shorter than its 8-byte size field",
+                             what, bytes.size());
     }
     uint64_t raw_size = 0;
     std::memcpy(&raw_size, bytes.data(), 8);
     // LZ4 expands at most 255:1, so a larger claim is corrupt; this also bounds the allocation.
     if (raw_size > uint64_t(LZ4_MAX_INPUT_SIZE) || raw_size > 255 * (bytes.size() - 8) + 16) {
-        return DataLossError("{}: side section claims {} bytes decompressed from {} (impossible for LZ4)", what,
-                             raw_size, bytes.size() - 8);
+        return DataLossError(
+            "{}: side section claims {} bytes decompressed from {} (impossible for LZ4)", what,
+            raw_size, bytes.size() - 8);
     }
     std::string out(raw_size, '\0');
-    const int n = LZ4_decompress_safe(bytes.data() + 8, out.data(), int(bytes.size() - 8), int(raw_size));
+    const int n =
+        LZ4_decompress_safe(bytes.data() + 8, out.data(), int(bytes.size() - 8), int(raw_size));
     if (n < 0 || uint64_t(n) != raw_size) {
-        return DataLossError("{}: LZ4 cannot decompress the side section (result {}, expected {} bytes)", what, n,
-                             raw_size);
+        return DataLossError(
+            "{}: LZ4 cannot decompress the side section (result {}, expected {} bytes)", what, n,
+            raw_size);
     }
     return out;
 }

@@ -1,7 +1,7 @@
 #pragma once
-// Encoding and decoding of one brick's payload (internal to nave_store). The mesh section is a 16-byte
-// prefix (the brick's integer position base) followed by a Draco bitstream; the side section is LZ4.
-// Byte layouts: docs/store-format.md. No Draco or LZ4 type leaves brick_codec.cpp.
+// Encoding and decoding of one brick's payload (internal to nave_store). The mesh section is a
+// 16-byte prefix (the brick's integer position base) followed by a Draco bitstream; the side
+// section is LZ4. Byte layouts: docs/store-format.md. No Draco or LZ4 type leaves brick_codec.cpp.
 
 #include <cstdint>
 #include <string>
@@ -16,16 +16,18 @@ namespace nave::store::codec {
 
 /// Bytes of the mesh section's prefix (int32 base x, y, z; uint32 flags).
 inline constexpr size_t kMeshPrefixBytes = 16;
-/// Largest span of a brick's positions along one axis, in grid steps. Keeps Draco's integer prediction
-/// (a + b - c, in int32) far from overflow.
+/// Largest span of a brick's positions along one axis, in grid steps. Keeps Draco's integer
+/// prediction (a + b - c, in int32) far from overflow.
 inline constexpr int64_t kMaxBrickSpanSteps = int64_t(1) << 29;
 
 /// The result of encoding a mesh: the section bytes and what the directory needs to know.
 struct EncodedMesh {
     std::string bytes;
-    Bounds3f geometry_bounds;     ///< box of the decoded (grid-snapped) positions
-    uint64_t triangle_count = 0;  ///< stored triangles (input minus those that collapse on the grid)
-    uint64_t vertex_count = 0;    ///< vertices after decoding (Draco splits vertices at attribute seams)
+    Bounds3f geometry_bounds;  ///< box of the decoded (grid-snapped) positions
+    uint64_t triangle_count =
+        0;  ///< stored triangles (input minus those that collapse on the grid)
+    uint64_t vertex_count =
+        0;  ///< vertices after decoding (Draco splits vertices at attribute seams)
     uint64_t decoded_bytes = 0;
     uint64_t dropped_triangle_count = 0;
     uint32_t max_material_id = 0;
@@ -33,16 +35,19 @@ struct EncodedMesh {
     bool has_uvs = false;
 };
 
-/// Snaps, encodes, then decodes the result once to check it and to learn the decoded counts. Thread-safe.
-StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid, const EncodeOptions& options);
+/// Snaps, encodes, then decodes the result once to check it and to learn the decoded counts.
+/// Thread-safe.
+StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
+                                        const EncodeOptions& options);
 
 /// Decodes a mesh section. `material_count` bounds the material ids; `what` prefixes every error
 /// ("abbey.nave brick 12 @0x1a2b"). Thread-safe.
-StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& grid, uint64_t material_count,
-                                      const std::string& what);
+StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& grid,
+                                      uint64_t material_count, const std::string& what);
 
 /// BrickMesh::MemoryBytes() of a decoded mesh with these counts (decoding allocates exactly this).
-uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals, bool has_uvs);
+uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
+                      bool has_uvs);
 
 /// LZ4-compresses a side section: uint64 raw size, then one LZ4 block.
 std::string CompressSideSection(std::string_view raw);

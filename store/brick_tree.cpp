@@ -21,30 +21,37 @@ Status BrickTree::Validate(uint32_t brick_count) const {
     while (!stack.empty()) {
         const auto [n, depth] = stack.back();
         stack.pop_back();
-        if (seen_node[n]) return DataLossError("brick tree node {} is reached twice (a cycle or shared child)", n);
+        if (seen_node[n])
+            return DataLossError("brick tree node {} is reached twice (a cycle or shared child)",
+                                 n);
         seen_node[n] = 1;
         // Traverse keeps at most one pending node per level on a fixed stack.
         if (depth >= kMaxDepth) {
-            return DataLossError("brick tree node {} is at depth {}, deeper than the limit {}", n, depth, kMaxDepth);
+            return DataLossError("brick tree node {} is at depth {}, deeper than the limit {}", n,
+                                 depth, kMaxDepth);
         }
         const BrickTreeNode& node = nodes_[n];
         if (node.IsLeaf()) {
             if (node.brick == kNoBrick) continue;
             if (node.brick >= brick_count) {
-                return DataLossError("brick tree leaf {} names brick {} but the store has {} bricks", n,
-                                     node.brick, brick_count);
+                return DataLossError(
+                    "brick tree leaf {} names brick {} but the store has {} bricks", n, node.brick,
+                    brick_count);
             }
-            if (seen_brick[node.brick]) return DataLossError("brick {} appears in two brick tree leaves", node.brick);
+            if (seen_brick[node.brick])
+                return DataLossError("brick {} appears in two brick tree leaves", node.brick);
             seen_brick[node.brick] = 1;
             continue;
         }
-        if (node.axis > 3) return DataLossError("brick tree node {} has axis {} (expected 0..3)", n, node.axis);
+        if (node.axis > 3)
+            return DataLossError("brick tree node {} has axis {} (expected 0..3)", n, node.axis);
         if (!std::isfinite(node.split)) {
             return DataLossError("brick tree node {} has a split plane at {}", n, node.split);
         }
         for (uint32_t c : node.child) {
             if (c == 0 || c >= nodes_.size()) {
-                return DataLossError("brick tree node {} has child {} out of range [1, {})", n, c, nodes_.size());
+                return DataLossError("brick tree node {} has child {} out of range [1, {})", n, c,
+                                     nodes_.size());
             }
             stack.push_back({c, depth + 1});
         }
@@ -86,7 +93,8 @@ std::vector<Bounds3f> BrickTree::BrickCells(uint32_t brick_count) const {
 void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, float t_max,
                          const std::function<bool(uint32_t, float, float)>& visit) const {
     if (nodes_.empty()) return;
-    // Clip the ray to the root box (slab test), then walk the kd-tree front to back with an explicit stack.
+    // Clip the ray to the root box (slab test), then walk the kd-tree front to back with an
+    // explicit stack.
     float t0 = t_min, t1 = t_max;
     for (int a = 0; a < 3; ++a) {
         float inv = 1.0f / dir[a];
@@ -116,8 +124,8 @@ void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, flo
             const int axis = node.axis;
             const float o = origin[axis];
             const float d = dir[axis];
-            // The child that holds the ray's start (ties go to the upper cell, as in Locate, unless the ray
-            // moves downward from the plane).
+            // The child that holds the ray's start (ties go to the upper cell, as in Locate, unless
+            // the ray moves downward from the plane).
             const bool start_above = o > node.split || (o == node.split && d >= 0);
             uint32_t first = node.child[start_above ? 1 : 0];
             uint32_t second = node.child[start_above ? 0 : 1];

@@ -10,8 +10,8 @@
 namespace nave::store::format {
 namespace {
 
-// Upper bounds that keep a corrupt count from turning into a huge allocation before a checksum or size
-// check can catch it.
+// Upper bounds that keep a corrupt count from turning into a huge allocation before a checksum or
+// size check can catch it.
 constexpr uint32_t kMaxStringBytes = 1u << 24;
 constexpr uint32_t kMaxHeaderBytes = 1u << 16;
 
@@ -56,8 +56,8 @@ void ByteWriter::PutString(std::string_view s) {
 
 Status ByteReader::Need(size_t n) const {
     if (n > bytes_.size() - pos_) {
-        return DataLossError("{} @0x{:x}: need {} bytes but only {} remain in the table", what_, file_pos(), n,
-                             bytes_.size() - pos_);
+        return DataLossError("{} @0x{:x}: need {} bytes but only {} remain in the table", what_,
+                             file_pos(), n, bytes_.size() - pos_);
     }
     return Status::Ok();
 }
@@ -73,7 +73,8 @@ Status ByteReader::GetString(std::string* s) {
     const uint64_t at = file_pos();
     NAVE_RETURN_IF_ERROR(Get(&n));
     if (n > kMaxStringBytes) {
-        return DataLossError("{} @0x{:x}: string length {} exceeds the limit {}", what_, at, n, kMaxStringBytes);
+        return DataLossError("{} @0x{:x}: string length {} exceeds the limit {}", what_, at, n,
+                             kMaxStringBytes);
     }
     NAVE_RETURN_IF_ERROR(Need(n));
     s->assign(bytes_.data() + pos_, n);
@@ -87,7 +88,8 @@ Status ByteReader::Skip(size_t n) {
     return Status::Ok();
 }
 
-// ---- header -------------------------------------------------------------------------------------------
+// ---- header
+// -------------------------------------------------------------------------------------------
 
 std::string EncodeHeader(const RawHeader& h) {
     ByteWriter w;
@@ -118,29 +120,34 @@ std::string EncodeHeader(const RawHeader& h) {
     return std::move(w.bytes());
 }
 
-StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name, uint64_t file_bytes) {
-    // Magic and version come first and are checked before anything else is trusted: a future major version
-    // may lay out everything after the 16-byte prefix differently.
+StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name,
+                                 uint64_t file_bytes) {
+    // Magic and version come first and are checked before anything else is trusted: a future major
+    // version may lay out everything after the 16-byte prefix differently.
     if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
         const size_t n = std::min(bytes.size(), sizeof(kMagic));
         if (n < sizeof(kMagic) && std::memcmp(bytes.data(), kMagic, n) == 0) {
-            return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)", name,
-                                 file_bytes, kHeaderBytes);
+            return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)",
+                                 name, file_bytes, kHeaderBytes);
         }
-        if (n == sizeof(kMagic) && std::all_of(bytes.begin(), bytes.begin() + n, [](char c) { return c == 0; })) {
-            // The writer's placeholder: the header is written last, so this store was never finished.
-            return DataLossError("{}: the header is all zeros: the store's writing never finished", name);
+        if (n == sizeof(kMagic) &&
+            std::all_of(bytes.begin(), bytes.begin() + n, [](char c) { return c == 0; })) {
+            // The writer's placeholder: the header is written last, so this store was never
+            // finished.
+            return DataLossError("{}: the header is all zeros: the store's writing never finished",
+                                 name);
         }
         std::string found;
         for (size_t i = 0; i < n; ++i) {
             const unsigned char c = static_cast<unsigned char>(bytes[i]);
-            found += (c >= 32 && c < 127) ? fmt::format("{}", char(c)) : fmt::format("\\x{:02x}", c);
+            found +=
+                (c >= 32 && c < 127) ? fmt::format("{}", char(c)) : fmt::format("\\x{:02x}", c);
         }
         return UnsupportedError("{}: not a nave store: magic \"{}\" != \"NAVESTOR\"", name, found);
     }
     if (bytes.size() < kHeaderPrefixBytes) {
-        return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)", name, file_bytes,
-                             kHeaderBytes);
+        return DataLossError("{}: truncated: {} bytes, too short for a store header ({} bytes)",
+                             name, file_bytes, kHeaderBytes);
     }
     ByteReader r(bytes, name + " header", 0);
     NAVE_RETURN_IF_ERROR(r.Skip(sizeof(kMagic)));
@@ -149,27 +156,30 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     NAVE_RETURN_IF_ERROR(r.Get(&h.minor));
     if (h.major != kFormatMajor) {
         return UnsupportedError(
-            "{}: store format version {}.{} cannot be read by this nave, which reads version {}.x (up to {}.{}); "
+            "{}: store format version {}.{} cannot be read by this nave, which reads version {}.x "
+            "(up to {}.{}); "
             "{}",
             name, h.major, h.minor, kFormatMajor, kFormatMajor, kFormatMinor,
-            h.major > kFormatMajor ? "use a newer nave" : "re-create the store with `nave preprocess`");
+            h.major > kFormatMajor ? "use a newer nave"
+                                   : "re-create the store with `nave preprocess`");
     }
     NAVE_RETURN_IF_ERROR(r.Get(&h.header_bytes));
     if (h.header_bytes < kHeaderBytes || h.header_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} @0x{:x}: header size {} out of range [{}, {}]", name, 12, h.header_bytes,
-                             kHeaderBytes, kMaxHeaderBytes);
+        return DataLossError("{} @0x{:x}: header size {} out of range [{}, {}]", name, 12,
+                             h.header_bytes, kHeaderBytes, kMaxHeaderBytes);
     }
     if (bytes.size() < h.header_bytes) {
-        return DataLossError("{}: truncated: {} bytes, too short for its {}-byte header", name, file_bytes,
-                             h.header_bytes);
+        return DataLossError("{}: truncated: {} bytes, too short for its {}-byte header", name,
+                             file_bytes, h.header_bytes);
     }
     uint64_t stored_checksum = 0;
     std::memcpy(&stored_checksum, bytes.data() + h.header_bytes - 8, 8);
     const uint64_t checksum = Checksum64(bytes.data(), h.header_bytes - 8);
     if (checksum != stored_checksum) {
-        return DataLossError("{} header @0x0: checksum {} != stored {} (the header is corrupt, or the file was "
-                             "not completely written)",
-                             name, ChecksumHex(checksum), ChecksumHex(stored_checksum));
+        return DataLossError(
+            "{} header @0x0: checksum {} != stored {} (the header is corrupt, or the file was "
+            "not completely written)",
+            name, ChecksumHex(checksum), ChecksumHex(stored_checksum));
     }
     NAVE_RETURN_IF_ERROR(r.Get(&h.file_bytes));
     NAVE_RETURN_IF_ERROR(r.Get(&h.grid.origin.x));
@@ -191,21 +201,26 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.tree));
     NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.materials));
 
-    // The checksum matched, so what follows catches writer bugs and files cut or extended after writing.
+    // The checksum matched, so what follows catches writer bugs and files cut or extended after
+    // writing.
     if (h.file_bytes != file_bytes) {
-        return DataLossError("{}: the file has {} bytes but its header says {} ({})", name, file_bytes,
-                             h.file_bytes, file_bytes < h.file_bytes ? "truncated" : "extra bytes appended");
+        return DataLossError("{}: the file has {} bytes but its header says {} ({})", name,
+                             file_bytes, h.file_bytes,
+                             file_bytes < h.file_bytes ? "truncated" : "extra bytes appended");
     }
     if (!(h.grid.step > 0) || !std::isfinite(h.grid.step) || !IsFinite(h.grid.origin)) {
-        return DataLossError("{} header: invalid grid (origin {}, step {})", name, fmt::streamed(h.grid.origin), h.grid.step);
+        return DataLossError("{} header: invalid grid (origin {}, step {})", name,
+                             fmt::streamed(h.grid.origin), h.grid.step);
     }
-    if (h.directory_entry_bytes < kDirectoryEntryBytes || h.directory_entry_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} header: directory entry size {} < {} (the minimum for version {}.x)", name,
-                             h.directory_entry_bytes, kDirectoryEntryBytes, kFormatMajor);
+    if (h.directory_entry_bytes < kDirectoryEntryBytes ||
+        h.directory_entry_bytes > kMaxHeaderBytes) {
+        return DataLossError(
+            "{} header: directory entry size {} < {} (the minimum for version {}.x)", name,
+            h.directory_entry_bytes, kDirectoryEntryBytes, kFormatMajor);
     }
     if (h.tree_node_bytes < kTreeNodeBytes || h.tree_node_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} header: tree node size {} < {} (the minimum for version {}.x)", name,
-                             h.tree_node_bytes, kTreeNodeBytes, kFormatMajor);
+        return DataLossError("{} header: tree node size {} < {} (the minimum for version {}.x)",
+                             name, h.tree_node_bytes, kTreeNodeBytes, kFormatMajor);
     }
     struct Named {
         const char* what;
@@ -215,24 +230,28 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
                            Named{"tree", &h.tree}, Named{"materials", &h.materials}}) {
         if (t.ref->offset < h.header_bytes || t.ref->offset > file_bytes ||
             t.ref->length > file_bytes - t.ref->offset) {
-            return DataLossError("{} header: {} table [0x{:x}, +{}) lies outside the file's data [0x{:x}, 0x{:x})",
-                                 name, t.what, t.ref->offset, t.ref->length, h.header_bytes, file_bytes);
+            return DataLossError(
+                "{} header: {} table [0x{:x}, +{}) lies outside the file's data [0x{:x}, 0x{:x})",
+                name, t.what, t.ref->offset, t.ref->length, h.header_bytes, file_bytes);
         }
     }
     const uint64_t expected_dir = uint64_t(h.brick_count) * h.directory_entry_bytes;
     if (h.directory.length != expected_dir) {
         return DataLossError("{} header: directory is {} bytes, expected {} bricks x {} = {}", name,
-                             h.directory.length, h.brick_count, h.directory_entry_bytes, expected_dir);
+                             h.directory.length, h.brick_count, h.directory_entry_bytes,
+                             expected_dir);
     }
     const uint64_t expected_tree = 24 + uint64_t(h.tree_node_count) * h.tree_node_bytes;
     if (h.tree.length != expected_tree) {
-        return DataLossError("{} header: tree table is {} bytes, expected 24 + {} nodes x {} = {}", name,
-                             h.tree.length, h.tree_node_count, h.tree_node_bytes, expected_tree);
+        return DataLossError("{} header: tree table is {} bytes, expected 24 + {} nodes x {} = {}",
+                             name, h.tree.length, h.tree_node_count, h.tree_node_bytes,
+                             expected_tree);
     }
     return h;
 }
 
-// ---- provenance ---------------------------------------------------------------------------------------
+// ---- provenance
+// ---------------------------------------------------------------------------------------
 
 std::string EncodeProvenance(const StoreProvenance& p) {
     ByteWriter w;
@@ -243,15 +262,17 @@ std::string EncodeProvenance(const StoreProvenance& p) {
     return std::move(w.bytes());
 }
 
-StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::string& name, uint64_t offset) {
+StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::string& name,
+                                           uint64_t offset) {
     ByteReader r(bytes, name + " provenance", offset);
     StoreProvenance p;
     uint32_t n = 0;
     NAVE_RETURN_IF_ERROR(r.Get(&n));
-    // Each name takes at least its 4-byte length: a count beyond that is corrupt, whatever the checksum said.
+    // Each name takes at least its 4-byte length: a count beyond that is corrupt, whatever the
+    // checksum said.
     if (n > r.remaining() / 4) {
-        return DataLossError("{} @0x{:x}: {} source files cannot fit in {} bytes", r.what(), offset, n,
-                             bytes.size());
+        return DataLossError("{} @0x{:x}: {} source files cannot fit in {} bytes", r.what(), offset,
+                             n, bytes.size());
     }
     p.source_files.resize(n);
     for (std::string& f : p.source_files) NAVE_RETURN_IF_ERROR(r.GetString(&f));
@@ -261,7 +282,8 @@ StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::st
     return p;
 }
 
-// ---- directory ----------------------------------------------------------------------------------------
+// ---- directory
+// ----------------------------------------------------------------------------------------
 
 std::string EncodeDirectory(const std::vector<RawBrickEntry>& entries) {
     ByteWriter w;
@@ -302,30 +324,35 @@ StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, con
         e.info.has_normals = (e.flags & kBrickHasNormals) != 0;
         e.info.has_uvs = (e.flags & kBrickHasUvs) != 0;
         if (e.info.id != i) {
-            return DataLossError("{} brick {} @0x{:x}: directory entry says id {} (expected {})", name, i,
-                                 entry_offset, e.info.id, i);
+            return DataLossError("{} brick {} @0x{:x}: directory entry says id {} (expected {})",
+                                 name, i, entry_offset, e.info.id, i);
         }
-        for (const auto& [what, s] : {std::pair<const char*, const SectionInfo*>{"mesh", &e.info.mesh},
-                                      std::pair<const char*, const SectionInfo*>{"side", &e.info.side}}) {
+        for (const auto& [what, s] :
+             {std::pair<const char*, const SectionInfo*>{"mesh", &e.info.mesh},
+              std::pair<const char*, const SectionInfo*>{"side", &e.info.side}}) {
             if (s->length == 0) continue;
-            if (s->offset < h.header_bytes || s->offset > payload_end || s->length > payload_end - s->offset) {
+            if (s->offset < h.header_bytes || s->offset > payload_end ||
+                s->length > payload_end - s->offset) {
                 return DataLossError(
-                    "{} brick {} @0x{:x}: {} section [0x{:x}, +{}) lies outside the payload area [0x{:x}, 0x{:x})",
+                    "{} brick {} @0x{:x}: {} section [0x{:x}, +{}) lies outside the payload area "
+                    "[0x{:x}, 0x{:x})",
                     name, i, entry_offset, what, s->offset, s->length, h.header_bytes, payload_end);
             }
         }
         if (e.info.mesh.length == 0 && e.info.triangle_count > 0) {
-            return DataLossError("{} brick {} @0x{:x}: {} triangles but no mesh section", name, i, entry_offset,
-                                 e.info.triangle_count);
+            return DataLossError("{} brick {} @0x{:x}: {} triangles but no mesh section", name, i,
+                                 entry_offset, e.info.triangle_count);
         }
         if (!FiniteBounds(e.info.cell)) {
-            return DataLossError("{} brick {} @0x{:x}: cell {} is not finite", name, i, entry_offset, fmt::streamed(e.info.cell));
+            return DataLossError("{} brick {} @0x{:x}: cell {} is not finite", name, i,
+                                 entry_offset, fmt::streamed(e.info.cell));
         }
     }
     return entries;
 }
 
-// ---- tree ---------------------------------------------------------------------------------------------
+// ---- tree
+// ---------------------------------------------------------------------------------------------
 
 std::string EncodeTree(const BrickTree& tree) {
     ByteWriter w;
@@ -341,12 +368,14 @@ std::string EncodeTree(const BrickTree& tree) {
     return std::move(w.bytes());
 }
 
-StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h, const std::string& name) {
+StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h,
+                               const std::string& name) {
     ByteReader r(bytes, name + " tree", h.tree.offset);
     Bounds3f bounds;
     NAVE_RETURN_IF_ERROR(r.GetBounds(&bounds));
     if (!FiniteBounds(bounds)) {
-        return DataLossError("{} tree @0x{:x}: root bounds {} are not finite", name, h.tree.offset, fmt::streamed(bounds));
+        return DataLossError("{} tree @0x{:x}: root bounds {} are not finite", name, h.tree.offset,
+                             fmt::streamed(bounds));
     }
     std::vector<BrickTreeNode> nodes(h.tree_node_count);
     for (uint32_t i = 0; i < h.tree_node_count; ++i) {
@@ -366,7 +395,8 @@ StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h, const
     return tree;
 }
 
-// ---- materials ----------------------------------------------------------------------------------------
+// ---- materials
+// ----------------------------------------------------------------------------------------
 
 std::string EncodeMaterials(const std::vector<MaterialRecord>& materials) {
     ByteWriter w;
@@ -398,8 +428,8 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
     ByteReader table(bytes, name + " materials", h.materials.offset);
     // Each record takes at least its 4-byte length.
     if (h.material_count > bytes.size() / 4) {
-        return DataLossError("{} materials @0x{:x}: {} materials cannot fit in {} bytes", name, h.materials.offset,
-                             h.material_count, bytes.size());
+        return DataLossError("{} materials @0x{:x}: {} materials cannot fit in {} bytes", name,
+                             h.materials.offset, h.material_count, bytes.size());
     }
     std::vector<MaterialRecord> materials(h.material_count);
     for (uint32_t i = 0; i < h.material_count; ++i) {
@@ -407,11 +437,12 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
         const uint64_t at = table.file_pos();
         NAVE_RETURN_IF_ERROR(table.Get(&record_bytes));
         if (record_bytes > table.remaining()) {
-            return DataLossError("{} material {} @0x{:x}: record of {} bytes overruns the table ({} bytes left)",
-                                 name, i, at, record_bytes, table.remaining());
+            return DataLossError(
+                "{} material {} @0x{:x}: record of {} bytes overruns the table ({} bytes left)",
+                name, i, at, record_bytes, table.remaining());
         }
-        ByteReader r(bytes.substr(table.pos(), record_bytes), fmt::format("{} material {}", name, i),
-                     table.file_pos());
+        ByteReader r(bytes.substr(table.pos(), record_bytes),
+                     fmt::format("{} material {}", name, i), table.file_pos());
         NAVE_RETURN_IF_ERROR(table.Skip(record_bytes));
         MaterialRecord& m = materials[i];
         NAVE_RETURN_IF_ERROR(r.GetString(&m.name));
@@ -426,8 +457,8 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
         uint32_t texture_count = 0;
         NAVE_RETURN_IF_ERROR(r.Get(&texture_count));
         if (texture_count > r.remaining() / 8) {
-            return DataLossError("{} material {} @0x{:x}: {} textures cannot fit in {} bytes", name, i, at,
-                                 texture_count, r.remaining());
+            return DataLossError("{} material {} @0x{:x}: {} textures cannot fit in {} bytes", name,
+                                 i, at, texture_count, r.remaining());
         }
         for (uint32_t t = 0; t < texture_count; ++t) {
             std::string slot, path;
@@ -437,8 +468,8 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
         }
     }
     if (table.remaining() != 0) {
-        return DataLossError("{} materials @0x{:x}: {} bytes left after {} records", name, table.file_pos(),
-                             table.remaining(), h.material_count);
+        return DataLossError("{} materials @0x{:x}: {} bytes left after {} records", name,
+                             table.file_pos(), table.remaining(), h.material_count);
     }
     return materials;
 }

@@ -1,11 +1,12 @@
 #pragma once
-// The on-disk layout of a `.nave` store (internal to nave_store; docs/store-format.md is the reference).
-// Everything is little-endian. This file owns the byte layout of the header and of the tables; the brick
-// payloads (Draco + LZ4) are brick_codec's business.
+// The on-disk layout of a `.nave` store (internal to nave_store; docs/store-format.md is the
+// reference). Everything is little-endian. This file owns the byte layout of the header and of the
+// tables; the brick payloads (Draco + LZ4) are brick_codec's business.
 //
 //   [header, kHeaderBytes]  [brick payloads ...]  [provenance] [directory] [tree] [materials]
 //
-// The tables are written after the payloads and the header last, so a file cut anywhere fails to open.
+// The tables are written after the payloads and the header last, so a file cut anywhere fails to
+// open.
 
 #include <bit>
 #include <cstdint>
@@ -22,7 +23,8 @@
 
 namespace nave::store::format {
 
-static_assert(std::endian::native == std::endian::little, "the store format is little-endian; add byte swaps");
+static_assert(std::endian::native == std::endian::little,
+              "the store format is little-endian; add byte swaps");
 
 /// The first 8 bytes of every store.
 inline constexpr char kMagic[8] = {'N', 'A', 'V', 'E', 'S', 'T', 'O', 'R'};
@@ -93,10 +95,12 @@ class ByteWriter {
     std::string bytes_;
 };
 
-/// Reads little-endian values from a table with bounds checks; errors name the table and the file offset.
+/// Reads little-endian values from a table with bounds checks; errors name the table and the file
+/// offset.
 class ByteReader {
   public:
-    /// `what` names the table in errors ("abbey.nave directory"); `file_offset` is where `bytes` start.
+    /// `what` names the table in errors ("abbey.nave directory"); `file_offset` is where `bytes`
+    /// start.
     ByteReader(std::string_view bytes, std::string what, uint64_t file_offset)
         : bytes_(bytes), what_(std::move(what)), file_offset_(file_offset) {}
 
@@ -127,12 +131,15 @@ class ByteReader {
 
 /// Serializes the header into exactly `kHeaderBytes` bytes, its checksum in the last 8.
 std::string EncodeHeader(const RawHeader& h);
-/// Parses and checks a header read from the start of the file: magic, version (refusing another major,
-/// naming both), size, checksum. `name` is the file name for messages; `file_bytes` its actual size.
-StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name, uint64_t file_bytes);
+/// Parses and checks a header read from the start of the file: magic, version (refusing another
+/// major, naming both), size, checksum. `name` is the file name for messages; `file_bytes` its
+/// actual size.
+StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name,
+                                 uint64_t file_bytes);
 
 std::string EncodeProvenance(const StoreProvenance& p);
-StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::string& name, uint64_t offset);
+StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::string& name,
+                                           uint64_t offset);
 
 std::string EncodeDirectory(const std::vector<RawBrickEntry>& entries);
 StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, const RawHeader& h,

@@ -29,8 +29,8 @@ struct Store::Impl {
         NAVE_RETURN_IF_ERROR(file.ReadAt(ref.offset, bytes.data(), bytes.size()));
         const uint64_t checksum = Checksum64(bytes.data(), bytes.size());
         if (checksum != ref.checksum) {
-            return DataLossError("{} {} table @0x{:x}: checksum {} != stored {}", name, what, ref.offset,
-                                 ChecksumHex(checksum), ChecksumHex(ref.checksum));
+            return DataLossError("{} {} table @0x{:x}: checksum {} != stored {}", name, what,
+                                 ref.offset, ChecksumHex(checksum), ChecksumHex(ref.checksum));
         }
         return bytes;
     }
@@ -39,12 +39,14 @@ struct Store::Impl {
     StatusOr<std::string> ReadSection(uint32_t id, const char* what, const SectionInfo& s) const {
         std::string bytes(s.length, '\0');
         Status read = file.ReadAt(s.offset, bytes.data(), bytes.size());
-        if (!read.ok()) return read.WithContext(fmt::format("{} brick {} @0x{:x} {} section", name, id, s.offset, what));
+        if (!read.ok())
+            return read.WithContext(
+                fmt::format("{} brick {} @0x{:x} {} section", name, id, s.offset, what));
         bytes_read.fetch_add(s.length, std::memory_order_relaxed);
         const uint64_t checksum = Checksum64(bytes.data(), bytes.size());
         if (checksum != s.checksum) {
-            return DataLossError("{} brick {} @0x{:x}: {} checksum {} != stored {}", name, id, s.offset, what,
-                                 ChecksumHex(checksum), ChecksumHex(s.checksum));
+            return DataLossError("{} brick {} @0x{:x}: {} checksum {} != stored {}", name, id,
+                                 s.offset, what, ChecksumHex(checksum), ChecksumHex(s.checksum));
         }
         return bytes;
     }
@@ -62,8 +64,9 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
     const ReadOnlyFile& file = impl->file;
     const uint64_t size = file.size();
     if (size == 0) {
-        return DataLossError("{}: empty file (0 bytes): not a nave store, or one whose writing never finished",
-                             name);
+        return DataLossError(
+            "{}: empty file (0 bytes): not a nave store, or one whose writing never finished",
+            name);
     }
     // The header records its own size; read enough for any header a 1.x writer may produce.
     std::string head(std::min<uint64_t>(size, 1u << 16), '\0');
@@ -71,7 +74,8 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
     NAVE_ASSIGN_OR_RETURN(impl->raw, format::DecodeHeader(head, name, size));
     const format::RawHeader& h = impl->raw;
 
-    NAVE_ASSIGN_OR_RETURN(std::string provenance_bytes, impl->ReadTable("provenance", h.provenance));
+    NAVE_ASSIGN_OR_RETURN(std::string provenance_bytes,
+                          impl->ReadTable("provenance", h.provenance));
     NAVE_ASSIGN_OR_RETURN(std::string directory_bytes, impl->ReadTable("directory", h.directory));
     NAVE_ASSIGN_OR_RETURN(std::string tree_bytes, impl->ReadTable("tree", h.tree));
     NAVE_ASSIGN_OR_RETURN(std::string material_bytes, impl->ReadTable("materials", h.materials));
@@ -97,26 +101,29 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
     for (const format::RawBrickEntry& e : entries) {
         const BrickInfo& b = e.info;
         const uint64_t entry_offset = h.directory.offset + uint64_t(b.id) * h.directory_entry_bytes;
-        const uint64_t expected = codec::DecodedBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
+        const uint64_t expected =
+            codec::DecodedBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
         if (b.decoded_bytes != expected) {
-            return DataLossError("{} brick {} @0x{:x}: decoded size {} != {} implied by its {} vertices and {} "
-                                 "triangles",
-                                 name, b.id, entry_offset, b.decoded_bytes, expected, b.vertex_count,
-                                 b.triangle_count);
+            return DataLossError(
+                "{} brick {} @0x{:x}: decoded size {} != {} implied by its {} vertices and {} "
+                "triangles",
+                name, b.id, entry_offset, b.decoded_bytes, expected, b.vertex_count,
+                b.triangle_count);
         }
         triangles += b.triangle_count;
         impl->bricks.push_back(b);
     }
     if (triangles != h.triangle_count) {
-        return DataLossError("{}: the bricks hold {} triangles but the header says {}", name, triangles,
-                             h.triangle_count);
+        return DataLossError("{}: the bricks hold {} triangles but the header says {}", name,
+                             triangles, h.triangle_count);
     }
     std::vector<uint8_t> in_tree(h.brick_count, 0);
     for (const BrickTreeNode& n : impl->tree.nodes()) {
         if (n.IsLeaf() && n.brick != kNoBrick) in_tree[n.brick] = 1;
     }
     for (uint32_t b = 0; b < h.brick_count; ++b) {
-        if (!in_tree[b]) return DataLossError("{} tree @0x{:x}: brick {} is in no leaf", name, h.tree.offset, b);
+        if (!in_tree[b])
+            return DataLossError("{} tree @0x{:x}: brick {} is in no leaf", name, h.tree.offset, b);
     }
     return std::unique_ptr<Store>(new Store(std::move(impl)));
 }
@@ -132,23 +139,27 @@ uint64_t Store::bytes_read() const { return impl_->bytes_read.load(std::memory_o
 StatusOr<BrickMesh> Store::ReadBrick(uint32_t id) const {
     const Impl& s = *impl_;
     if (id >= s.bricks.size()) {
-        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id, s.bricks.size());
+        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
+                             s.bricks.size());
     }
     const BrickInfo& info = s.bricks[id];
     const std::string what = fmt::format("{} brick {} @0x{:x}", s.name, id, info.mesh.offset);
     if (info.side.length > 0) {
-        // Format 1.0 defines no side-section content; verify it so corruption never passes silently.
+        // Format 1.0 defines no side-section content; verify it so corruption never passes
+        // silently.
         NAVE_ASSIGN_OR_RETURN(std::string side, s.ReadSection(id, "side", info.side));
         NAVE_RETURN_IF_ERROR(codec::DecompressSideSection(side, what).status());
     }
     NAVE_ASSIGN_OR_RETURN(std::string bytes, s.ReadSection(id, "mesh", info.mesh));
-    NAVE_ASSIGN_OR_RETURN(BrickMesh mesh, codec::DecodeMeshSection(bytes, s.header.grid, s.materials.size(), what));
+    NAVE_ASSIGN_OR_RETURN(BrickMesh mesh,
+                          codec::DecodeMeshSection(bytes, s.header.grid, s.materials.size(), what));
     if (mesh.TriangleCount() != info.triangle_count || mesh.VertexCount() != info.vertex_count ||
         mesh.HasNormals() != info.has_normals || mesh.HasUvs() != info.has_uvs) {
-        return DataLossError("{}: decoded {} triangles, {} vertices{}{} but the directory says {}, {}{}{}", what,
-                             mesh.TriangleCount(), mesh.VertexCount(), mesh.HasNormals() ? ", normals" : "",
-                             mesh.HasUvs() ? ", uvs" : "", info.triangle_count, info.vertex_count,
-                             info.has_normals ? ", normals" : "", info.has_uvs ? ", uvs" : "");
+        return DataLossError(
+            "{}: decoded {} triangles, {} vertices{}{} but the directory says {}, {}{}{}", what,
+            mesh.TriangleCount(), mesh.VertexCount(), mesh.HasNormals() ? ", normals" : "",
+            mesh.HasUvs() ? ", uvs" : "", info.triangle_count, info.vertex_count,
+            info.has_normals ? ", normals" : "", info.has_uvs ? ", uvs" : "");
     }
     return mesh;
 }
@@ -159,8 +170,9 @@ Status Store::VerifyBrick(uint32_t id) const {
     Bounds3f box;
     for (const Vec3f& p : mesh.positions) box.Extend(p);
     if (mesh.TriangleCount() > 0 && !(box == info.geometry_bounds)) {
-        return DataLossError("{} brick {} @0x{:x}: decoded geometry box {} != directory's {}", impl_->name, id,
-                             info.mesh.offset, fmt::streamed(box), fmt::streamed(info.geometry_bounds));
+        return DataLossError("{} brick {} @0x{:x}: decoded geometry box {} != directory's {}",
+                             impl_->name, id, info.mesh.offset, fmt::streamed(box),
+                             fmt::streamed(info.geometry_bounds));
     }
     return Status::Ok();
 }

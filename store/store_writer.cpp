@@ -14,7 +14,8 @@ namespace nave::store {
 
 Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count) {
     if (mesh.indices.size() % 3 != 0) {
-        return InvalidArgumentError("brick mesh has {} indices, not a multiple of 3", mesh.indices.size());
+        return InvalidArgumentError("brick mesh has {} indices, not a multiple of 3",
+                                    mesh.indices.size());
     }
     const size_t triangles = mesh.TriangleCount();
     const size_t vertices = mesh.VertexCount();
@@ -22,57 +23,68 @@ Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count) {
         return InvalidArgumentError("brick mesh has {} vertices, more than 2^32 - 1", vertices);
     }
     if (mesh.material_ids.size() != triangles) {
-        return InvalidArgumentError("brick mesh has {} material ids for {} triangles", mesh.material_ids.size(),
-                                    triangles);
+        return InvalidArgumentError("brick mesh has {} material ids for {} triangles",
+                                    mesh.material_ids.size(), triangles);
     }
     if (!mesh.normals.empty() && mesh.normals.size() != vertices) {
-        return InvalidArgumentError("brick mesh has {} normals for {} vertices (expected none or one each)",
-                                    mesh.normals.size(), vertices);
+        return InvalidArgumentError(
+            "brick mesh has {} normals for {} vertices (expected none or one each)",
+            mesh.normals.size(), vertices);
     }
     if (!mesh.uvs.empty() && mesh.uvs.size() != vertices) {
-        return InvalidArgumentError("brick mesh has {} texture coordinates for {} vertices (expected none or one "
-                                    "each)",
-                                    mesh.uvs.size(), vertices);
+        return InvalidArgumentError(
+            "brick mesh has {} texture coordinates for {} vertices (expected none or one "
+            "each)",
+            mesh.uvs.size(), vertices);
     }
     for (size_t i = 0; i < mesh.indices.size(); ++i) {
         if (mesh.indices[i] >= vertices) {
-            return InvalidArgumentError("brick mesh triangle {} corner {}: index {} out of range [0, {})", i / 3,
-                                        i % 3, mesh.indices[i], vertices);
+            return InvalidArgumentError(
+                "brick mesh triangle {} corner {}: index {} out of range [0, {})", i / 3, i % 3,
+                mesh.indices[i], vertices);
         }
     }
     for (size_t t = 0; t < triangles; ++t) {
         if (mesh.material_ids[t] >= material_count) {
-            return InvalidArgumentError("brick mesh triangle {}: material id {} out of range [0, {})", t,
-                                        mesh.material_ids[t], material_count);
+            return InvalidArgumentError(
+                "brick mesh triangle {}: material id {} out of range [0, {})", t,
+                mesh.material_ids[t], material_count);
         }
     }
     for (size_t v = 0; v < vertices; ++v) {
         if (!IsFinite(mesh.positions[v])) {
-            return InvalidArgumentError("brick mesh vertex {}: position {} is not finite", v, fmt::streamed(mesh.positions[v]));
+            return InvalidArgumentError("brick mesh vertex {}: position {} is not finite", v,
+                                        fmt::streamed(mesh.positions[v]));
         }
     }
     for (size_t v = 0; v < mesh.normals.size(); ++v) {
         const Vec3f& n = mesh.normals[v];
         const float len = Length(n);
-        // Normals are normalized before encoding; a zero or non-finite one has no direction to keep.
+        // Normals are normalized before encoding; a zero or non-finite one has no direction to
+        // keep.
         if (!IsFinite(n) || !(len > 1e-12f) || !std::isfinite(len)) {
-            return InvalidArgumentError("brick mesh vertex {}: normal {} has no direction (length {})", v, fmt::streamed(n), len);
+            return InvalidArgumentError(
+                "brick mesh vertex {}: normal {} has no direction (length {})", v, fmt::streamed(n),
+                len);
         }
     }
     for (size_t v = 0; v < mesh.uvs.size(); ++v) {
         if (!std::isfinite(mesh.uvs[v][0]) || !std::isfinite(mesh.uvs[v][1])) {
-            return InvalidArgumentError("brick mesh vertex {}: texture coordinates ({}, {}) are not finite", v,
-                                        mesh.uvs[v][0], mesh.uvs[v][1]);
+            return InvalidArgumentError(
+                "brick mesh vertex {}: texture coordinates ({}, {}) are not finite", v,
+                mesh.uvs[v][0], mesh.uvs[v][1]);
         }
     }
     return Status::Ok();
 }
 
-StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell, const GlobalGrid& grid,
-                                   const EncodeOptions& options) {
-    // Material ids are checked against the table when the store is finished (Finish knows the table).
+StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
+                                   const GlobalGrid& grid, const EncodeOptions& options) {
+    // Material ids are checked against the table when the store is finished (Finish knows the
+    // table).
     NAVE_RETURN_IF_ERROR(ValidateBrickMesh(mesh, size_t(0x7fffffff) + 1));
-    NAVE_ASSIGN_OR_RETURN(codec::EncodedMesh encoded, codec::EncodeMeshSection(mesh, grid, options));
+    NAVE_ASSIGN_OR_RETURN(codec::EncodedMesh encoded,
+                          codec::EncodeMeshSection(mesh, grid, options));
     EncodedBrick brick;
     brick.mesh_bytes = std::move(encoded.bytes);
     brick.cell = cell;
@@ -89,9 +101,10 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell, 
 
 namespace {
 
-Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h, const StoreProvenance& provenance,
-                            const std::vector<format::RawBrickEntry>& entries, const BrickTree& tree,
-                            const std::vector<MaterialRecord>& materials) {
+Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
+                            const StoreProvenance& provenance,
+                            const std::vector<format::RawBrickEntry>& entries,
+                            const BrickTree& tree, const std::vector<MaterialRecord>& materials) {
     auto write_table = [&](const std::string& bytes, format::TableRef* ref) -> Status {
         *ref = {file.size(), bytes.size(), Checksum64(bytes.data(), bytes.size())};
         return file.Write(bytes);
@@ -121,16 +134,20 @@ StoreWriter::StoreWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 StoreWriter::~StoreWriter() = default;  // AtomicFile removes the temporary file unless committed
 
 StatusOr<std::unique_ptr<StoreWriter>> StoreWriter::Create(const std::filesystem::path& path,
-                                                           const GlobalGrid& grid, StoreProvenance provenance) {
+                                                           const GlobalGrid& grid,
+                                                           StoreProvenance provenance) {
     if (!(grid.step > 0) || !std::isfinite(grid.step) || !IsFinite(grid.origin)) {
-        return InvalidArgumentError("{}: invalid grid: origin {}, step {} (the step must be finite and > 0)",
-                                    path.string(), fmt::streamed(grid.origin), grid.step);
+        return InvalidArgumentError(
+            "{}: invalid grid: origin {}, step {} (the step must be finite and > 0)", path.string(),
+            fmt::streamed(grid.origin), grid.step);
     }
     NAVE_ASSIGN_OR_RETURN(AtomicFile file, AtomicFile::Create(path));
-    // A zero header: until Finish() patches it, the file has no magic and can never open as a store.
+    // A zero header: until Finish() patches it, the file has no magic and can never open as a
+    // store.
     const std::string zeros(format::kHeaderBytes, '\0');
     NAVE_RETURN_IF_ERROR(file.Write(zeros));
-    auto impl = std::make_unique<Impl>(Impl{std::move(file), grid, std::move(provenance), {}, {}, false});
+    auto impl =
+        std::make_unique<Impl>(Impl{std::move(file), grid, std::move(provenance), {}, {}, false});
     return std::unique_ptr<StoreWriter>(new StoreWriter(std::move(impl)));
 }
 
@@ -140,15 +157,18 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
     NAVE_CHECK(!impl_->finished) << "StoreWriter::Append after Finish";
     const std::string& name = impl_->file.path().string();
     const uint32_t id = uint32_t(impl_->entries.size());
-    if (id == kNoBrick) return InvalidArgumentError("{}: too many bricks (at most {})", name, kNoBrick);
+    if (id == kNoBrick)
+        return InvalidArgumentError("{}: too many bricks (at most {})", name, kNoBrick);
     if (brick.mesh_bytes.size() < codec::kMeshPrefixBytes) {
-        return InvalidArgumentError("{}: brick {} has a mesh section of {} bytes; use EncodeBrick to make one",
-                                    name, id, brick.mesh_bytes.size());
+        return InvalidArgumentError(
+            "{}: brick {} has a mesh section of {} bytes; use EncodeBrick to make one", name, id,
+            brick.mesh_bytes.size());
     }
-    if (brick.decoded_bytes !=
-        codec::DecodedBytes(brick.vertex_count, brick.triangle_count, brick.has_normals, brick.has_uvs)) {
-        return InvalidArgumentError("{}: brick {}: decoded_bytes {} does not match its counts; use EncodeBrick",
-                                    name, id, brick.decoded_bytes);
+    if (brick.decoded_bytes != codec::DecodedBytes(brick.vertex_count, brick.triangle_count,
+                                                   brick.has_normals, brick.has_uvs)) {
+        return InvalidArgumentError(
+            "{}: brick {}: decoded_bytes {} does not match its counts; use EncodeBrick", name, id,
+            brick.decoded_bytes);
     }
     format::RawBrickEntry e;
     e.info.id = id;
@@ -159,7 +179,8 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
     e.info.decoded_bytes = brick.decoded_bytes;
     e.info.has_normals = brick.has_normals;
     e.info.has_uvs = brick.has_uvs;
-    e.flags = (brick.has_normals ? format::kBrickHasNormals : 0) | (brick.has_uvs ? format::kBrickHasUvs : 0);
+    e.flags = (brick.has_normals ? format::kBrickHasNormals : 0) |
+              (brick.has_uvs ? format::kBrickHasUvs : 0);
     e.info.mesh = {impl_->file.size(), brick.mesh_bytes.size(),
                    Checksum64(brick.mesh_bytes.data(), brick.mesh_bytes.size())};
     NAVE_RETURN_IF_ERROR(impl_->file.Write(brick.mesh_bytes));
@@ -180,7 +201,8 @@ Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const B
     const std::string name = w.file.path().string();
     const uint32_t brick_count = uint32_t(w.entries.size());
 
-    // Check everything before writing a byte of the tables, so a refused Finish can be fixed and retried.
+    // Check everything before writing a byte of the tables, so a refused Finish can be fixed and
+    // retried.
     if (materials.size() > 0xffffffffu) return InvalidArgumentError("{}: too many materials", name);
     std::set<std::string> names;
     for (size_t i = 0; i < materials.size(); ++i) {
@@ -191,13 +213,15 @@ Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const B
     }
     for (uint32_t b = 0; b < brick_count; ++b) {
         if (w.entries[b].info.triangle_count > 0 && w.max_material_ids[b] >= materials.size()) {
-            return InvalidArgumentError("{}: brick {} uses material {} but the material table has {} entries",
-                                        name, b, w.max_material_ids[b], materials.size());
+            return InvalidArgumentError(
+                "{}: brick {} uses material {} but the material table has {} entries", name, b,
+                w.max_material_ids[b], materials.size());
         }
     }
     if (tree.nodes().empty()) return InvalidArgumentError("{}: the brick tree has no nodes", name);
     if (!IsFinite(tree.bounds().min) || !IsFinite(tree.bounds().max) || tree.bounds().Empty()) {
-        return InvalidArgumentError("{}: the brick tree's bounds {} are not a finite box", name, fmt::streamed(tree.bounds()));
+        return InvalidArgumentError("{}: the brick tree's bounds {} are not a finite box", name,
+                                    fmt::streamed(tree.bounds()));
     }
     Status valid = tree.Validate(brick_count);
     if (!valid.ok()) return Status(StatusCode::kInvalidArgument, name + ": " + valid.message());
@@ -207,12 +231,14 @@ Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const B
     }
     const std::vector<Bounds3f> cells = tree.BrickCells(brick_count);
     for (uint32_t b = 0; b < brick_count; ++b) {
-        if (!in_tree[b]) return InvalidArgumentError("{}: brick {} is in no leaf of the brick tree", name, b);
+        if (!in_tree[b])
+            return InvalidArgumentError("{}: brick {} is in no leaf of the brick tree", name, b);
         // The tree is the authority on cells; a brick appended without a cell takes the tree's.
         const Bounds3f& cell = w.entries[b].info.cell;
         if (!cell.Empty() && !(cell == cells[b])) {
-            return InvalidArgumentError("{}: brick {} was appended with cell {} but its tree leaf's cell is {}",
-                                        name, b, fmt::streamed(cell), fmt::streamed(cells[b]));
+            return InvalidArgumentError(
+                "{}: brick {} was appended with cell {} but its tree leaf's cell is {}", name, b,
+                fmt::streamed(cell), fmt::streamed(cells[b]));
         }
     }
     for (uint32_t b = 0; b < brick_count; ++b) w.entries[b].info.cell = cells[b];
@@ -228,13 +254,12 @@ Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const B
         if (e.info.triangle_count > 0) h.bounds.Extend(e.info.geometry_bounds);
     }
 
-    // From here on a failure abandons the file: tables after the payloads, each with its checksum, then
-    // the header at offset 0, then fsync and rename.
+    // From here on a failure abandons the file: tables after the payloads, each with its checksum,
+    // then the header at offset 0, then fsync and rename.
     w.finished = true;
     Status written = WriteTablesAndCommit(w.file, h, w.provenance, w.entries, tree, materials);
     if (!written.ok()) w.file.Abandon();
     return written;
 }
-
 
 }  // namespace nave::store

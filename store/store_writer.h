@@ -19,7 +19,7 @@ namespace nave::store {
 
 /// Encoder settings. Defaults and why: docs/store-format.md.
 struct EncodeOptions {
-    int draco_speed = 5;        ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
+    int draco_speed = 6;        ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
     int normal_bits = 10;       ///< octahedral quantization of normals
     int uv_bits = 14;           ///< quantization of texture coordinates
 };

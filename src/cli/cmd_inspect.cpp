@@ -1,11 +1,12 @@
-// `nave inspect FILE [--json] [--bricks]`: what a brick store holds, read from its header and tables only
-// (no brick is decoded): bricks, triangles, bytes, bounds, grid and error bound, materials, provenance.
+// `nave inspect FILE [--json] [--bricks]`: what a brick store holds, read from its header and
+// tables only (no brick is decoded): bricks, triangles, bytes, bounds, grid and error bound,
+// materials, provenance.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "core/memory.h"
@@ -19,10 +20,18 @@ std::string JsonString(const std::string& s) {
     std::string out = "\"";
     for (const char c : s) {
         switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
             default:
                 if (static_cast<unsigned char>(c) < 0x20) {
                     out += fmt::format("\\u{:04x}", int(c));
@@ -60,7 +69,8 @@ Summary Summarize(const store::Store& s) {
         sum.decoded_bytes += b.decoded_bytes;
         sum.vertices += b.vertex_count;
         sum.empty += b.triangle_count == 0 ? 1 : 0;
-        if (sum.largest == store::kNoBrick || b.triangle_count > s.bricks()[sum.largest].triangle_count) {
+        if (sum.largest == store::kNoBrick ||
+            b.triangle_count > s.bricks()[sum.largest].triangle_count) {
             sum.largest = b.id;
         }
     }
@@ -70,7 +80,8 @@ Summary Summarize(const store::Store& s) {
 void PrintJson(const store::Store& s, bool list_bricks) {
     const store::StoreHeader& h = s.header();
     const Summary sum = Summarize(s);
-    const double per_triangle = h.triangle_count ? double(s.file_size()) / double(h.triangle_count) : 0.0;
+    const double per_triangle =
+        h.triangle_count ? double(s.file_size()) / double(h.triangle_count) : 0.0;
     std::string out = "{\n";
     out += fmt::format("  \"file\": {},\n", JsonString(s.path().string()));
     out += fmt::format("  \"format_version\": \"{}.{}\",\n", h.major, h.minor);
@@ -83,21 +94,27 @@ void PrintJson(const store::Store& s, bool list_bricks) {
     out += fmt::format("  \"payload_bytes\": {},\n", sum.payload_bytes);
     out += fmt::format("  \"decoded_bytes\": {},\n", sum.decoded_bytes);
     out += fmt::format("  \"bytes_per_triangle\": {:.4f},\n", per_triangle);
-    out += fmt::format("  \"bounds\": {{\"min\": {}, \"max\": {}}},\n", JsonVec(h.bounds.min), JsonVec(h.bounds.max));
-    out += fmt::format("  \"grid\": {{\"origin\": {}, \"step\": {}, \"max_axis_error\": {}, \"max_error\": {}}},\n",
-                       JsonVec(h.grid.origin), h.grid.step, h.grid.MaxAxisError(),
-                       h.grid.MaxAxisError() * std::sqrt(3.0));
+    out += fmt::format("  \"bounds\": {{\"min\": {}, \"max\": {}}},\n", JsonVec(h.bounds.min),
+                       JsonVec(h.bounds.max));
+    out += fmt::format(
+        "  \"grid\": {{\"origin\": {}, \"step\": {}, \"max_axis_error\": {}, \"max_error\": "
+        "{}}},\n",
+        JsonVec(h.grid.origin), h.grid.step, h.grid.MaxAxisError(),
+        h.grid.MaxAxisError() * std::sqrt(3.0));
     if (sum.largest != store::kNoBrick) {
         const store::BrickInfo& b = s.bricks()[sum.largest];
-        out += fmt::format("  \"largest_brick\": {{\"id\": {}, \"triangles\": {}, \"vertices\": {}, \"bytes\": {}, "
-                           "\"decoded_bytes\": {}}},\n",
-                           b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(), b.decoded_bytes);
+        out += fmt::format(
+            "  \"largest_brick\": {{\"id\": {}, \"triangles\": {}, \"vertices\": {}, \"bytes\": "
+            "{}, "
+            "\"decoded_bytes\": {}}},\n",
+            b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(), b.decoded_bytes);
     }
     out += "  \"materials\": [";
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
-        out += fmt::format("{}\n    {{\"id\": {}, \"name\": {}, \"diffuse\": [{}, {}, {}], \"textures\": {{", i ? "," : "",
-                           i, JsonString(m.name), m.diffuse[0], m.diffuse[1], m.diffuse[2]);
+        out += fmt::format(
+            "{}\n    {{\"id\": {}, \"name\": {}, \"diffuse\": [{}, {}, {}], \"textures\": {{",
+            i ? "," : "", i, JsonString(m.name), m.diffuse[0], m.diffuse[1], m.diffuse[2]);
         bool first = true;
         for (const auto& [slot, path] : m.textures) {
             out += fmt::format("{}{}: {}", first ? "" : ", ", JsonString(slot), JsonString(path));
@@ -110,15 +127,16 @@ void PrintJson(const store::Store& s, bool list_bricks) {
     for (size_t i = 0; i < h.provenance.source_files.size(); ++i) {
         out += (i ? ", " : "") + JsonString(h.provenance.source_files[i]);
     }
-    out += fmt::format("], \"tool_version\": {}, \"options\": {}}}", JsonString(h.provenance.tool_version),
-                       JsonString(h.provenance.options));
+    out += fmt::format("], \"tool_version\": {}, \"options\": {}}}",
+                       JsonString(h.provenance.tool_version), JsonString(h.provenance.options));
     if (list_bricks) {
         out += ",\n  \"brick_list\": [";
         for (const store::BrickInfo& b : s.bricks()) {
-            out += fmt::format("{}\n    {{\"id\": {}, \"triangles\": {}, \"vertices\": {}, \"bytes\": {}, "
-                               "\"offset\": {}, \"cell\": {{\"min\": {}, \"max\": {}}}}}",
-                               b.id ? "," : "", b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(),
-                               b.mesh.offset, JsonVec(b.cell.min), JsonVec(b.cell.max));
+            out += fmt::format(
+                "{}\n    {{\"id\": {}, \"triangles\": {}, \"vertices\": {}, \"bytes\": {}, "
+                "\"offset\": {}, \"cell\": {{\"min\": {}, \"max\": {}}}}}",
+                b.id ? "," : "", b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(),
+                b.mesh.offset, JsonVec(b.cell.min), JsonVec(b.cell.max));
         }
         out += s.bricks().empty() ? "]" : "\n  ]";
     }
@@ -133,49 +151,59 @@ void PrintText(const store::Store& s, bool list_bricks) {
     out += fmt::format("{}: nave brick store, format {}.{}\n", s.path().string(), h.major, h.minor);
     out += fmt::format("  bricks       {}{}\n", s.bricks().size(),
                        sum.empty ? fmt::format(" ({} without triangles)", sum.empty) : "");
-    const double duplicated = h.source_triangle_count
-                                  ? 100.0 * (double(h.triangle_count) - double(h.source_triangle_count)) /
-                                        double(h.source_triangle_count)
-                                  : 0.0;
-    out += fmt::format("  triangles    {} stored ({}), {} in the source ({:+.2f} % from cutting into bricks "
-                       "and dropping triangles that collapse on the grid)\n",
-                       FormatCount(double(h.triangle_count)), h.triangle_count,
-                       FormatCount(double(h.source_triangle_count)), duplicated);
+    const double duplicated =
+        h.source_triangle_count
+            ? 100.0 * (double(h.triangle_count) - double(h.source_triangle_count)) /
+                  double(h.source_triangle_count)
+            : 0.0;
+    out += fmt::format(
+        "  triangles    {} stored ({}), {} in the source ({:+.2f} % from cutting into bricks "
+        "and dropping triangles that collapse on the grid)\n",
+        FormatCount(double(h.triangle_count)), h.triangle_count,
+        FormatCount(double(h.source_triangle_count)), duplicated);
     out += fmt::format("  vertices     {}\n", FormatCount(double(sum.vertices)));
     out += fmt::format("  on disk      {} ({} bytes), {:.2f} bytes/triangle; brick payloads {}\n",
                        FormatBytes(s.file_size()), s.file_size(),
                        h.triangle_count ? double(s.file_size()) / double(h.triangle_count) : 0.0,
                        FormatBytes(sum.payload_bytes));
-    out += fmt::format("  decoded      {} if every brick were resident\n", FormatBytes(sum.decoded_bytes));
+    out += fmt::format("  decoded      {} if every brick were resident\n",
+                       FormatBytes(sum.decoded_bytes));
     out += fmt::format("  bounds       {} - {} (size {})\n", Vec(h.bounds.min), Vec(h.bounds.max),
                        Vec(h.bounds.Empty() ? Vec3f{} : h.bounds.Diagonal()));
-    out += fmt::format("  grid         step {}, origin ({}, {}, {}); max position error {} per axis, {} in length\n",
-                       Length(h.grid.step), h.grid.origin.x, h.grid.origin.y, h.grid.origin.z,
-                       Length(h.grid.MaxAxisError()), Length(h.grid.MaxAxisError() * std::sqrt(3.0)));
+    out += fmt::format(
+        "  grid         step {}, origin ({}, {}, {}); max position error {} per axis, {} in "
+        "length\n",
+        Length(h.grid.step), h.grid.origin.x, h.grid.origin.y, h.grid.origin.z,
+        Length(h.grid.MaxAxisError()), Length(h.grid.MaxAxisError() * std::sqrt(3.0)));
     if (sum.largest != store::kNoBrick) {
         const store::BrickInfo& b = s.bricks()[sum.largest];
-        out += fmt::format("  largest      brick {}: {} triangles, {} vertices, {} on disk, {} decoded\n", b.id,
-                           FormatCount(double(b.triangle_count)), FormatCount(double(b.vertex_count)),
-                           FormatBytes(b.BytesOnDisk()), FormatBytes(b.decoded_bytes));
+        out += fmt::format(
+            "  largest      brick {}: {} triangles, {} vertices, {} on disk, {} decoded\n", b.id,
+            FormatCount(double(b.triangle_count)), FormatCount(double(b.vertex_count)),
+            FormatBytes(b.BytesOnDisk()), FormatBytes(b.decoded_bytes));
     }
     out += fmt::format("  materials    {}\n", s.materials().size());
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
         std::string textures;
         for (const auto& [slot, path] : m.textures) textures += fmt::format(" {}={}", slot, path);
-        out += fmt::format("    {:>4}  {:<24} diffuse ({:.3f}, {:.3f}, {:.3f}){}\n", i, m.name, m.diffuse[0],
-                           m.diffuse[1], m.diffuse[2], textures);
+        out += fmt::format("    {:>4}  {:<24} diffuse ({:.3f}, {:.3f}, {:.3f}){}\n", i, m.name,
+                           m.diffuse[0], m.diffuse[1], m.diffuse[2], textures);
     }
     std::string sources;
-    for (const std::string& f : h.provenance.source_files) sources += (sources.empty() ? "" : ", ") + f;
+    for (const std::string& f : h.provenance.source_files)
+        sources += (sources.empty() ? "" : ", ") + f;
     out += fmt::format("  sources      {}\n", sources.empty() ? "(none recorded)" : sources);
-    out += fmt::format("  made by      {}\n", h.provenance.tool_version.empty() ? "(unknown)" : h.provenance.tool_version);
-    out += fmt::format("  options      {}\n", h.provenance.options.empty() ? "(none)" : h.provenance.options);
+    out += fmt::format("  made by      {}\n",
+                       h.provenance.tool_version.empty() ? "(unknown)" : h.provenance.tool_version);
+    out += fmt::format("  options      {}\n",
+                       h.provenance.options.empty() ? "(none)" : h.provenance.options);
     if (list_bricks) {
         out += "  id        triangles    vertices       bytes       offset  cell\n";
         for (const store::BrickInfo& b : s.bricks()) {
-            out += fmt::format("  {:<8} {:>10} {:>11} {:>11}  0x{:<10x} {} - {}\n", b.id, b.triangle_count,
-                               b.vertex_count, b.BytesOnDisk(), b.mesh.offset, Vec(b.cell.min), Vec(b.cell.max));
+            out += fmt::format("  {:<8} {:>10} {:>11} {:>11}  0x{:<10x} {} - {}\n", b.id,
+                               b.triangle_count, b.vertex_count, b.BytesOnDisk(), b.mesh.offset,
+                               Vec(b.cell.min), Vec(b.cell.max));
         }
     }
     std::fputs(out.c_str(), stdout);
@@ -184,14 +212,16 @@ void PrintText(const store::Store& s, bool list_bricks) {
 }  // namespace
 
 void RegisterInspectCommand(CLI::App& app, CommandRun& run) {
-    CLI::App* cmd = app.add_subcommand(
-        "inspect", "Describe a brick store: bricks, triangles, bytes, bounds, grid and error, materials, provenance");
+    CLI::App* cmd = app.add_subcommand("inspect",
+                                       "Describe a brick store: bricks, triangles, bytes, bounds, "
+                                       "grid and error, materials, provenance");
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     auto bricks = std::make_shared<bool>(false);
     cmd->add_option("FILE", *file, "The .nave store")->required();
     cmd->add_flag("--json", *json, "Print JSON on stdout instead of text");
-    cmd->add_flag("--bricks", *bricks, "Also list every brick (id, triangles, vertices, bytes, offset, cell)");
+    cmd->add_flag("--bricks", *bricks,
+                  "Also list every brick (id, triangles, vertices, bytes, offset, cell)");
     cmd->callback([&run, file, json, bricks] {
         run = [file, json, bricks]() -> Status {
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> s, store::Store::Open(*file));

@@ -1,6 +1,8 @@
-// `nave verify FILE [--json] [--threads N]`: reads every brick of a store, checks its checksums, decodes it
-// and compares it with the directory. Succeeds (exit 0) only if every brick is intact; otherwise lists each
-// damaged brick with its error and fails (exit 1).
+// `nave verify FILE [--json] [--threads N]`: reads every brick of a store, checks its checksums,
+// decodes it and compares it with the directory. Succeeds (exit 0) only if every brick is intact;
+// otherwise lists each damaged brick with its error and fails (exit 1).
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
@@ -8,8 +10,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "cli/commands.h"
 #include "core/log.h"
@@ -24,10 +24,18 @@ std::string JsonString(const std::string& s) {
     std::string out = "\"";
     for (const char c : s) {
         switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
             default:
                 if (static_cast<unsigned char>(c) < 0x20) {
                     out += fmt::format("\\u{:04x}", int(c));
@@ -70,7 +78,8 @@ Status Verify(const std::string& file, bool json, int threads) {
     worker();
     for (std::thread& t : pool) t.join();
     progress.Finish();
-    std::sort(bad.begin(), bad.end(), [](const BadBrick& a, const BadBrick& b) { return a.id < b.id; });
+    std::sort(bad.begin(), bad.end(),
+              [](const BadBrick& a, const BadBrick& b) { return a.id < b.id; });
 
     const double seconds = std::max(progress.ElapsedSeconds(), 1e-9);
     const uint64_t triangles = s->header().triangle_count;
@@ -93,18 +102,21 @@ Status Verify(const std::string& file, bool json, int threads) {
         out += bad.empty() ? "]\n}\n" : "\n  ]\n}\n";
         std::fputs(out.c_str(), stdout);
     } else {
-        for (const BadBrick& b : bad) std::printf("brick %u: %s\n", b.id, b.status.ToString().c_str());
-        std::printf("%s: %u of %u bricks intact, %s triangles, %s read in %s (%s triangles/s, %s/s), peak memory %s\n",
-                    file.c_str(), brick_count - uint32_t(bad.size()), brick_count,
-                    FormatCount(double(triangles)).c_str(), FormatBytes(s->bytes_read()).c_str(),
-                    FormatDuration(seconds).c_str(), FormatCount(double(triangles) / seconds).c_str(),
-                    FormatBytes(uint64_t(double(s->bytes_read()) / seconds)).c_str(),
-                    FormatBytes(PeakRssBytes()).c_str());
+        for (const BadBrick& b : bad)
+            std::printf("brick %u: %s\n", b.id, b.status.ToString().c_str());
+        std::printf(
+            "%s: %u of %u bricks intact, %s triangles, %s read in %s (%s triangles/s, %s/s), peak "
+            "memory %s\n",
+            file.c_str(), brick_count - uint32_t(bad.size()), brick_count,
+            FormatCount(double(triangles)).c_str(), FormatBytes(s->bytes_read()).c_str(),
+            FormatDuration(seconds).c_str(), FormatCount(double(triangles) / seconds).c_str(),
+            FormatBytes(uint64_t(double(s->bytes_read()) / seconds)).c_str(),
+            FormatBytes(PeakRssBytes()).c_str());
     }
     std::fflush(stdout);
     if (!bad.empty()) {
-        return DataLossError("{}: {} of {} bricks are damaged (first: brick {})", file, bad.size(), brick_count,
-                             bad.front().id);
+        return DataLossError("{}: {} of {} bricks are damaged (first: brick {})", file, bad.size(),
+                             brick_count, bad.front().id);
     }
     return Status::Ok();
 }
@@ -112,8 +124,9 @@ Status Verify(const std::string& file, bool json, int threads) {
 }  // namespace
 
 void RegisterVerifyCommand(CLI::App& app, CommandRun& run) {
-    CLI::App* cmd = app.add_subcommand(
-        "verify", "Read every brick of a store, check its checksums and decode it; exit 0 only if all are intact");
+    CLI::App* cmd = app.add_subcommand("verify",
+                                       "Read every brick of a store, check its checksums and "
+                                       "decode it; exit 0 only if all are intact");
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     auto threads = std::make_shared<int>(int(std::max(1u, std::thread::hardware_concurrency())));

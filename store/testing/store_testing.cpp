@@ -1,13 +1,15 @@
 #include "store/testing/store_testing.h"
 
 #include <cmath>
+#include <random>
 
 namespace nave::store::testing {
 namespace {
 
-// Builds a kd-tree over the cell index box [lo, hi) (cells, not coordinates), splitting the longest index
-// range in the middle; leaves hold the linear cell index.
-uint32_t BuildCellTree(const Bounds3f& bounds, Vec3i n, Vec3i lo, Vec3i hi, std::vector<BrickTreeNode>& nodes) {
+// Builds a kd-tree over the cell index box [lo, hi) (cells, not coordinates), splitting the longest
+// index range in the middle; leaves hold the linear cell index.
+uint32_t BuildCellTree(const Bounds3f& bounds, Vec3i n, Vec3i lo, Vec3i hi,
+                       std::vector<BrickTreeNode>& nodes) {
     const uint32_t index = uint32_t(nodes.size());
     nodes.emplace_back();
     int axis = 0;
@@ -20,7 +22,8 @@ uint32_t BuildCellTree(const Bounds3f& bounds, Vec3i n, Vec3i lo, Vec3i hi, std:
         return index;
     }
     const int mid = (lo[axis] + hi[axis]) / 2;
-    const float split = bounds.min[axis] + (bounds.max[axis] - bounds.min[axis]) * float(mid) / float(n[axis]);
+    const float split =
+        bounds.min[axis] + (bounds.max[axis] - bounds.min[axis]) * float(mid) / float(n[axis]);
     Vec3i below_hi = hi, above_lo = lo;
     below_hi[axis] = mid;
     above_lo[axis] = mid;
@@ -39,9 +42,15 @@ BrickMesh MakeSurface(const SurfaceOptions& o) {
     BrickMesh mesh;
     const uint32_t vx = o.quads_x + 1, vy = o.quads_y + 1;
     const float k = 2.f * 3.14159265f / o.size_m;  // one period across the surface
+    std::mt19937 rng(o.seed);
+    std::uniform_real_distribution<float> unit(0.f, 1.f);
     for (uint32_t j = 0; j < vy; ++j) {
         for (uint32_t i = 0; i < vx; ++i) {
-            const float u = float(i) / float(o.quads_x), v = float(j) / float(o.quads_y);
+            float u = float(i) / float(o.quads_x), v = float(j) / float(o.quads_y);
+            if (o.jitter > 0 && i > 0 && j > 0 && i < o.quads_x && j < o.quads_y) {
+                u += o.jitter * (unit(rng) - 0.5f) / float(o.quads_x);
+                v += o.jitter * (unit(rng) - 0.5f) / float(o.quads_y);
+            }
             const float x = u * o.size_m, y = v * o.size_m;
             const float z = o.amplitude_m * std::sin(k * x) * std::cos(k * y);
             mesh.positions.push_back({x, y, z});
@@ -57,8 +66,13 @@ BrickMesh MakeSurface(const SurfaceOptions& o) {
     for (uint32_t j = 0; j < o.quads_y; ++j) {
         for (uint32_t i = 0; i < o.quads_x; ++i) {
             const uint32_t a = j * vx + i, b = a + 1, c = a + vx, d = c + 1;
-            const uint32_t material = o.material_count == 0 ? 0 : (i * o.material_count / o.quads_x);
-            mesh.indices.insert(mesh.indices.end(), {a, b, d, a, d, c});
+            const uint32_t material =
+                o.material_count == 0 ? 0 : (i * o.material_count / o.quads_x);
+            if (o.jitter > 0 && unit(rng) < 0.5f) {
+                mesh.indices.insert(mesh.indices.end(), {a, b, c, b, d, c});
+            } else {
+                mesh.indices.insert(mesh.indices.end(), {a, b, d, a, d, c});
+            }
             mesh.material_ids.insert(mesh.material_ids.end(), {material, material});
         }
     }
@@ -93,9 +107,10 @@ GridStore SplitOnGrid(const BrickMesh& mesh, Vec3i cells) {
     // Triangles to cells by centroid, with the tree's own rule for points on a split plane.
     std::vector<std::vector<uint32_t>> by_cell(cell_count);
     for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
-        const Vec3f c = (mesh.positions[mesh.indices[3 * t]] + mesh.positions[mesh.indices[3 * t + 1]] +
-                         mesh.positions[mesh.indices[3 * t + 2]]) /
-                        3.f;
+        const Vec3f c =
+            (mesh.positions[mesh.indices[3 * t]] + mesh.positions[mesh.indices[3 * t + 1]] +
+             mesh.positions[mesh.indices[3 * t + 2]]) /
+            3.f;
         by_cell[cell_tree.Locate(c)].push_back(uint32_t(t));
     }
     GridStore out;
@@ -136,7 +151,8 @@ StatusOr<GridStore> WriteGridStore(const std::filesystem::path& path, const Bric
     NAVE_ASSIGN_OR_RETURN(auto writer, StoreWriter::Create(path, grid, provenance));
     const std::vector<Bounds3f> cell_boxes = split.tree.BrickCells(uint32_t(split.bricks.size()));
     for (size_t b = 0; b < split.bricks.size(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(EncodedBrick encoded, EncodeBrick(split.bricks[b], cell_boxes[b], grid, options));
+        NAVE_ASSIGN_OR_RETURN(EncodedBrick encoded,
+                              EncodeBrick(split.bricks[b], cell_boxes[b], grid, options));
         NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
         NAVE_CHECK_EQ(id, uint32_t(b));
     }

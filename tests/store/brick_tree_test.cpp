@@ -1,18 +1,19 @@
-// The brick tree: Locate and Traverse against brute force over the leaf cells, and Validate's refusals.
+// The brick tree: Locate and Traverse against brute force over the leaf cells, and Validate's
+// refusals.
+
+#include "store/brick_tree.h"
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <limits>
 #include <random>
 
-#include <gtest/gtest.h>
-
-#include "store/brick_tree.h"
-
 namespace nave::store {
 namespace {
 
-// A random kd-tree over `bounds`: random axes and split positions, about a quarter of the leaves empty,
-// brick ids shuffled so that they do not follow the node order.
+// A random kd-tree over `bounds`: random axes and split positions, about a quarter of the leaves
+// empty, brick ids shuffled so that they do not follow the node order.
 BrickTree RandomTree(std::mt19937& rng, const Bounds3f& bounds, int depth, uint32_t* brick_count) {
     std::vector<BrickTreeNode> nodes;
     std::vector<uint32_t> leaves;
@@ -49,9 +50,10 @@ BrickTree RandomTree(std::mt19937& rng, const Bounds3f& bounds, int depth, uint3
     return BrickTree(bounds, std::move(nodes));
 }
 
-// The parametric interval of the ray inside `box`, clipped to [t_min, t_max] (empty if lo > hi). Boxes are
-// closed; computed in double so it serves as the reference.
-std::pair<double, double> Clip(const Bounds3f& box, const Vec3f& o, const Vec3f& d, double t_min, double t_max) {
+// The parametric interval of the ray inside `box`, clipped to [t_min, t_max] (empty if lo > hi).
+// Boxes are closed; computed in double so it serves as the reference.
+std::pair<double, double> Clip(const Bounds3f& box, const Vec3f& o, const Vec3f& d, double t_min,
+                               double t_max) {
     double lo = t_min, hi = t_max;
     for (int a = 0; a < 3; ++a) {
         if (d[a] == 0) {
@@ -83,7 +85,8 @@ TEST(BrickTree, LocateMatchesBruteForce) {
                 bool inside = true;
                 for (int a = 0; a < 3; ++a) {
                     inside &= p[a] >= cells[b].min[a] &&
-                              (p[a] < cells[b].max[a] || (p[a] == bounds.max[a] && cells[b].max[a] == bounds.max[a]));
+                              (p[a] < cells[b].max[a] ||
+                               (p[a] == bounds.max[a] && cells[b].max[a] == bounds.max[a]));
                 }
                 if (inside) {
                     EXPECT_EQ(expected, kNoBrick) << "cells overlap at " << p;
@@ -98,7 +101,8 @@ TEST(BrickTree, LocateMatchesBruteForce) {
 TEST(BrickTree, TraverseVisitsEveryCrossedCellOnceFrontToBack) {
     std::mt19937 rng(11);
     const Bounds3f bounds({0, 0, 0}, {10, 6, 4});
-    std::uniform_real_distribution<float> ox(-3, 13), oy(-3, 9), oz(-3, 7), dir(-1, 1), t_start(0, 2);
+    std::uniform_real_distribution<float> ox(-3, 13), oy(-3, 9), oz(-3, 7), dir(-1, 1),
+        t_start(0, 2);
     std::bernoulli_distribution axis_aligned(0.15);
     int rays_with_hits = 0;
     for (int trial = 0; trial < 10; ++trial) {
@@ -136,7 +140,8 @@ TEST(BrickTree, TraverseVisitsEveryCrossedCellOnceFrontToBack) {
             for (uint32_t b = 0; b < bricks; ++b) {
                 const auto [lo, hi] = Clip(cells[b], o, d, t_min, t_max);
                 if (hi - lo > 1e-3) {
-                    EXPECT_EQ(count[b], 1) << "ray crosses brick " << b << " over [" << lo << ", " << hi << "]";
+                    EXPECT_EQ(count[b], 1)
+                        << "ray crosses brick " << b << " over [" << lo << ", " << hi << "]";
                 }
             }
             rays_with_hits += visited.empty() ? 0 : 1;
@@ -150,7 +155,8 @@ TEST(BrickTree, TraverseStopsWhenTheVisitorSaysSo) {
     uint32_t bricks = 0;
     const BrickTree tree = RandomTree(rng, Bounds3f({0, 0, 0}, {1, 1, 1}), 6, &bricks);
     int calls = 0;
-    tree.Traverse({-1, 0.5f, 0.5f}, {1, 0, 0}, 0, 10, [&](uint32_t, float, float) { return ++calls < 2; });
+    tree.Traverse({-1, 0.5f, 0.5f}, {1, 0, 0}, 0, 10,
+                  [&](uint32_t, float, float) { return ++calls < 2; });
     EXPECT_EQ(calls, 2);
 }
 
@@ -181,7 +187,8 @@ TEST(BrickTree, ValidateRefusesBrokenTrees) {
     EXPECT_NE(s.message().find("names brick 7"), std::string::npos) << s.message();
     s = BrickTree(box, {split(9, 0.5f, 1, 2), leaf(0), leaf(1)}).Validate(2);
     EXPECT_NE(s.message().find("axis 9"), std::string::npos) << s.message();
-    s = BrickTree(box, {split(0, std::numeric_limits<float>::quiet_NaN(), 1, 2), leaf(0), leaf(1)}).Validate(2);
+    s = BrickTree(box, {split(0, std::numeric_limits<float>::quiet_NaN(), 1, 2), leaf(0), leaf(1)})
+            .Validate(2);
     EXPECT_NE(s.message().find("split plane"), std::string::npos) << s.message();
     // A chain deeper than Traverse's stack.
     std::vector<BrickTreeNode> nodes(141);

@@ -1,11 +1,11 @@
-// End to end: `nave inspect` and `nave verify` run as a user runs them, on a small store and a damaged copy.
+// End to end: `nave inspect` and `nave verify` run as a user runs them, on a small store and a
+// damaged copy.
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <fstream>
-
-#include <gtest/gtest.h>
 
 #include "core/file.h"
 #include "store/store_reader.h"
@@ -23,7 +23,8 @@ struct CommandResult {
 };
 
 CommandResult RunNave(const std::string& args, bool with_stderr = false) {
-    const std::string command = std::string(NAVE_BINARY) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+    const std::string command =
+        std::string(NAVE_BINARY) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
     CommandResult run;
     FILE* pipe = ::popen(command.c_str(), "r");
     NAVE_CHECK(pipe != nullptr) << command;
@@ -59,12 +60,15 @@ TEST_F(NaveCli, InspectJsonDescribesTheStore) {
     const CommandResult run = RunNave("inspect --json " + store_.string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     for (const std::string& part :
-         {fmt::format("\"triangles\": {},", triangles_), fmt::format("\"source_triangles\": {},", triangles_),
-          std::string("\"bricks\": 4,"), std::string("\"format_version\": \"1.0\""), std::string("\"step\": 0.001"),
+         {fmt::format("\"triangles\": {},", triangles_),
+          fmt::format("\"source_triangles\": {},", triangles_), std::string("\"bricks\": 4,"),
+          std::string("\"format_version\": \"1.0\""), std::string("\"step\": 0.001"),
           std::string("\"max_axis_error\": 0.0005"), std::string("\"name\": \"m2\""),
-          std::string("\"map_Kd\": \"textures/m1.png\""), std::string("\"source_files\": [\"synthetic-surface\"]"),
+          std::string("\"map_Kd\": \"textures/m1.png\""),
+          std::string("\"source_files\": [\"synthetic-surface\"]"),
           fmt::format("\"bytes_on_disk\": {},", std::filesystem::file_size(store_))}) {
-        EXPECT_NE(run.output.find(part), std::string::npos) << "missing " << part << " in\n" << run.output;
+        EXPECT_NE(run.output.find(part), std::string::npos) << "missing " << part << " in\n"
+                                                            << run.output;
     }
     EXPECT_EQ(run.output.front(), '{');
     EXPECT_EQ(run.output.substr(run.output.size() - 2), "}\n");
@@ -72,7 +76,8 @@ TEST_F(NaveCli, InspectJsonDescribesTheStore) {
     const CommandResult text = RunNave("inspect --bricks " + store_.string());
     EXPECT_EQ(text.exit_code, 0);
     EXPECT_NE(text.output.find("bytes/triangle"), std::string::npos) << text.output;
-    EXPECT_NE(text.output.find("max position error 0.5 mm per axis"), std::string::npos) << text.output;
+    EXPECT_NE(text.output.find("max position error 0.5 mm per axis"), std::string::npos)
+        << text.output;
 }
 
 TEST_F(NaveCli, VerifyDamagedStoreFailsNamingTheBrick) {
@@ -88,8 +93,8 @@ TEST_F(NaveCli, VerifyDamagedStoreFailsNamingTheBrick) {
 
     const CommandResult run = RunNave("-q verify " + damaged.string(), true);
     EXPECT_EQ(run.exit_code, 1) << run.output;
-    EXPECT_NE(run.output.find(fmt::format("brick 2: data loss: {} brick 2 @0x{:x}: mesh checksum", damaged.string(),
-                                          brick.mesh.offset)),
+    EXPECT_NE(run.output.find(fmt::format("brick 2: data loss: {} brick 2 @0x{:x}: mesh checksum",
+                                          damaged.string(), brick.mesh.offset)),
               std::string::npos)
         << run.output;
     EXPECT_NE(run.output.find("3 of 4 bricks intact"), std::string::npos) << run.output;
@@ -98,7 +103,8 @@ TEST_F(NaveCli, VerifyDamagedStoreFailsNamingTheBrick) {
     const CommandResult json = RunNave("-q verify --json " + damaged.string());
     EXPECT_EQ(json.exit_code, 1);
     EXPECT_NE(json.output.find("\"ok\": false"), std::string::npos) << json.output;
-    EXPECT_NE(json.output.find("{\"id\": 2, \"error\": \"data loss:"), std::string::npos) << json.output;
+    EXPECT_NE(json.output.find("{\"id\": 2, \"error\": \"data loss:"), std::string::npos)
+        << json.output;
 }
 
 TEST_F(NaveCli, MissingOrForeignFilesFailCleanly) {

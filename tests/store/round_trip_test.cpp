@@ -1,13 +1,13 @@
-// Write -> read round trips of the brick store: exact topology and material ids, positions within the grid's
-// bound, normals and UVs within their quantization bounds, and no cracks between bricks.
+// Write -> read round trips of the brick store: exact topology and material ids, positions within
+// the grid's bound, normals and UVs within their quantization bounds, and no cracks between bricks.
+
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 #include <random>
 #include <set>
 #include <thread>
-
-#include <gtest/gtest.h>
 
 #include "store/brick_codec.h"
 #include "store/store_reader.h"
@@ -24,16 +24,17 @@ using test::SortedKeys;
 // A grid whose origin is not on any round number, so that snapping really moves the vertices.
 GlobalGrid TestGrid(double step = 1e-3) { return GlobalGrid{{-1.2345, 2.3456, -0.3579}, step}; }
 
-// Bound on the angle-free error |n_decoded - n| of Draco's octahedral normal quantization with `bits` bits.
-// The octahedral parameters (u, v) in [-1, 1] are quantized with step d = 2 / (2^bits - 1), so each moves by
-// at most d/2. The unnormalized octahedron point (u, v, 1 - |u| - |v|) then moves by at most
-// sqrt((d/2)^2 + (d/2)^2 + d^2) = d sqrt(1.5), and normalizing a vector of length >= 1/sqrt(3) (the
-// octahedron's closest point to the origin) scales that by at most sqrt(3): |error| <= d sqrt(4.5).
-// Octahedral mapping: Meyer et al., "On Floating-Point Normal Vectors", EGSR 2010, section 3.
+// Bound on the angle-free error |n_decoded - n| of Draco's octahedral normal quantization with
+// `bits` bits. The octahedral parameters (u, v) in [-1, 1] are quantized with step d = 2 / (2^bits
+// - 1), so each moves by at most d/2. The unnormalized octahedron point (u, v, 1 - |u| - |v|) then
+// moves by at most sqrt((d/2)^2 + (d/2)^2 + d^2) = d sqrt(1.5), and normalizing a vector of length
+// >= 1/sqrt(3) (the octahedron's closest point to the origin) scales that by at most sqrt(3):
+// |error| <= d sqrt(4.5). Octahedral mapping: Meyer et al., "On Floating-Point Normal Vectors",
+// EGSR 2010, section 3.
 double NormalErrorBound(int bits) { return 2.0 / ((1 << bits) - 1) * std::sqrt(4.5); }
 
-// Draco quantizes each UV component on a uniform grid spanning the brick's largest UV range with 2^bits - 1
-// steps, so the error is at most half a step.
+// Draco quantizes each UV component on a uniform grid spanning the brick's largest UV range with
+// 2^bits - 1 steps, so the error is at most half a step.
 double UvErrorBound(int bits, double range) { return 0.5 * range / ((1 << bits) - 1); }
 
 TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
@@ -45,7 +46,8 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
     const auto materials = testing::MakeMaterials(3);
     const GlobalGrid grid = TestGrid();
     const EncodeOptions options;
-    auto written = testing::WriteGridStore(dir / "surface.nave", mesh, materials, {3, 2, 1}, grid, options);
+    auto written =
+        testing::WriteGridStore(dir / "surface.nave", mesh, materials, {3, 2, 1}, grid, options);
     ASSERT_TRUE(written.ok()) << written.status().ToString();
     EXPECT_EQ(dir.Files(), std::vector<std::string>{"surface.nave"});
 
@@ -58,7 +60,8 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
     EXPECT_EQ(store.header().grid.step, grid.step);
     EXPECT_EQ(store.header().triangle_count, mesh.TriangleCount());
     EXPECT_EQ(store.header().source_triangle_count, mesh.TriangleCount());
-    EXPECT_EQ(store.header().provenance.source_files, std::vector<std::string>{"synthetic-surface"});
+    EXPECT_EQ(store.header().provenance.source_files,
+              std::vector<std::string>{"synthetic-surface"});
     EXPECT_EQ(store.header().provenance.tool_version, "nave test");
     EXPECT_EQ(store.header().provenance.options, "grid-split");
     EXPECT_EQ(store.materials(), materials);
@@ -66,8 +69,8 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
     ASSERT_EQ(store.bricks().size(), 6u);
     EXPECT_EQ(store.tree().nodes().size(), written->tree.nodes().size());
 
-    // Where each grid point decodes, over all bricks: a vertex shared by two bricks must decode bit for bit
-    // to the same coordinates in both.
+    // Where each grid point decodes, over all bricks: a vertex shared by two bricks must decode bit
+    // for bit to the same coordinates in both.
     std::map<std::array<int32_t, 3>, std::pair<Vec3f, int>> decoded_at;
     Bounds3f all;
     for (uint32_t b = 0; b < store.bricks().size(); ++b) {
@@ -87,24 +90,30 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
         EXPECT_TRUE(out.HasUvs() && info.has_uvs);
 
         // Positions within step/2 per axis (plus the float rounding of the decoded value).
-        std::map<std::array<int32_t, 3>, uint32_t> input_vertex;  // the surface has one vertex per point
-        for (uint32_t v = 0; v < in.VertexCount(); ++v) input_vertex[test::GridKey(grid, in.positions[v])] = v;
+        std::map<std::array<int32_t, 3>, uint32_t>
+            input_vertex;  // the surface has one vertex per point
+        for (uint32_t v = 0; v < in.VertexCount(); ++v)
+            input_vertex[test::GridKey(grid, in.positions[v])] = v;
         float uv_lo = 1e30f, uv_hi = -1e30f;
-        for (const auto& uv : in.uvs) uv_lo = std::min({uv_lo, uv[0], uv[1]}), uv_hi = std::max({uv_hi, uv[0], uv[1]});
+        for (const auto& uv : in.uvs)
+            uv_lo = std::min({uv_lo, uv[0], uv[1]}), uv_hi = std::max({uv_hi, uv[0], uv[1]});
         Bounds3f box;
         for (uint32_t v = 0; v < out.VertexCount(); ++v) {
             const auto key = test::GridKey(grid, out.positions[v]);
             auto it = input_vertex.find(key);
-            ASSERT_NE(it, input_vertex.end()) << "decoded vertex " << v << " is on no input grid point";
+            ASSERT_NE(it, input_vertex.end())
+                << "decoded vertex " << v << " is on no input grid point";
             const uint32_t src = it->second;
             for (int a = 0; a < 3; ++a) {
-                const double err = std::fabs(double(out.positions[v][a]) - double(in.positions[src][a]));
+                const double err =
+                    std::fabs(double(out.positions[v][a]) - double(in.positions[src][a]));
                 // Half a float ulp of the decoded value, which lies within step/2 of the input.
                 const double round = (std::fabs(double(in.positions[src][a])) + grid.step) * 6e-8;
                 EXPECT_LE(err, grid.MaxAxisError() + round) << "vertex " << v << " axis " << a;
             }
             const Vec3f n = in.normals[src];
-            EXPECT_LE(Length(out.normals[v] - n), NormalErrorBound(options.normal_bits)) << "vertex " << v;
+            EXPECT_LE(Length(out.normals[v] - n), NormalErrorBound(options.normal_bits))
+                << "vertex " << v;
             EXPECT_NEAR(Length(out.normals[v]), 1.f, 1e-5f);
             for (int c = 0; c < 2; ++c) {
                 EXPECT_LE(std::fabs(out.uvs[v][c] - in.uvs[src][c]),
@@ -113,7 +122,8 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
             }
             box.Extend(out.positions[v]);
             auto [slot, inserted] = decoded_at.try_emplace(key, out.positions[v], 0);
-            EXPECT_EQ(slot->second.first, out.positions[v]) << "grid point decodes differently in two bricks";
+            EXPECT_EQ(slot->second.first, out.positions[v])
+                << "grid point decodes differently in two bricks";
             slot->second.second += inserted ? 1 : 0;
         }
         EXPECT_EQ(box, info.geometry_bounds);
@@ -134,9 +144,9 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
     EXPECT_GT(store.bytes_read(), 0u);
 }
 
-// A brick with everything Draco finds awkward: a random material per triangle (vertices split between
-// materials), an edge shared by three triangles, a duplicated triangle, vertices the input split for
-// seams, isolated vertices, and triangles that collapse on the grid.
+// A brick with everything Draco finds awkward: a random material per triangle (vertices split
+// between materials), an edge shared by three triangles, a duplicated triangle, vertices the input
+// split for seams, isolated vertices, and triangles that collapse on the grid.
 BrickMesh AwkwardMesh(std::mt19937& rng, uint32_t materials) {
     BrickMesh m = testing::MakeSurface({.quads_x = 12, .quads_y = 9, .material_count = 1});
     std::uniform_int_distribution<uint32_t> pick(0, materials - 1);
@@ -189,9 +199,30 @@ TEST(StoreRoundTrip, AwkwardMeshKeepsEveryTriangleAndMaterial) {
     }
 }
 
+TEST(StoreRoundTrip, IrregularSurfaceAtEverySpeed) {
+    const GlobalGrid grid = TestGrid();
+    testing::SurfaceOptions surface;
+    surface.quads_x = 20;
+    surface.quads_y = 17;
+    surface.jitter = 0.8f;
+    surface.material_count = 4;
+    const BrickMesh mesh = testing::MakeSurface(surface);
+    for (int speed = 0; speed <= 10; ++speed) {
+        SCOPED_TRACE("speed " + std::to_string(speed));
+        EncodeOptions options;
+        options.draco_speed = speed;
+        auto encoded = EncodeBrick(mesh, {}, grid, options);
+        ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
+        auto decoded = codec::DecodeMeshSection(encoded->mesh_bytes, grid, 4, "test");
+        ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+        EXPECT_EQ(SortedKeys(*decoded, grid, false), SortedKeys(mesh, grid, false));
+    }
+}
+
 TEST(StoreRoundTrip, MeshWithoutNormalsOrUvs) {
     const GlobalGrid grid = TestGrid(0.01);
-    const BrickMesh mesh = testing::MakeSurface({.quads_x = 8, .quads_y = 8, .normals = false, .uvs = false});
+    const BrickMesh mesh =
+        testing::MakeSurface({.quads_x = 8, .quads_y = 8, .normals = false, .uvs = false});
     auto encoded = EncodeBrick(mesh, Bounds3f({0, 0, 0}, {10, 10, 1}), grid, {});
     ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
     EXPECT_FALSE(encoded->has_normals);
@@ -221,7 +252,8 @@ TEST(StoreRoundTrip, BrickWhoseTrianglesAllCollapseIsEmpty) {
 TEST(StoreRoundTrip, ConcurrentReadsGiveIdenticalBricks) {
     ScratchDir dir;
     const BrickMesh mesh = testing::MakeSurface({.quads_x = 24, .quads_y = 24});
-    auto written = testing::WriteGridStore(dir / "s.nave", mesh, testing::MakeMaterials(3), {2, 2, 1}, TestGrid());
+    auto written = testing::WriteGridStore(dir / "s.nave", mesh, testing::MakeMaterials(3),
+                                           {2, 2, 1}, TestGrid());
     ASSERT_TRUE(written.ok()) << written.status().ToString();
     auto store = Store::Open(dir / "s.nave");
     ASSERT_TRUE(store.ok()) << store.status().ToString();
@@ -267,7 +299,8 @@ TEST(StoreRoundTrip, SideSectionIsVerifiedAndRoundTrips) {
     ASSERT_TRUE(encoded.ok());
     encoded->side_bytes = packed;
     ASSERT_TRUE((*writer)->Append(*encoded).ok());
-    ASSERT_TRUE((*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
+    ASSERT_TRUE(
+        (*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
     auto store = Store::Open(dir / "side.nave");
     ASSERT_TRUE(store.ok()) << store.status().ToString();
     EXPECT_EQ((*store)->bricks()[0].side.length, packed.size());
@@ -282,7 +315,9 @@ TEST(StoreWriter, RefusesBadMeshes) {
     bad.indices[4] = 99;
     Status s = EncodeBrick(bad, {}, grid, {}).status();
     EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
-    EXPECT_NE(s.message().find("triangle 1 corner 1: index 99 out of range [0, 9)"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("triangle 1 corner 1: index 99 out of range [0, 9)"),
+              std::string::npos)
+        << s.message();
 
     bad = mesh;
     bad.material_ids.pop_back();
@@ -300,7 +335,8 @@ TEST(StoreWriter, RefusesBadMeshes) {
     EXPECT_NE(s.message().find("vertex 2"), std::string::npos) << s.message();
     EXPECT_NE(s.message().find("int32 range"), std::string::npos) << s.message();
 
-    EXPECT_EQ(ValidateBrickMesh(mesh, 1).code(), StatusCode::kInvalidArgument);  // material 1 and 2 >= 1
+    EXPECT_EQ(ValidateBrickMesh(mesh, 1).code(),
+              StatusCode::kInvalidArgument);  // material 1 and 2 >= 1
     EXPECT_TRUE(ValidateBrickMesh(mesh, 3).ok());
 }
 
@@ -332,7 +368,8 @@ TEST(StoreWriter, FinishRefusesInconsistentTablesAndCanRetry) {
     EXPECT_NE(s.message().find("brick 1 is in no leaf"), std::string::npos) << s.message();
     EXPECT_FALSE(std::filesystem::exists(dir / "w.nave"));
     // Fixed: it commits.
-    ASSERT_TRUE((*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
+    ASSERT_TRUE(
+        (*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
     EXPECT_TRUE(Store::Open(dir / "w.nave").ok());
 }
 

@@ -1,7 +1,8 @@
 #pragma once
-// Helpers shared by the store tests: a scratch directory and triangle keys that compare meshes as sets of
-// oriented triangles on the store's grid.
+// Helpers shared by the store tests: a scratch directory and triangle keys that compare meshes as
+// sets of oriented triangles on the store's grid.
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "store/brick_mesh.h"
 #include "store/grid.h"
@@ -23,9 +22,11 @@ class ScratchDir {
   public:
     ScratchDir() {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "nave";
+        std::string name =
+            info ? std::string(info->test_suite_name()) + "." + info->name() : "nave";
         std::replace(name.begin(), name.end(), '/', '_');
-        path_ = std::filesystem::temp_directory_path() / ("nave_store_test_" + std::to_string(::getpid()) + "_" + name);
+        path_ = std::filesystem::temp_directory_path() /
+                ("nave_store_test_" + std::to_string(::getpid()) + "_" + name);
         std::filesystem::remove_all(path_);
         std::filesystem::create_directories(path_);
     }
@@ -38,7 +39,8 @@ class ScratchDir {
     /// Names of the files in the directory.
     std::vector<std::string> Files() const {
         std::vector<std::string> out;
-        for (const auto& e : std::filesystem::directory_iterator(path_)) out.push_back(e.path().filename().string());
+        for (const auto& e : std::filesystem::directory_iterator(path_))
+            out.push_back(e.path().filename().string());
         std::sort(out.begin(), out.end());
         return out;
     }
@@ -47,8 +49,8 @@ class ScratchDir {
     std::filesystem::path path_;
 };
 
-/// A triangle as its three grid points, rotated so the smallest comes first (orientation kept), plus its
-/// material.
+/// A triangle as its three grid points, rotated so the smallest comes first (orientation kept),
+/// plus its material.
 using TriangleKey = std::tuple<std::array<std::array<int32_t, 3>, 3>, uint32_t>;
 
 inline std::array<int32_t, 3> GridKey(const GlobalGrid& grid, const Vec3f& p) {
@@ -65,7 +67,8 @@ inline TriangleKey KeyOf(const BrickMesh& mesh, size_t t, const GlobalGrid& grid
 }
 
 /// Keys of every triangle of `mesh` whose corners land on three distinct grid points, sorted.
-inline std::vector<TriangleKey> SortedKeys(const BrickMesh& mesh, const GlobalGrid& grid, bool skip_degenerate) {
+inline std::vector<TriangleKey> SortedKeys(const BrickMesh& mesh, const GlobalGrid& grid,
+                                           bool skip_degenerate) {
     std::vector<TriangleKey> keys;
     for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
         TriangleKey k = KeyOf(mesh, t, grid);
