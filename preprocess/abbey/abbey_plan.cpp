@@ -34,7 +34,10 @@ constexpr double kAisleRise = 5.25;       // aisle vault crown at 14 m
 constexpr double kWallTop = 30.0, kAisleWallTop = 15.5;
 constexpr double kRidge = 39.0;
 constexpr double kAmbulatory = 13.0;      // inner face of the ambulatory wall (radius)
-constexpr double kChapelRadius = 2.6;
+constexpr double kChapelRadius = 3.0;
+// The hemicycle: five bays of 36 degrees round the apse centre, so that one radiating chapel is on the axis.
+constexpr int kApseBays = 5;
+constexpr double kApseStep = 180.0 / kApseBays;
 const Vec3d kApse(kChoirX1, 0, 0);
 
 Vec3d Dir(double degrees) {
@@ -43,9 +46,11 @@ Vec3d Dir(double degrees) {
 }
 
 // The ambulatory's radiating chapels sit on the bisectors of the hemicycle's six bays.
-double ChapelAngle(int k) { return -75.0 + 30.0 * k; }
+double ChapelAngle(int k) { return -90.0 + kApseStep * (k + 0.5); }
+// Angle of the k-th radial line of the hemicycle (k = 0 south, kApseBays north).
+double ApseAngle(int k) { return -90.0 + kApseStep * k; }
 Vec3d ChapelCentre(int k) {
-    return kApse + Dir(ChapelAngle(k)) * (kAmbulatory * std::cos(15 * kPi / 180) + kOuterWallT);
+    return kApse + Dir(ChapelAngle(k)) * (kAmbulatory * std::cos(kApseStep / 2 * kPi / 180) + kOuterWallT);
 }
 
 // A triangular prism: the triangle a b c extruded by `e` (gables).
@@ -77,6 +82,18 @@ WallSpec Wall(Vec3d origin, Vec3d along, Vec3d inward, double length, double z0,
     return w;
 }
 
+// A side of a convex polygonal wall (hemicycle, ambulatory, chapels) from a to b, interior to the left. Each
+// side is lengthened by thickness * tan(turn / 2) at both ends so that neighbouring sides close the wedge
+// between them on the outside (the overlap is hidden inside the neighbour).
+WallSpec PolygonSide(Vec3d a, Vec3d b, double turn_degrees, double z0, double z1, double thickness,
+                     uint64_t seed) {
+    Vec3d along = Normalize(b - a);
+    double e = thickness * std::tan(turn_degrees / 2 * kPi / 180);
+    WallSpec w = Wall(a - along * e, along, Cross(Vec3d(0, 0, 1), along), Length(b - a) + 2 * e, z0, z1,
+                      thickness, seed);
+    return w;
+}
+
 Opening Window(double center, double half_width, double sill, double spring, double rise) {
     Opening o;
     o.center = center;
@@ -104,10 +121,10 @@ bool InsidePlan(double x, double y) {
     if (x >= kChoirX1) {
         Vec3d d(x - kApse.x, y, 0);
         double r = Length(d);
-        // The ambulatory is a polygon of six sides whose inner faces are at distance 13 cos 15 deg at the
-        // bisectors; a disc of that radius is inside it.
-        if (r <= kAmbulatory * std::cos(15 * kPi / 180)) return true;
-        for (int k = 0; k < 6; ++k) {
+        // The ambulatory is a polygon whose inner faces are at distance 13 cos(step / 2) at the bisectors; a
+        // disc of that radius is inside it.
+        if (r <= kAmbulatory * std::cos(kApseStep / 2 * kPi / 180)) return true;
+        for (int k = 0; k < kApseBays; ++k) {
             Vec3d q = ChapelCentre(k);
             Vec3d dq(x - q.x, y - q.y, 0);
             Vec3d axis = Dir(ChapelAngle(k));
@@ -115,13 +132,13 @@ bool InsidePlan(double x, double y) {
             // Between the chapel and the ambulatory: the opening through the wall.
             double along = Dot(dq, axis);
             double across = std::abs(Dot(dq, Cross(Vec3d(0, 0, 1), axis)));
-            if (along <= 0 && along >= -kOuterWallT - 0.05 && across <= 2.2) return true;
+            if (along <= 0 && along >= -kOuterWallT - 0.05 && across <= 2.6) return true;
         }
         // Ambulatory sectors: inside the polygon through the six bay corners at radius 13.
         double a = std::atan2(y, x - kApse.x) * 180 / kPi;
         if (a < -90 || a > 90) return false;
-        int k = std::min(5, int((a + 90) / 30));
-        Vec3d p0 = kApse + Dir(-90 + 30.0 * k) * kAmbulatory, p1 = kApse + Dir(-60 + 30.0 * k) * kAmbulatory;
+        int k = std::min(kApseBays - 1, int((a + 90) / kApseStep));
+        Vec3d p0 = kApse + Dir(ApseAngle(k)) * kAmbulatory, p1 = kApse + Dir(ApseAngle(k + 1)) * kAmbulatory;
         Vec3d e = p1 - p0, v(x - p0.x, y - p0.y, 0);
         return Cross(e, v).z >= 0;  // left of the edge going counter-clockwise = inside
     }
@@ -151,7 +168,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     for (double x : {kCrossingX0, kCrossingX1, kCrossingX1 + kBay}) {
         for (double s : {-1.0, 1.0}) piers.push_back(Vec3d(x, s * kArcadeY, 0));
     }
-    for (int k = 0; k <= 6; ++k) piers.push_back(kApse + Dir(-90 + 30.0 * k) * kArcadeY);
+    for (int k = 0; k <= kApseBays; ++k) piers.push_back(kApse + Dir(ApseAngle(k)) * kArcadeY);
     for (size_t i = 0; i < piers.size(); ++i) {
         PierSpec p;
         p.base = piers[i];
@@ -162,32 +179,42 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         add(fmt::format("pier {}", i), [=](Emitter& em) { EmitPier(em, p, d); });
     }
 
-    // Upper walls of nave and choir: arcade arches below, clerestory windows above.
+    // Upper walls of nave and choir: arcade arches below, clerestory windows above. A wall course holds one
+    // opening per column, so the arcade storey and the clerestory storey are two courses (split at 17 m).
+    const double kStorey = 17.0;
     auto upper_wall = [&](double x0, int bays, double side, const std::string& name) {
         Vec3d origin(x0, side * kNaveInner, 0);
-        WallSpec w = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kArcadeSpring, kWallTop,
-                          kUpperWallT, seed++);
+        WallSpec arcade = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kArcadeSpring, kStorey,
+                               kUpperWallT, seed++);
+        WallSpec clerestory = Wall(origin, Vec3d(1, 0, 0), Vec3d(0, -side, 0), bays * kBay, kStorey, kWallTop,
+                                   kUpperWallT, seed++);
         for (int b = 0; b < bays; ++b) {
             double c = (b + 0.5) * kBay;
-            w.openings.push_back(Arch(c, kBay / 2 - 0.9, kArcadeSpring, kArcadeSpring, 4.9));
-            w.openings.push_back(Window(c, 1.3, kVaultSpring, 23.6, 2.2));
+            arcade.openings.push_back(Arch(c, kBay / 2 - 0.9, kArcadeSpring, kArcadeSpring, 4.9));
+            clerestory.openings.push_back(Window(c, 1.3, kVaultSpring, 23.6, 2.2));
         }
-        add(name, [=](Emitter& em) { EmitWall(em, w, d); });
+        add(name, [=](Emitter& em) {
+            EmitWall(em, arcade, d);
+            EmitWall(em, clerestory, d);
+        });
     };
     for (double s : {-1.0, 1.0}) {
         upper_wall(0, kNaveBays, s, "nave upper wall");
         upper_wall(kCrossingX1, 2, s, "choir upper wall");
     }
-    // Hemicycle upper walls: six narrow bays between the apse piers.
-    for (int k = 0; k < 6; ++k) {
-        Vec3d a = kApse + Dir(-90 + 30.0 * k) * kNaveInner, b = kApse + Dir(-60 + 30.0 * k) * kNaveInner;
-        Vec3d along = Normalize(b - a);
-        Vec3d inward = Cross(Vec3d(0, 0, 1), along);  // counter-clockwise round the apse: left is inside
-        WallSpec w = Wall(a, along, inward, Length(b - a), kArcadeSpring, kWallTop, kUpperWallT, seed++);
-        double c = Length(b - a) / 2;
-        w.openings.push_back(Arch(c, 0.8, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
-        w.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
-        add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) { EmitWall(em, w, d); });
+    // Hemicycle upper walls: narrow bays between the apse piers.
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d a = kApse + Dir(ApseAngle(k)) * kNaveInner, b = kApse + Dir(ApseAngle(k + 1)) * kNaveInner;
+        // Counter-clockwise round the apse: the interior is on the left. Two storeys, as in the nave.
+        WallSpec w = PolygonSide(a, b, kApseStep, kArcadeSpring, kStorey, kUpperWallT, seed++);
+        WallSpec up = PolygonSide(a, b, kApseStep, kStorey, kWallTop, kUpperWallT, seed++);
+        double c = w.length / 2;
+        w.openings.push_back(Arch(c, 0.95, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
+        up.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
+        add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) {
+            EmitWall(em, w, d);
+            EmitWall(em, up, d);
+        });
     }
 
     // Aisle walls with a window per bay, and the buttresses and flying buttresses between the bays.
@@ -254,7 +281,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             double x = east ? kCrossingX1 : kCrossingX0;
             Vec3d inward(east ? -1 : 1, 0, 0);
             // Over the aisle (|y| 6.5..13): wall above the aisle vault only.
-            WallSpec over = Wall(Vec3d(x, s * kArcadeY, 0), Vec3d(0, s, 0), inward, kAisleWall - kArcadeY, 14.6,
+            WallSpec over = Wall(Vec3d(x, s * kArcadeY, 0), Vec3d(0, s, 0), inward, kAisleWall - kArcadeY, 13.0,
                                  kWallTop, kOuterWallT, seed++);
             WallSpec arm = Wall(Vec3d(x, s * kAisleWall, 0), Vec3d(0, s, 0), inward, kTransept - kAisleWall, 0,
                                 kWallTop, kOuterWallT, seed++);
@@ -284,12 +311,10 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
     }
 
     // Ambulatory wall, with an arch into each radiating chapel.
-    for (int k = 0; k < 6; ++k) {
-        Vec3d a = kApse + Dir(-90 + 30.0 * k) * kAmbulatory, b = kApse + Dir(-60 + 30.0 * k) * kAmbulatory;
-        Vec3d along = Normalize(b - a);
-        WallSpec w = Wall(a, along, Cross(Vec3d(0, 0, 1), along), Length(b - a), 0, kAisleWallTop, kOuterWallT,
-                          seed++);
-        w.openings = {Arch(Length(b - a) / 2, 2.2, 0, 5.5, 3.0)};
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d a = kApse + Dir(ApseAngle(k)) * kAmbulatory, b = kApse + Dir(ApseAngle(k + 1)) * kAmbulatory;
+        WallSpec w = PolygonSide(a, b, kApseStep, 0, kAisleWallTop, kOuterWallT, seed++);
+        w.openings = {Arch(w.length / 2, 2.6, 0, 5.5, 3.0)};
         Vec3d q = ChapelCentre(k);
         Vec3d axis = Dir(ChapelAngle(k));
         std::vector<WallSpec> chapel;
@@ -297,9 +322,8 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         for (int j = 0; j < kSides; ++j) {
             double a0 = ChapelAngle(k) - 90 + 180.0 * j / kSides, a1 = ChapelAngle(k) - 90 + 180.0 * (j + 1) / kSides;
             Vec3d p0 = q + Dir(a0) * kChapelRadius, p1 = q + Dir(a1) * kChapelRadius;
-            Vec3d al = Normalize(p1 - p0);
-            WallSpec c = Wall(p0, al, Cross(Vec3d(0, 0, 1), al), Length(p1 - p0), 0, 11.0, 0.9, seed++);
-            c.openings = {Window(Length(p1 - p0) / 2, 0.35, 3.0, 6.2, 1.0)};
+            WallSpec c = PolygonSide(p0, p1, 180.0 / kSides, 0, 11.0, 0.9, seed++);
+            c.openings = {Window(c.length / 2, 0.35, 3.0, 6.2, 1.0)};
             chapel.push_back(c);
         }
         add(fmt::format("ambulatory bay {}", k), [=](Emitter& em) {
@@ -356,14 +380,14 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
                 false, "choir aisle vault");
         }
     }
-    for (int k = 0; k < 6; ++k) {
-        Vec3d d0 = Dir(-90 + 30.0 * k), d1 = Dir(-60 + 30.0 * k);
+    for (int k = 0; k < kApseBays; ++k) {
+        Vec3d d0 = Dir(ApseAngle(k)), d1 = Dir(ApseAngle(k + 1));
         double ri = kArcadeY + kUpperWallT / 2;
         bay(kApse + d0 * ri, kApse + d1 * ri, kApse + d1 * kAmbulatory, kApse + d0 * kAmbulatory, kArcadeSpring,
-            kAisleRise, k == 5, "ambulatory vault");
+            kAisleRise, k == kApseBays - 1, "ambulatory vault");
     }
     add("apse vault", [=](Emitter& em) {
-        EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, 5, d);
+        EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, kApseBays - 1, d);
     });
 
     // Roofs: the main roof over nave and choir, the transept roof, the apse's half cone, lean-to roofs
@@ -401,6 +425,24 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             }
         });
     }
+    add("ridges", [=](Emitter& em) {
+        // Half-round ridge tiles over the main and transept ridges.
+        auto ridge = [&](Vec3d a, Vec3d b, Vec3d side) {
+            std::vector<Vec2> profile;
+            int n = d.Seg(8);
+            for (int i = 0; i <= n; ++i) {
+                double t = kPi * i / n;
+                profile.push_back({0.2 * std::cos(t), 0.2 * std::sin(t)});
+            }
+            std::vector<Vec3d> path;
+            int m = std::max(2, d.Seg(40));
+            for (int i = 0; i <= m; ++i) path.push_back(a + (b - a) * (double(i) / m));
+            Sweep(em, path, side, profile, kRoofSlate);
+        };
+        ridge(Vec3d(-1.5, 0, kRidge - 0.05), Vec3d(kChoirX1, 0, kRidge - 0.05), Vec3d(0, 1, 0));
+        double y1 = kTransept + kOuterWallT + 0.3, xc = 0.5 * (kCrossingX0 + kCrossingX1);
+        ridge(Vec3d(xc, -y1, kRidge - 0.05), Vec3d(xc, y1, kRidge - 0.05), Vec3d(1, 0, 0));
+    });
     add("apse roof", [=](Emitter& em) {
         auto cone = [=](double u, double t) {
             return kApse + Dir(-90 + 180 * u) * (eave * (1 - t)) + Vec3d(0, 0, kWallTop + pitch * t);

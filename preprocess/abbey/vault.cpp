@@ -72,9 +72,9 @@ void EmitVaultBay(Emitter& em, const VaultBay& b, const Detail& detail) {
             return Intrados(b, u, v);
         };
         ParamGrid(em, intrados, n, n, [&](const Vec3d& p) { return axis - p; }, kLimestone);
+        // The extrados as finely divided as the intrados: coarser chords would sag below it.
         auto extrados = [&](double s, double t) { return intrados(s, t) + Vec3d(0, 0, b.thickness); };
-        ParamGrid(em, extrados, std::max(2, n / 2), std::max(2, n / 2),
-                  [&](const Vec3d& p) { return p - axis; }, kLimestone);
+        ParamGrid(em, extrados, n, n, [&](const Vec3d& p) { return p - axis; }, kLimestone);
     }
     // Diagonal ribs along u = v and u = -v, transverse arches along u = -1 / +1.
     int m = detail.Seg(24);
@@ -112,8 +112,7 @@ void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius,
         auto intrados = [&](double s, double t) { return point(s, a0 + (a1 - a0) * t); };
         ParamGrid(em, intrados, n, n, [&](const Vec3d& p) { return centre - p; }, kLimestone);
         auto extrados = [&](double s, double t) { return intrados(s, t) + Vec3d(0, 0, 0.3); };
-        ParamGrid(em, extrados, std::max(2, n / 2), std::max(2, n / 2),
-                  [&](const Vec3d& p) { return p - centre; }, kLimestone);
+        ParamGrid(em, extrados, n, n, [&](const Vec3d& p) { return p - centre; }, kLimestone);
     }
     int m = detail.Seg(16);
     for (int k = 1; k <= ribs; ++k) {

@@ -31,7 +31,8 @@ struct WallSpec {
     Vec3d along;               ///< unit, horizontal
     Vec3d inward;              ///< unit, horizontal: the interior face faces this way
     double length = 1, z0 = 0, z1 = 1, thickness = 1;
-    std::vector<Opening> openings;  ///< sorted by center, disjoint, within the wall
+    std::vector<Opening> openings;  ///< sorted by center, within the wall, at most one per column (their
+                                    ///< horizontal spans disjoint: stack storeys as separate walls)
     bool stones_inside = true, stones_outside = true;
     bool close_ends = true;
     uint32_t material = 0;

@@ -14,7 +14,7 @@ namespace nave::preprocess {
 /// Errors: NotFound, Unsupported (unknown format, naming the extension and the formats nave reads).
 StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path);
 
-/// Opens every input and merges them (material names made unique). One input is returned as is.
+/// Opens every input and merges them (material names made unique).
 StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths);
 
 }  // namespace nave::preprocess

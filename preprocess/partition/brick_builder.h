@@ -18,6 +18,25 @@ struct BuiltBrick {
     uint64_t collapsed_triangles = 0;  ///< dropped: two corners on one grid point
 };
 
+/// Builds bricks one after the other, reusing its buffers (large fresh allocations cost page faults on
+/// every brick). Not thread-safe: one per encoding thread.
+class BrickBuilder {
+  public:
+    /// The returned brick stays valid until the next call.
+    const BuiltBrick& Build(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid);
+
+  private:
+    struct VertexKey {
+        Vec3i q;
+        uint32_t n[3];
+        uint32_t uv[2];
+    };
+    BuiltBrick out_;
+    std::vector<VertexKey> keys_;
+    std::vector<uint32_t> slots_;
+};
+
+/// One-off convenience over BrickBuilder.
 BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid);
 
 /// Working memory of BuildBrickMesh + EncodeBrick per triangle, in bytes: the Triangle list, the mesh

@@ -254,7 +254,6 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::vector<Triangle> batch;
     std::vector<int> candidates, stack;
     const float m = float(margin_);
-    uint64_t processed = 0;
     while (true) {
         batch.clear();
         NAVE_ASSIGN_OR_RETURN(bool more, reader->Read(batch, 1 << 14));
@@ -287,7 +286,6 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
                 NAVE_RETURN_IF_ERROR(writers[candidates[0]]->Append(t));
             }
         }
-        processed += batch.size();
         progress_->Add(batch.size());
     }
     reader.reset();
@@ -297,7 +295,6 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::filesystem::remove(task.file, ec);
     AddTempBytes(-parent_bytes);
     int64_t child_bytes = 0;
-    (void)processed;
 
     std::lock_guard<std::mutex> lock(mutex_);
     // Graft the local tree onto the brick tree: the task's leaf becomes the local root.

@@ -32,7 +32,7 @@ struct PartitionConfig {
     size_t block_bytes = 256 << 10;        ///< bin block size (uncompressed)
     int threads = 1;
     size_t root_sample = 1 << 18;          ///< centroids sampled from the whole input
-    size_t child_sample = 1 << 14;         ///< per child bin
+    size_t child_sample = 1 << 12;         ///< per child bin (64 children: 3 MiB per splitting thread)
     int max_fanout = 64;
 };
 

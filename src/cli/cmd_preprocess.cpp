@@ -17,7 +17,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
         uint64_t brick_triangles = 1'000'000;
         double precision = 0;
         int threads = 0;
-        int draco_speed = 5;
+        int draco_speed = store::EncodeOptions{}.draco_speed;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("inputs", opt->inputs, "Model files; several are merged into one model");

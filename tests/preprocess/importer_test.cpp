@@ -4,6 +4,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <random>
+
+#include "core/file.h"
 #include "preprocess/import/importer.h"
 #include "preprocess/import/triangle_check.h"
 #include "test_util.h"
@@ -168,6 +171,21 @@ TEST(GltfImporter, NodeTransformsAndMaterials) {
     EXPECT_EQ(source->units(), "m");
 }
 
+TEST(GltfImporter, BinaryGlbGivesTheSameTriangle) {
+    auto text = ReadModel(Fixture("node_transform.gltf"));
+    auto binary = ReadModel(Fixture("node_transform.glb"));
+    ASSERT_EQ(binary.size(), 1u);
+    EXPECT_EQ(binary[0].p, text[0].p);
+}
+
+TEST(AssimpImporter, OtherFormatsThroughAssimp) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("square.off"), &source);
+    ASSERT_EQ(tris.size(), 2u);  // the quad, triangulated
+    EXPECT_NEAR(Area(tris[0]) + Area(tris[1]), 1.0, 1e-6);
+    EXPECT_EQ(source->units(), "unknown");
+}
+
 TEST(MergedInputs, MaterialNamesAreMadeUnique) {
     auto source = OpenModels({Fixture("shapes_crlf.obj"), Fixture("shapes_crlf.obj"), Fixture("ascii.stl")});
     ASSERT_TRUE(source.ok()) << source.status().ToString();
@@ -180,6 +198,48 @@ TEST(MergedInputs, MaterialNamesAreMadeUnique) {
                                                        "undefined_in_mtl.1", "default"));
     EXPECT_EQ((*source)->materials()[(*tris)[6].material].name, "red.1");
     EXPECT_EQ((*source)->warnings().Count("missing textures (material kept, colour used)"), 2u);
+}
+
+}  // namespace
+}  // namespace nave::preprocess
+
+namespace nave::preprocess {
+namespace {
+
+// Garbage and every truncation of valid files: each read ends in an error or a model, never a crash.
+TEST(ImporterRobustness, GarbageAndTruncationsNeverCrash) {
+    auto dir = testing::MakeTempDir("garbage");
+    std::mt19937 rng(99);
+    int errors = 0;
+    for (const char* ext : {".obj", ".ply", ".stl", ".gltf", ".glb"}) {
+        for (int i = 0; i < 12; ++i) {
+            std::string bytes(size_t(rng() % 600), '\0');
+            for (char& c : bytes) c = char(rng());
+            if (i % 4 == 1) bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n" + bytes;
+            if (i % 4 == 2) bytes = "solid x\n" + bytes;
+            if (i % 4 == 3) bytes = "v 1 2 3\nf 1 1 1\n" + bytes;
+            auto path = dir / (std::to_string(i) + ext);
+            std::FILE* f = std::fopen(path.c_str(), "wb");
+            std::fwrite(bytes.data(), 1, bytes.size(), f);
+            std::fclose(f);
+            if (!ReadError(path).empty()) ++errors;
+        }
+    }
+    EXPECT_GT(errors, 50);  // nearly all garbage is refused with a message
+    for (const char* name : {"faces_little.ply", "strips_big.ply", "solid_binary.stl", "shapes_crlf.obj",
+                             "tetra_ascii.ply", "node_transform.glb"}) {
+        auto bytes = ReadFileToString(Fixture(name));
+        ASSERT_TRUE(bytes.ok());
+        std::string ext = std::filesystem::path(name).extension().string();
+        for (size_t cut = 0; cut < bytes->size(); cut += (cut + 16 < bytes->size() ? 5 : 1)) {
+            auto path = dir / ("cut" + ext);
+            std::FILE* f = std::fopen(path.c_str(), "wb");
+            std::fwrite(bytes->data(), 1, cut, f);
+            std::fclose(f);
+            (void)ReadError(path);  // must return, whatever it says
+        }
+    }
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
