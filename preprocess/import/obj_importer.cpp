@@ -8,6 +8,7 @@
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
+#include "preprocess/import/triangulate.h"
 
 namespace nave::preprocess {
 namespace {
@@ -119,8 +120,12 @@ class ObjSource final : public TriangleSource {
             return Status::Ok();
         }
         uint32_t material = CurrentMaterial();
-        for (size_t k = 1; k + 1 < corners_.size(); ++k) {
-            const Corner* c[3] = {&corners_[0], &corners_[k], &corners_[k + 1]};
+        polygon_.clear();
+        for (const Corner& c : corners_) polygon_.push_back(positions_[c.v]);
+        fan_.clear();
+        TriangulatePolygon(polygon_, fan_);
+        for (const auto& tri : fan_) {
+            const Corner* c[3] = {&corners_[tri[0]], &corners_[tri[1]], &corners_[tri[2]]};
             Triangle t;
             t.material = material;
             t.has_normals = c[0]->vn >= 0 && c[1]->vn >= 0 && c[2]->vn >= 0;
@@ -209,6 +214,8 @@ class ObjSource final : public TriangleSource {
     std::vector<Vec3f> positions_, normals_;
     std::vector<std::array<float, 2>> uvs_;
     std::vector<Corner> corners_;
+    std::vector<Vec3f> polygon_;
+    std::vector<std::array<uint32_t, 3>> fan_;
     std::vector<store::MaterialRecord> materials_;
     std::unordered_map<std::string, int64_t> material_index_;
     std::unordered_map<std::string, store::MaterialRecord> library_;

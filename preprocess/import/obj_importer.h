@@ -1,6 +1,6 @@
 #pragma once
-// Wavefront OBJ (+ MTL), read as a stream in one forward pass. Polygons are triangulated as fans (exact for
-// the convex faces CAD exports write), negative (relative) indices are resolved, CRLF lines are accepted.
+// Wavefront OBJ (+ MTL), read as a stream in one forward pass. Polygons are triangulated (import/triangulate.h:
+// fans when convex, ear clipping when concave), negative (relative) indices are resolved, CRLF lines are accepted.
 //
 // Memory: OBJ faces index into vertex, texture-coordinate and normal arrays that may appear anywhere before
 // them, so those arrays are kept and grow with the file (12 bytes per v and vn, 8 per vt): inherent to the

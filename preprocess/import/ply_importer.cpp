@@ -9,6 +9,7 @@
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
+#include "preprocess/import/triangulate.h"
 
 namespace nave::preprocess {
 namespace {
@@ -303,8 +304,12 @@ class PlySource final : public TriangleSource {
                 warnings_.Add("faces with fewer than 3 vertices skipped", where);
                 return Status::Ok();
             }
-            for (size_t k = 1; k + 1 < indices_.size(); ++k) {
-                NAVE_RETURN_IF_ERROR(EmitTriangle(indices_[0], indices_[k], indices_[k + 1], batch, where));
+            polygon_.clear();
+            for (int64_t i : indices_) polygon_.push_back(positions_[i]);
+            fan_.clear();
+            TriangulatePolygon(polygon_, fan_);
+            for (const auto& tri : fan_) {
+                NAVE_RETURN_IF_ERROR(EmitTriangle(indices_[tri[0]], indices_[tri[1]], indices_[tri[2]], batch, where));
             }
             return Status::Ok();
         }
@@ -337,6 +342,8 @@ class PlySource final : public TriangleSource {
     std::vector<Vec3f> positions_, normals_;
     std::vector<std::array<float, 2>> uvs_;
     std::vector<int64_t> indices_;
+    std::vector<Vec3f> polygon_;
+    std::vector<std::array<uint32_t, 3>> fan_;
     std::vector<store::MaterialRecord> materials_;
     ImportWarnings warnings_;
 };

@@ -1,5 +1,5 @@
 #pragma once
-// Stanford PLY: ASCII, binary little and big endian. Faces are lists of any length (triangulated as fans);
+// Stanford PLY: ASCII, binary little and big endian. Faces are lists of any length (triangulated as in import/triangulate.h);
 // `tristrips` elements (lists with -1 restarts, as 3D scanners write) become triangles with alternating
 // winding; properties nave does not use (colours, confidence...) are read and ignored.
 //

@@ -57,6 +57,20 @@ TEST(ObjImporter, CrlfQuadsNgonsNegativeIndicesAndMaterials) {
     EXPECT_EQ(source->warnings().Count("materials used but defined in no MTL (default colour used)"), 1u);
 }
 
+TEST(ObjImporter, ConcavePolygonsAreEarClipped) {
+    auto tris = ReadModel(Fixture("l_shape.obj"));
+    ASSERT_EQ(tris.size(), 4u);
+    double area = 0;
+    for (const auto& t : tris) {
+        area += Area(t);
+        EXPECT_GT(Normal(t).z, 0.99);  // winding kept
+        // Every triangle inside the L: its centroid is not in the missing square [1, 2] x [1, 2].
+        Vec3f c = (t.p[0] + t.p[1] + t.p[2]) * (1.f / 3);
+        EXPECT_FALSE(c.x > 1 && c.y > 1) << "triangle outside the polygon";
+    }
+    EXPECT_NEAR(area, 3.0, 1e-6);  // a fan from corner (2, 1) would give 4
+}
+
 TEST(ObjImporter, MissingMtlIsOneWarningAndADefaultMaterial) {
     std::unique_ptr<TriangleSource> source;
     auto tris = ReadModel(Fixture("missing_mtl.obj"), &source);
