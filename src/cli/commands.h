@@ -22,7 +22,5 @@ void RegisterSpectrumCommand(CLI::App& app, CommandRun& run);
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run);
 void RegisterGenerateCommand(CLI::App& app, CommandRun& run);
 void RegisterRenderCommand(CLI::App& app, CommandRun& run);
-void RegisterSunCommand(CLI::App& app, CommandRun& run);
-void RegisterSpectrumCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

@@ -44,8 +44,6 @@ int main(int argc, char** argv) {
     nave::cli::RegisterPreprocessCommand(app, run);
     nave::cli::RegisterGenerateCommand(app, run);
     nave::cli::RegisterRenderCommand(app, run);
-    nave::cli::RegisterSunCommand(app, run);
-    nave::cli::RegisterSpectrumCommand(app, run);
 
     try {
         app.parse(argc, argv);
