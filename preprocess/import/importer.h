@@ -1,6 +1,6 @@
 #pragma once
-// Opening model files: the format is chosen by extension (and, for files without a known extension, by the
-// first bytes), and several inputs become one merged source.
+// Opening model files: the format is chosen by extension (and, for files without a known extension,
+// by the first bytes), and several inputs become one merged source.
 
 #include <filesystem>
 #include <memory>
@@ -15,6 +15,7 @@ namespace nave::preprocess {
 StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path);
 
 /// Opens every input and merges them (material names made unique).
-StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths);
+StatusOr<std::unique_ptr<TriangleSource>> OpenModels(
+    const std::vector<std::filesystem::path>& paths);
 
 }  // namespace nave::preprocess

@@ -9,7 +9,9 @@ struct P2 {
     double x, y;
 };
 
-double Cross2(const P2& o, const P2& a, const P2& b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
+double Cross2(const P2& o, const P2& a, const P2& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
 
 void Fan(size_t n, std::vector<std::array<uint32_t, 3>>& out) {
     for (uint32_t k = 1; k + 1 < n; ++k) out.push_back({0, k, k + 1});
@@ -17,7 +19,8 @@ void Fan(size_t n, std::vector<std::array<uint32_t, 3>>& out) {
 
 }  // namespace
 
-void TriangulatePolygon(const std::vector<Vec3f>& corners, std::vector<std::array<uint32_t, 3>>& out) {
+void TriangulatePolygon(const std::vector<Vec3f>& corners,
+                        std::vector<std::array<uint32_t, 3>>& out) {
     const size_t n = corners.size();
     if (n < 3) return;
     if (n == 3 || n > 256) {
@@ -32,8 +35,9 @@ void TriangulatePolygon(const std::vector<Vec3f>& corners, std::vector<std::arra
         normal.y += (a.z - b.z) * (a.x + b.x);
         normal.z += (a.x - b.x) * (a.y + b.y);
     }
-    int axis = std::abs(normal.x) > std::abs(normal.y) ? (std::abs(normal.x) > std::abs(normal.z) ? 0 : 2)
-                                                       : (std::abs(normal.y) > std::abs(normal.z) ? 1 : 2);
+    int axis = std::abs(normal.x) > std::abs(normal.y)
+                   ? (std::abs(normal.x) > std::abs(normal.z) ? 0 : 2)
+                   : (std::abs(normal.y) > std::abs(normal.z) ? 1 : 2);
     if (normal[axis] == 0) {
         Fan(n, out);
         return;
@@ -62,7 +66,8 @@ void TriangulatePolygon(const std::vector<Vec3f>& corners, std::vector<std::arra
             bool empty = true;
             for (uint32_t q : ring) {
                 if (q == a || q == b || q == c) continue;
-                if (Cross2(p[a], p[b], p[q]) >= 0 && Cross2(p[b], p[c], p[q]) >= 0 && Cross2(p[c], p[a], p[q]) >= 0) {
+                if (Cross2(p[a], p[b], p[q]) >= 0 && Cross2(p[b], p[c], p[q]) >= 0 &&
+                    Cross2(p[c], p[a], p[q]) >= 0) {
                     empty = false;
                     break;
                 }
@@ -75,7 +80,8 @@ void TriangulatePolygon(const std::vector<Vec3f>& corners, std::vector<std::arra
         }
         if (!clipped) {
             // Self-intersecting or degenerate: fan what is left.
-            for (size_t k = 1; k + 1 < ring.size(); ++k) out.push_back({ring[0], ring[k], ring[k + 1]});
+            for (size_t k = 1; k + 1 < ring.size(); ++k)
+                out.push_back({ring[0], ring[k], ring[k + 1]});
             return;
         }
     }

@@ -31,7 +31,8 @@ BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::G
     return builder.Build(triangles, grid);
 }
 
-const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid) {
+const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
+                                      const store::GlobalGrid& grid) {
     BuiltBrick& out = out_;
     out.bounds = Bounds3f();
     out.collapsed_triangles = 0;
@@ -53,8 +54,8 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles, co
     if (uvs) mesh.uvs.reserve(triangles.size());
     mesh.indices.reserve(triangles.size() * 3);
     mesh.material_ids.reserve(triangles.size());
-    // Open addressing with linear probing; slots hold vertex index + 1 (0: empty). At most three vertices per
-    // triangle, so the table is at most half full.
+    // Open addressing with linear probing; slots hold vertex index + 1 (0: empty). At most three
+    // vertices per triangle, so the table is at most half full.
     size_t cap = 16;
     while (cap < 6 * triangles.size() + 32) cap <<= 1;
     slots_.assign(cap, 0);
@@ -90,7 +91,8 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles, co
             k.q = grid.Quantize(t.p[j]);
             Vec3f n = normals ? (t.has_normals ? t.n[j] : face_normal) : Vec3f();
             if (normals && t.has_normals) {
-                // Bad input normals (zero, NaN, not unit) are replaced or renormalised, not passed on.
+                // Bad input normals (zero, NaN, not unit) are replaced or renormalised, not passed
+                // on.
                 float len = Length(n);
                 n = (len > 1e-12f && std::isfinite(len)) ? n / len : face_normal;
             }

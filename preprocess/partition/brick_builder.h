@@ -1,8 +1,8 @@
 #pragma once
-// Turns a brick's triangles into an indexed BrickMesh: vertices shared when their grid position, normal and
-// texture coordinates agree (positions are snapped to the store's global grid here, as the store will).
-// A brick has normals if any of its triangles has; flat triangles then carry their face normal (likewise
-// texture coordinates, (0, 0) where absent).
+// Turns a brick's triangles into an indexed BrickMesh: vertices shared when their grid position,
+// normal and texture coordinates agree (positions are snapped to the store's global grid here, as
+// the store will). A brick has normals if any of its triangles has; flat triangles then carry their
+// face normal (likewise texture coordinates, (0, 0) where absent).
 
 #include <vector>
 
@@ -14,12 +14,12 @@ namespace nave::preprocess {
 
 struct BuiltBrick {
     store::BrickMesh mesh;
-    Bounds3f bounds;                 ///< of the snapped positions
+    Bounds3f bounds;                   ///< of the snapped positions
     uint64_t collapsed_triangles = 0;  ///< dropped: two corners on one grid point
 };
 
-/// Builds bricks one after the other, reusing its buffers (large fresh allocations cost page faults on
-/// every brick). Not thread-safe: one per encoding thread.
+/// Builds bricks one after the other, reusing its buffers (large fresh allocations cost page faults
+/// on every brick). Not thread-safe: one per encoding thread.
 class BrickBuilder {
   public:
     /// The returned brick stays valid until the next call.
@@ -39,9 +39,9 @@ class BrickBuilder {
 /// One-off convenience over BrickBuilder.
 BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid);
 
-/// Working memory of BuildBrickMesh + EncodeBrick per triangle, in bytes: the Triangle list, the mesh
-/// (about one vertex per triangle), the vertex hash table and the encoder's buffers (measured on the
-/// abbey and on scans, with a margin; see docs/preprocess.md "Memory").
+/// Working memory of BuildBrickMesh + EncodeBrick per triangle, in bytes: the Triangle list, the
+/// mesh (about one vertex per triangle), the vertex hash table and the encoder's buffers (measured
+/// on the abbey and on scans, with a margin; see docs/preprocess.md "Memory").
 inline constexpr uint64_t kEncodeBytesPerTriangle = 600;
 
 }  // namespace nave::preprocess

@@ -1,10 +1,9 @@
-// A development tool, not a test: renders quick previews of the procedural abbey (primary rays with Embree,
-// material colour times a head-light term) to check its geometry and the camera spots of docs/abbey.md.
-// Usage: abbey_preview DETAIL OUT_DIR
-
-#include <embree3/rtcore.h>
+// A development tool, not a test: renders quick previews of the procedural abbey (primary rays with
+// Embree, material colour times a head-light term) to check its geometry and the camera spots of
+// docs/abbey.md. Usage: abbey_preview DETAIL OUT_DIR
 
 #include <OpenImageIO/imageio.h>
+#include <embree3/rtcore.h>
 
 #include <cmath>
 #include <cstdio>
@@ -29,7 +28,8 @@ int main(int argc, char** argv) {
     auto source = preprocess::MakeAbbeySource(detail);
     std::vector<float> verts;
     std::vector<unsigned> mats, part_of;
-    // Generated part by part here (not through the source) to know which part each triangle comes from.
+    // Generated part by part here (not through the source) to know which part each triangle comes
+    // from.
     auto parts = preprocess::abbey::AbbeyParts(preprocess::abbey::Detail(detail));
     unsigned current = 0;
     preprocess::abbey::Emitter em(
@@ -47,8 +47,10 @@ int main(int argc, char** argv) {
     RTCDevice device = rtcNewDevice(nullptr);
     RTCScene scene = rtcNewScene(device);
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, verts.data(), 0, 12, 3 * n);
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, n));
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, verts.data(), 0, 12,
+                               3 * n);
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, n));
     for (size_t i = 0; i < 3 * n; ++i) ib[i] = unsigned(i);
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene, g);
@@ -74,14 +76,21 @@ int main(int argc, char** argv) {
         float scale = std::tan(v.fov_deg * 3.14159265f / 360);
         for (int y = 0; y < h; ++y) {
             for (int x = 0; x < w; ++x) {
-                float sx = (2 * (x + 0.5f) / w - 1) * scale, sy = (1 - 2 * (y + 0.5f) / h) * scale * h / w;
+                float sx = (2 * (x + 0.5f) / w - 1) * scale,
+                      sy = (1 - 2 * (y + 0.5f) / h) * scale * h / w;
                 Vec3f d = Normalize(fwd + right * sx + up * sy);
                 RTCIntersectContext ctx;
                 rtcInitIntersectContext(&ctx);
                 RTCRayHit rh{};
-                rh.ray.org_x = v.eye.x; rh.ray.org_y = v.eye.y; rh.ray.org_z = v.eye.z;
-                rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
-                rh.ray.tnear = 0; rh.ray.tfar = 1e30f; rh.ray.mask = ~0u;
+                rh.ray.org_x = v.eye.x;
+                rh.ray.org_y = v.eye.y;
+                rh.ray.org_z = v.eye.z;
+                rh.ray.dir_x = d.x;
+                rh.ray.dir_y = d.y;
+                rh.ray.dir_z = d.z;
+                rh.ray.tnear = 0;
+                rh.ray.tfar = 1e30f;
+                rh.ray.mask = ~0u;
                 rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                 rtcIntersect1(scene, &ctx, &rh);
                 float r = 0.55f, gg = 0.7f, b = 0.95f;  // sky
@@ -89,7 +98,8 @@ int main(int argc, char** argv) {
                     Vec3f nn = Normalize(Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
                     const auto& m = materials[mats[rh.hit.primID]];
                     bool front = Dot(nn, d) < 0;
-                    float shade = 0.25f + 0.75f * std::abs(Dot(nn, Normalize(Vec3f(0.3f, -0.5f, 0.8f))));
+                    float shade =
+                        0.25f + 0.75f * std::abs(Dot(nn, Normalize(Vec3f(0.3f, -0.5f, 0.8f))));
                     shade *= 0.6f + 0.4f * std::abs(Dot(nn, d));
                     r = m.diffuse[0] * shade;
                     gg = m.diffuse[1] * shade;
@@ -98,10 +108,13 @@ int main(int argc, char** argv) {
                         r = 1;
                         gg = 0;
                         b = 1;
-                        if (back[mats[rh.hit.primID]]++ % 5000 == 0 && std::getenv("NAVE_PREVIEW_DEBUG")) {
+                        if (back[mats[rh.hit.primID]]++ % 5000 == 0 &&
+                            std::getenv("NAVE_PREVIEW_DEBUG")) {
                             Vec3f hp = v.eye + d * rh.ray.tfar;
-                            std::printf("  back face at (%.2f %.2f %.2f) Ng (%.2f %.2f %.2f) of %s\n", hp.x, hp.y,
-                                        hp.z, nn.x, nn.y, nn.z, parts[part_of[rh.hit.primID]].name.c_str());
+                            std::printf(
+                                "  back face at (%.2f %.2f %.2f) Ng (%.2f %.2f %.2f) of %s\n", hp.x,
+                                hp.y, hp.z, nn.x, nn.y, nn.z,
+                                parts[part_of[rh.hit.primID]].name.c_str());
                         }
                     }
                 }
@@ -118,7 +131,8 @@ int main(int argc, char** argv) {
         file->write_image(OIIO::TypeDesc::UINT8, img.data());
         file->close();
         std::printf("wrote %s", path.c_str());
-        for (auto [m, count] : back) std::printf(" [back faces of %s: %d px]", materials[m].name.c_str(), count);
+        for (auto [m, count] : back)
+            std::printf(" [back faces of %s: %d px]", materials[m].name.c_str(), count);
         std::printf("\n");
     }
     rtcReleaseScene(scene);

@@ -57,15 +57,16 @@ TEST(AbbeySlow, DetailScalesTriangles) {
     auto coarse = MakeAbbeySource(0.25);
     Digest d025 = Consume(*coarse);
     EXPECT_LT(d025.triangles, d1.triangles / 2);
-    std::printf("abbey triangles: detail 0.25 -> %llu, detail 1 -> %llu\n", (unsigned long long)d025.triangles,
-                (unsigned long long)d1.triangles);
+    std::printf("abbey triangles: detail 0.25 -> %llu, detail 1 -> %llu\n",
+                (unsigned long long)d025.triangles, (unsigned long long)d1.triangles);
 }
 
 TEST(AbbeySlow, DetailFourHasMoreThanTwiceDetailOne) {
     Digest d1 = Consume(*MakeAbbeySource(1.0));
     Digest d4 = Consume(*MakeAbbeySource(4.0));
     double ratio = double(d4.triangles) / double(d1.triangles);
-    std::printf("abbey triangles: detail 4 -> %llu (%.2f x detail 1)\n", (unsigned long long)d4.triangles, ratio);
+    std::printf("abbey triangles: detail 4 -> %llu (%.2f x detail 1)\n",
+                (unsigned long long)d4.triangles, ratio);
     EXPECT_GT(ratio, 2.0);
     EXPECT_LT(ratio, 5.0);
 }

@@ -1,5 +1,6 @@
-// The procedural abbey: deterministic, the material names every render config maps, the size of the church,
-// consistent normals, detail that scales the triangle count, and streaming in constant memory.
+// The procedural abbey: deterministic, the material names every render config maps, the size of the
+// church, consistent normals, detail that scales the triangle count, and streaming in constant
+// memory.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -50,8 +51,8 @@ Digest Consume(TriangleSource& source) {
 }
 
 TEST(Abbey, PointedArchProfile) {
-    // Crown at t = 0, springing at t = 1; the equilateral arch (rho = 2) rises sqrt(3) half-spans: at
-    // t = 0.5 its height is sqrt(4 - 1.5^2) / sqrt(3) of the rise.
+    // Crown at t = 0, springing at t = 1; the equilateral arch (rho = 2) rises sqrt(3) half-spans:
+    // at t = 0.5 its height is sqrt(4 - 1.5^2) / sqrt(3) of the rise.
     EXPECT_DOUBLE_EQ(abbey::PointedArch(0, 2), 1.0);
     EXPECT_NEAR(abbey::PointedArch(1, 2), 0.0, 1e-12);
     EXPECT_NEAR(abbey::PointedArch(0.5, 2), std::sqrt(4 - 2.25) / std::sqrt(3.0), 1e-12);
@@ -66,10 +67,12 @@ TEST(Abbey, DeterministicWithTheAgreedMaterialsAndSize) {
     EXPECT_EQ(da.hash, db.hash) << "same detail must give the same triangles";
     std::vector<std::string> names;
     for (const auto& m : a->materials()) names.push_back(m.name);
-    EXPECT_THAT(names, ::testing::ElementsAre("limestone", "limestone_dark", "floor_tile_light",
-                                              "floor_tile_dark", "glass_clear", "glass_blue", "glass_red",
-                                              "glass_yellow", "glass_green", "lead", "wood", "roof_slate"));
-    for (size_t m = 0; m < da.per_material.size(); ++m) EXPECT_GT(da.per_material[m], 0u) << names[m];
+    EXPECT_THAT(
+        names, ::testing::ElementsAre("limestone", "limestone_dark", "floor_tile_light",
+                                      "floor_tile_dark", "glass_clear", "glass_blue", "glass_red",
+                                      "glass_yellow", "glass_green", "lead", "wood", "roof_slate"));
+    for (size_t m = 0; m < da.per_material.size(); ++m)
+        EXPECT_GT(da.per_material[m], 0u) << names[m];
     // About 100 m long east-west, apse to the east (+x), ridge near 39 m, floor at 0.
     EXPECT_GT(da.bounds.max.x - da.bounds.min.x, 95.0);
     EXPECT_LT(da.bounds.max.x - da.bounds.min.x, 110.0);
@@ -83,23 +86,25 @@ TEST(Abbey, DeterministicWithTheAgreedMaterialsAndSize) {
 }
 
 TEST(Abbey, PlanContainsNaveChoirChapelsNotOutside) {
-    EXPECT_TRUE(abbey::InsidePlan(28, 0));     // nave
-    EXPECT_TRUE(abbey::InsidePlan(28, 10));    // north aisle
-    EXPECT_TRUE(abbey::InsidePlan(62, 24));    // north transept arm
-    EXPECT_TRUE(abbey::InsidePlan(90, 0));     // apse
-    EXPECT_TRUE(abbey::InsidePlan(83 + 9, 5)); // ambulatory
-    EXPECT_TRUE(abbey::InsidePlan(98, 0));     // axial chapel
-    EXPECT_FALSE(abbey::InsidePlan(28, 20));   // beside the aisle
-    EXPECT_FALSE(abbey::InsidePlan(-5, 0));    // west of the facade
-    EXPECT_FALSE(abbey::InsidePlan(75, 20));   // east of the transept, north of the choir aisle
+    EXPECT_TRUE(abbey::InsidePlan(28, 0));      // nave
+    EXPECT_TRUE(abbey::InsidePlan(28, 10));     // north aisle
+    EXPECT_TRUE(abbey::InsidePlan(62, 24));     // north transept arm
+    EXPECT_TRUE(abbey::InsidePlan(90, 0));      // apse
+    EXPECT_TRUE(abbey::InsidePlan(83 + 9, 5));  // ambulatory
+    EXPECT_TRUE(abbey::InsidePlan(98, 0));      // axial chapel
+    EXPECT_FALSE(abbey::InsidePlan(28, 20));    // beside the aisle
+    EXPECT_FALSE(abbey::InsidePlan(-5, 0));     // west of the facade
+    EXPECT_FALSE(abbey::InsidePlan(75, 20));    // east of the transept, north of the choir aisle
 }
 
 TEST(Abbey, GeneratorSpecErrors) {
     EXPECT_TRUE(OpenGenerator("abbey").ok());
     EXPECT_TRUE(OpenGenerator("abbey:detail=0.5").ok());
     EXPECT_THAT(OpenGenerator("castle").status().message(), ::testing::HasSubstr("unknown"));
-    EXPECT_THAT(OpenGenerator("abbey:detail=-1").status().message(), ::testing::HasSubstr("must be a number"));
-    EXPECT_THAT(OpenGenerator("abbey:size=3").status().message(), ::testing::HasSubstr("expected detail=D"));
+    EXPECT_THAT(OpenGenerator("abbey:detail=-1").status().message(),
+                ::testing::HasSubstr("must be a number"));
+    EXPECT_THAT(OpenGenerator("abbey:size=3").status().message(),
+                ::testing::HasSubstr("expected detail=D"));
 }
 
 }  // namespace

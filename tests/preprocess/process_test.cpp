@@ -1,8 +1,10 @@
-// `nave preprocess` run as a child process: peak memory stays under --memory for a stream several times
-// larger, an interrupted run leaves no store and no temporary files, a killed run's leftovers are removed
-// by the next run, and bad input exits with a message naming the file and line.
+// `nave preprocess` run as a child process: peak memory stays under --memory for a stream several
+// times larger, an interrupted run leaves no store and no temporary files, a killed run's leftovers
+// are removed by the next run, and bad input exits with a message naming the file and line.
 
 #include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -10,9 +12,6 @@
 
 #include <chrono>
 #include <thread>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/file.h"
 #include "store/store_reader.h"
@@ -24,15 +23,15 @@ namespace {
 using ::testing::HasSubstr;
 
 struct ChildResult {
-    int exit_code = -1;       ///< when it exited
-    int signal = 0;           ///< when a signal ended it
+    int exit_code = -1;  ///< when it exited
+    int signal = 0;      ///< when a signal ended it
     uint64_t max_rss_bytes = 0;
     std::string err;
 };
 
 // Runs NAVE_BINARY with `args` in `dir`; sends `sig` after `signal_after_ms` if > 0.
-ChildResult RunNave(const std::filesystem::path& dir, std::vector<std::string> args, int signal_after_ms = 0,
-                    int sig = SIGINT) {
+ChildResult RunNave(const std::filesystem::path& dir, std::vector<std::string> args,
+                    int signal_after_ms = 0, int sig = SIGINT) {
     std::filesystem::path err_path = dir / "stderr.txt";
     pid_t pid = fork();
     if (pid == 0) {
@@ -73,19 +72,21 @@ std::vector<std::string> Leftovers(const std::filesystem::path& dir) {
     return names;
 }
 
-// The abbey at detail 3 is several million triangles: several times the 64 MiB budget as triangles in memory
-// (104 bytes each).
+// The abbey at detail 3 is several million triangles: several times the 64 MiB budget as triangles
+// in memory (104 bytes each).
 TEST(PreprocessProcess, PeakMemoryStaysUnderTheBudget) {
     auto dir = testing::MakeTempDir("memory");
     const uint64_t budget = 64ull << 20;
-    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=3", "-o", "abbey.nave", "--memory",
-                                  "64M", "--brick-triangles", "20000"});
+    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=3", "-o", "abbey.nave",
+                                  "--memory", "64M", "--brick-triangles", "20000"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_LT(r.max_rss_bytes, budget) << "peak RSS " << r.max_rss_bytes << " over the budget " << budget;
+    EXPECT_LT(r.max_rss_bytes, budget)
+        << "peak RSS " << r.max_rss_bytes << " over the budget " << budget;
     EXPECT_GT(r.max_rss_bytes, 0u);
     auto store = store::Store::Open(dir / "abbey.nave");
     ASSERT_TRUE(store.ok()) << store.status().ToString();
-    EXPECT_GT((*store)->header().source_triangle_count, 4 * budget / 104);  // sizeof(Triangle) is 104 bytes
+    EXPECT_GT((*store)->header().source_triangle_count,
+              4 * budget / 104);  // sizeof(Triangle) is 104 bytes
     EXPECT_THAT(Leftovers(dir), ::testing::IsEmpty());
     std::filesystem::remove_all(dir);
 }
@@ -93,8 +94,9 @@ TEST(PreprocessProcess, PeakMemoryStaysUnderTheBudget) {
 TEST(PreprocessProcess, InterruptLeavesNoStoreAndNoTemporaries) {
     auto dir = testing::MakeTempDir("interrupt");
     for (int sig : {SIGINT, SIGTERM}) {
-        ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=1", "-o", "abbey.nave",
-                                      "--brick-triangles", "50000"},
+        ChildResult r = RunNave(dir,
+                                {"preprocess", "--generate", "abbey:detail=1", "-o", "abbey.nave",
+                                 "--brick-triangles", "50000"},
                                 1500, sig);
         EXPECT_EQ(r.exit_code, 130) << "signal " << sig << ": " << r.err;
         EXPECT_THAT(r.err, HasSubstr("interrupted"));
@@ -106,8 +108,9 @@ TEST(PreprocessProcess, InterruptLeavesNoStoreAndNoTemporaries) {
 
 TEST(PreprocessProcess, KilledRunLeavesNoValidStoreAndTheNextRunCleansUp) {
     auto dir = testing::MakeTempDir("kill");
-    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=1", "-o", "abbey.nave",
-                                  "--brick-triangles", "50000"},
+    ChildResult r = RunNave(dir,
+                            {"preprocess", "--generate", "abbey:detail=1", "-o", "abbey.nave",
+                             "--brick-triangles", "50000"},
                             2500, SIGKILL);
     EXPECT_EQ(r.signal, SIGKILL);
     // Whatever it left cannot be opened as a store.
@@ -116,8 +119,9 @@ TEST(PreprocessProcess, KilledRunLeavesNoValidStoreAndTheNextRunCleansUp) {
         EXPECT_FALSE(store::Store::Open(e.path()).ok()) << e.path() << " opens as a valid store";
     }
     // A rerun (here on a small model) removes the dead run's temporaries.
-    ChildResult ok = RunNave(dir, {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/tetra_ascii.ply", "-o",
-                                   "abbey.nave", "--brick-triangles", "1000"});
+    ChildResult ok =
+        RunNave(dir, {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/tetra_ascii.ply",
+                      "-o", "abbey.nave", "--brick-triangles", "1000"});
     ASSERT_EQ(ok.exit_code, 0) << ok.err;
     EXPECT_THAT(Leftovers(dir), ::testing::IsEmpty());
     EXPECT_TRUE(store::Store::Open(dir / "abbey.nave").ok());
@@ -126,11 +130,13 @@ TEST(PreprocessProcess, KilledRunLeavesNoValidStoreAndTheNextRunCleansUp) {
 
 TEST(PreprocessProcess, BadInputExitsWithFileAndLine) {
     auto dir = testing::MakeTempDir("badcli");
-    ChildResult r = RunNave(dir, {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/zero_index.obj", "-o",
-                                  "x.nave"});
+    ChildResult r = RunNave(
+        dir,
+        {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/zero_index.obj", "-o", "x.nave"});
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_THAT(r.err, HasSubstr("zero_index.obj:4"));
-    r = RunNave(dir, {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/truncated.stl", "-o", "x.nave"});
+    r = RunNave(dir, {"preprocess", std::string(NAVE_TEST_FIXTURES) + "/models/truncated.stl", "-o",
+                      "x.nave"});
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_THAT(r.err, HasSubstr("234 bytes expected, found 224"));
     r = RunNave(dir, {"preprocess", "--generate", "abbey", "-o", "x.nave", "--memory", "10M"});
