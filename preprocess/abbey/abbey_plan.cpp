@@ -381,8 +381,11 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             Vec3d(x0, kNaveInner, 0), kVaultSpring, kVaultRise, i == 1, "choir vault");
     }
     for (double s : {-1.0, 1.0}) {
-        double mid = 0.5 * (kArcadeY + kTransept);
-        for (auto [y0, y1] : {std::pair{kArcadeY, mid}, std::pair{mid, kTransept}}) {
+        // Three bays per arm: one over the aisle's width, then two of 7 m centred on the arm's
+        // clerestory windows (|y| = 16.5, 23.5), whose lateral cells then rise round them as the
+        // nave's do; two equal bays put a transverse arch right over a window.
+        for (auto [y0, y1] : {std::pair{kArcadeY, kAisleWall}, std::pair{kAisleWall, 20.0},
+                              std::pair{20.0, kTransept}}) {
             bay(Vec3d(kCrossingX1, s * y0, 0), Vec3d(kCrossingX1, s * y1, 0),
                 Vec3d(kCrossingX0, s * y1, 0), Vec3d(kCrossingX0, s * y0, 0), kVaultSpring,
                 kVaultRise, false, "transept vault");
@@ -406,8 +409,13 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             kArcadeSpring, kAisleRise, k == kApseBays - 1, "ambulatory vault");
     }
     add("apse vault", [=](Emitter& em) {
+        // The hemicycle's windows (0.55 m half width, apex at 25 m) stand above the dome's
+        // springing line: a lunette round each, 0.35 m clear of its jambs, crown 26.5 m.
+        Lunette lunette;
+        lunette.half_width = 0.9;
+        lunette.crown = 26.5;
         EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, kApseBays - 1,
-                     d);
+                     d, lunette);
     });
 
     // Roofs: the main roof over nave and choir, the transept roof, the apse's half cone, lean-to

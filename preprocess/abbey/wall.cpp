@@ -105,7 +105,6 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
     double dx = (b - a) / cols, dz = (apex - o.sill) / rows;
     const uint32_t palette[] = {kGlassClear, kGlassClear, kGlassClear,  kGlassBlue,  kGlassBlue,
                                 kGlassRed,   kGlassRed,   kGlassYellow, kGlassGreen, kGlassClear};
-    const double kHalfGlass = 0.003;
     for (int r = 0; r < rows; ++r) {
         double z0 = o.sill + r * dz, z1 = z0 + dz;
         for (int c = 0; c < cols; ++c) {
@@ -115,11 +114,10 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
             t0 = std::max(t0, z0);
             t1 = std::max(t1, z0);
             uint32_t m = palette[int(Hash01(seed, r, c) * 10) % 10];
-            for (double s : {-1.0, 1.0}) {
-                double d = mid + s * kHalfGlass;
-                Vec3d out = w.inward * (-s);
-                em.Quad(g.P(x0, z0, d), g.P(x1, z0, d), g.P(x1, t1, d), g.P(x0, t0, d), out, m);
-            }
+            // One sheet per pane, facing outward: the renderer's thin-pane material accounts for
+            // both faces of the glass in a single surface, so a closed slab would count them twice.
+            em.Quad(g.P(x0, z0, mid), g.P(x1, z0, mid), g.P(x1, t1, mid), g.P(x0, t0, mid),
+                    -w.inward, m);
         }
     }
     // Lead cames on every line between pieces: 12 mm wide, 20 mm deep boxes.
