@@ -80,9 +80,12 @@ void EmitFace(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, in
 // Below the springing the outline is stretched so that the sill falls by `drop` (the glacis).
 Vec3d OutlinePoint(const WallGeom& g, const Opening& o, double u, double z, double k, double drop,
                    double depth) {
-    double zk = z > o.spring ? o.spring + (z - o.spring) * k
-                             : o.spring - (o.spring - z) * (o.spring - o.sill + drop) /
-                                              (o.spring - o.sill);
+    double zk = z;
+    if (z > o.spring) {
+        zk = o.spring + (z - o.spring) * k;
+    } else if (drop > 0) {  // (a window with a glacis has its sill below its springing)
+        zk = o.spring - (o.spring - z) * (o.spring - o.sill + drop) / (o.spring - o.sill);
+    }
     return g.P(o.center + (u - o.center) * k, zk, depth);
 }
 
