@@ -116,9 +116,9 @@ void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius,
             double sector = kPi / sectors;
             double off = angle - sector * (std::floor(angle / sector) + 0.5);
             double across = radius * s * std::abs(std::sin(off));
-            double lift = spring + (lunette.crown - spring) *
-                                       PointedArch(across / lunette.half_width, kRho) -
-                          z;
+            double lift =
+                spring + (lunette.crown - spring) * PointedArch(across / lunette.half_width, kRho) -
+                z;
             double fade = std::clamp((s - lunette.fade_from) / (1 - lunette.fade_from), 0.0, 1.0);
             z += fade * std::max(0.0, lift);
         }

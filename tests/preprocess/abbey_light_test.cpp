@@ -99,11 +99,11 @@ std::vector<Window> ClerestoryWindows() {
         // Nave (8 bays of 7 m from x = 0) and choir (2 bays from x = 69): glass in the middle of
         // the 1.2 m upper walls whose inner faces are at |y| = 5.9.
         for (int b = 0; b < 8; ++b)
-            w.push_back({"nave " + std::to_string(b), Vec3d(3.5 + 7 * b, s * 6.5, 0),
-                         north * s, east, 1.3, 20.0, 23.6});
+            w.push_back({"nave " + std::to_string(b), Vec3d(3.5 + 7 * b, s * 6.5, 0), north * s,
+                         east, 1.3, 20.0, 23.6});
         for (int b = 0; b < 2; ++b)
-            w.push_back({"choir " + std::to_string(b), Vec3d(72.5 + 7 * b, s * 6.5, 0),
-                         north * s, east, 1.3, 20.0, 23.6});
+            w.push_back({"choir " + std::to_string(b), Vec3d(72.5 + 7 * b, s * 6.5, 0), north * s,
+                         east, 1.3, 20.0, 23.6});
         // Transept arms: west (x = 56) and east (x = 69) walls, windows at |y| = 16.5 and 23.5.
         for (double y : {16.5, 23.5}) {
             w.push_back({"transept west", Vec3d(55.4, s * y, 0), -east, north, 1.2, 19.0, 23.5});
@@ -117,8 +117,8 @@ std::vector<Window> ClerestoryWindows() {
         Vec3d p1(83 + 5.9 * std::cos(a1), 5.9 * std::sin(a1), 0);
         Vec3d mid = (p0 + p1) * 0.5;
         Vec3d out = Normalize(Vec3d(mid.x - 83, mid.y, 0));
-        w.push_back({"hemicycle " + std::to_string(k), mid + out * 0.6, out,
-                     Normalize(p1 - p0), 0.55, 20.0, 23.8});
+        w.push_back({"hemicycle " + std::to_string(k), mid + out * 0.6, out, Normalize(p1 - p0),
+                     0.55, 20.0, 23.8});
     }
     return w;
 }
@@ -151,9 +151,8 @@ TEST(AbbeyLight, FloorSeesEveryClerestoryWindowThroughOnePane) {
                     // Or the window's own reveal or moulding, in the wall's thickness (0.6 m on
                     // the outer side of the glass, the moulding's roll 0.07 m beyond).
                     if (!second.empty() && Dot(dir * t2, win.outward) < 0.6 + 0.07 + 0.01) continue;
-                    EXPECT_EQ(second, "")
-                        << "after its pane the ray hits '" << second << "' " << t2
-                        << " m further instead of leaving the church";
+                    EXPECT_EQ(second, "") << "after its pane the ray hits '" << second << "' " << t2
+                                          << " m further instead of leaving the church";
                     if (second.empty()) ++through;
                 }
             }
