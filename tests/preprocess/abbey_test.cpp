@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/abbey/materials.h"
@@ -13,42 +15,8 @@
 namespace nave::preprocess {
 namespace {
 
-struct Digest {
-    uint64_t triangles = 0, with_normals = 0, bad_normals = 0;
-    uint64_t hash = 1469598103934665603ull;
-    Bounds3d bounds;
-    std::vector<uint64_t> per_material;
-};
-
-Digest Consume(TriangleSource& source) {
-    Digest d;
-    d.per_material.assign(source.materials().size(), 0);
-    std::vector<Triangle> batch;
-    while (true) {
-        auto more = source.Next(batch, 5000);
-        EXPECT_TRUE(more.ok());
-        if (!more.ok() || !*more) break;
-        for (const Triangle& t : batch) {
-            ++d.triangles;
-            ++d.per_material.at(t.material);
-            for (const Vec3f& p : t.p) {
-                d.bounds.Extend(Vec3d(p));
-                uint32_t bits[3];
-                std::memcpy(bits, &p, 12);
-                for (uint32_t b : bits) d.hash = (d.hash ^ b) * 1099511628211ull;
-            }
-            if (t.has_normals) {
-                ++d.with_normals;
-                Vec3f g = Cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-                for (const Vec3f& n : t.n) {
-                    // A shading normal on the back of its triangle would be a winding error.
-                    if (!(Dot(n, g) > 0) || std::abs(Length(n) - 1) > 1e-3f) ++d.bad_normals;
-                }
-            }
-        }
-    }
-    return d;
-}
+using testing::AbbeyDigest;
+using testing::DigestOf;
 
 TEST(Abbey, PointedArchProfile) {
     // Crown at t = 0, springing at t = 1; the equilateral arch (rho = 2) rises sqrt(3) half-spans:
@@ -62,7 +30,7 @@ TEST(Abbey, PointedArchProfile) {
 TEST(Abbey, DeterministicWithTheAgreedMaterialsAndSize) {
     auto a = MakeAbbeySource(0.25);
     auto b = MakeAbbeySource(0.25);
-    Digest da = Consume(*a), db = Consume(*b);
+    AbbeyDigest da = DigestOf(*a), db = DigestOf(*b);
     EXPECT_EQ(da.triangles, db.triangles);
     EXPECT_EQ(da.hash, db.hash) << "same detail must give the same triangles";
     std::vector<std::string> names;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/vecmath.h"
 #include "preprocess/triangle_source.h"
 
 namespace nave::preprocess::testing {
@@ -19,6 +20,19 @@ std::vector<Triangle> ReadModel(const std::filesystem::path& path,
 
 /// The error message of opening and reading `path` completely ("" if it succeeded).
 std::string ReadError(const std::filesystem::path& path);
+
+/// What a triangle stream holds, in a few numbers: counts, bounds, a hash of every position (FNV-1a over
+/// the float bits, so two streams with equal digests are identical), and shading normals that point to the
+/// back of their triangle or are not unit length (winding errors).
+struct AbbeyDigest {
+    uint64_t triangles = 0, with_normals = 0, bad_normals = 0;
+    uint64_t hash = 1469598103934665603ull;
+    Bounds3d bounds;
+    std::vector<uint64_t> per_material;
+};
+
+/// Reads `source` to the end; fails the test on a read error.
+AbbeyDigest DigestOf(TriangleSource& source);
 
 /// A fresh empty directory under the system temp dir, removed by the caller.
 std::filesystem::path MakeTempDir(const std::string& tag);
