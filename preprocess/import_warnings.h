@@ -1,7 +1,7 @@
 #pragma once
-// Counted warnings for problems an importer can skip over: one line per kind at the end of a run, with the
-// count and the first place it happened ("skipped 12 degenerate faces (first at bunny.ply:1234)"), instead
-// of thousands of lines.
+// Counted warnings for problems an importer can skip over: one line per kind at the end of a run,
+// with the count and the first place it happened ("skipped 12 degenerate faces (first at
+// bunny.ply:1234)"), instead of thousands of lines.
 
 #include <cstdint>
 #include <map>

@@ -5,7 +5,9 @@
 namespace nave::preprocess {
 
 MergedSource::MergedSource(std::vector<std::unique_ptr<TriangleSource>> sources)
-    : sources_(std::move(sources)), remap_(sources_.size()), finished_progress_(sources_.size(), 0) {}
+    : sources_(std::move(sources)),
+      remap_(sources_.size()),
+      finished_progress_(sources_.size(), 0) {}
 
 uint32_t MergedSource::GlobalMaterial(size_t source, uint32_t local) {
     std::vector<int64_t>& remap = remap_[source];
@@ -24,7 +26,8 @@ uint32_t MergedSource::GlobalMaterial(size_t source, uint32_t local) {
 }
 
 void MergedSource::AddRemainingMaterials(size_t source) {
-    // Materials no triangle used still go into the table (the user may map them in a render config).
+    // Materials no triangle used still go into the table (the user may map them in a render
+    // config).
     for (uint32_t i = 0; i < sources_[source]->materials().size(); ++i) GlobalMaterial(source, i);
 }
 
@@ -54,8 +57,10 @@ std::string MergedSource::name() const {
 std::string MergedSource::units() const {
     std::string units;
     for (const auto& s : sources_) {
-        if (units.empty()) units = s->units();
-        else if (units != s->units()) return "mixed";
+        if (units.empty())
+            units = s->units();
+        else if (units != s->units())
+            return "mixed";
     }
     return units.empty() ? "unknown" : units;
 }
@@ -63,7 +68,8 @@ std::string MergedSource::units() const {
 uint64_t MergedSource::progress_done() const {
     uint64_t done = 0;
     for (size_t i = 0; i < sources_.size(); ++i) {
-        done += i < current_ ? sources_[i]->progress_total() : (i == current_ ? sources_[i]->progress_done() : 0);
+        done += i < current_ ? sources_[i]->progress_total()
+                             : (i == current_ ? sources_[i]->progress_done() : 0);
     }
     return done;
 }

@@ -1,6 +1,6 @@
 #pragma once
-// Several inputs as one model: their triangles one after the other, their material tables joined with names
-// made unique ("stone" from a.obj and "stone" from b.obj become "stone" and "stone.1").
+// Several inputs as one model: their triangles one after the other, their material tables joined
+// with names made unique ("stone" from a.obj and "stone" from b.obj become "stone" and "stone.1").
 
 #include <memory>
 #include <unordered_map>
@@ -30,7 +30,7 @@ class MergedSource final : public TriangleSource {
 
     std::vector<std::unique_ptr<TriangleSource>> sources_;
     size_t current_ = 0;
-    std::vector<std::vector<int64_t>> remap_;   // per source: local material -> global (-1 not yet)
+    std::vector<std::vector<int64_t>> remap_;  // per source: local material -> global (-1 not yet)
     std::vector<store::MaterialRecord> materials_;
     std::unordered_set<std::string> names_;
     ImportWarnings warnings_;

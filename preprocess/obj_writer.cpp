@@ -27,18 +27,23 @@ StatusOr<ObjWriteStats> WriteObj(TriangleSource& source, const std::filesystem::
         for (const Triangle& t : batch) {
             if (int64_t(t.material) != material) {
                 material = t.material;
-                fmt::format_to(std::back_inserter(out), "usemtl {}\n", source.materials().at(t.material).name);
+                fmt::format_to(std::back_inserter(out), "usemtl {}\n",
+                               source.materials().at(t.material).name);
             }
-            for (int j = 0; j < 3; ++j) fmt::format_to(std::back_inserter(out), "v {} {} {}\n", t.p[j].x, t.p[j].y, t.p[j].z);
+            for (int j = 0; j < 3; ++j)
+                fmt::format_to(std::back_inserter(out), "v {} {} {}\n", t.p[j].x, t.p[j].y,
+                               t.p[j].z);
             if (t.has_normals) {
                 for (int j = 0; j < 3; ++j) {
-                    fmt::format_to(std::back_inserter(out), "vn {:.4f} {:.4f} {:.4f}\n", t.n[j].x, t.n[j].y, t.n[j].z);
+                    fmt::format_to(std::back_inserter(out), "vn {:.4f} {:.4f} {:.4f}\n", t.n[j].x,
+                                   t.n[j].y, t.n[j].z);
                 }
-                fmt::format_to(std::back_inserter(out), "f {}//{} {}//{} {}//{}\n", vertices + 1, normals + 1,
-                               vertices + 2, normals + 2, vertices + 3, normals + 3);
+                fmt::format_to(std::back_inserter(out), "f {}//{} {}//{} {}//{}\n", vertices + 1,
+                               normals + 1, vertices + 2, normals + 2, vertices + 3, normals + 3);
                 normals += 3;
             } else {
-                fmt::format_to(std::back_inserter(out), "f {} {} {}\n", vertices + 1, vertices + 2, vertices + 3);
+                fmt::format_to(std::back_inserter(out), "f {} {} {}\n", vertices + 1, vertices + 2,
+                               vertices + 3);
             }
             vertices += 3;
         }
@@ -49,10 +54,13 @@ StatusOr<ObjWriteStats> WriteObj(TriangleSource& source, const std::filesystem::
     progress.Finish();
     out.clear();
     for (const auto& m : source.materials()) {
-        fmt::format_to(std::back_inserter(out), "newmtl {}\nKd {} {} {}\nKs {} {} {}\nKe {} {} {}\nNi {}\nd {}\n",
-                       m.name, m.diffuse[0], m.diffuse[1], m.diffuse[2], m.specular[0], m.specular[1],
-                       m.specular[2], m.emission[0], m.emission[1], m.emission[2], m.ior, m.opacity);
-        for (const auto& [slot, file] : m.textures) fmt::format_to(std::back_inserter(out), "{} {}\n", slot, file);
+        fmt::format_to(std::back_inserter(out),
+                       "newmtl {}\nKd {} {} {}\nKs {} {} {}\nKe {} {} {}\nNi {}\nd {}\n", m.name,
+                       m.diffuse[0], m.diffuse[1], m.diffuse[2], m.specular[0], m.specular[1],
+                       m.specular[2], m.emission[0], m.emission[1], m.emission[2], m.ior,
+                       m.opacity);
+        for (const auto& [slot, file] : m.textures)
+            fmt::format_to(std::back_inserter(out), "{} {}\n", slot, file);
         fmt::format_to(std::back_inserter(out), "\n");
     }
     NAVE_RETURN_IF_ERROR(mtl.Write(out.data(), out.size()));

@@ -1,7 +1,7 @@
 #pragma once
-// Writes any TriangleSource as OBJ + MTL (for looking at generated models in other tools), streaming:
-// vertices are written per triangle (no sharing), so memory stays constant. Both files go through
-// AtomicFile: an interrupted run leaves neither.
+// Writes any TriangleSource as OBJ + MTL (for looking at generated models in other tools),
+// streaming: vertices are written per triangle (no sharing), so memory stays constant. Both files
+// go through AtomicFile: an interrupted run leaves neither.
 
 #include <filesystem>
 

@@ -1,7 +1,7 @@
 #pragma once
-// `nave preprocess` as a library call: inputs (model files or a generator) -> a brick store, in bounded
-// memory. Phases: read/bin, split (partition/partitioner.h), encode (several threads, store::EncodeBrick)
-// and write (store::StoreWriter, atomic). See docs/preprocess.md.
+// `nave preprocess` as a library call: inputs (model files or a generator) -> a brick store, in
+// bounded memory. Phases: read/bin, split (partition/partitioner.h), encode (several threads,
+// store::EncodeBrick) and write (store::StoreWriter, atomic). See docs/preprocess.md.
 
 #include <cstdint>
 #include <filesystem>
@@ -19,19 +19,19 @@ struct PreprocessOptions {
     std::filesystem::path output;               ///< the .nave store
     uint64_t memory_bytes = 0;                  ///< budget; 0: a quarter of physical memory
     uint64_t brick_triangles = 1'000'000;       ///< target triangles per brick
-    double precision = 0;                       ///< grid step in model units; 0: bounds diagonal / 2^20
-    int threads = 0;                            ///< 0: all hardware threads
-    std::filesystem::path temp_dir;             ///< parent of the temporary directory; empty: beside output
+    double precision = 0;            ///< grid step in model units; 0: bounds diagonal / 2^20
+    int threads = 0;                 ///< 0: all hardware threads
+    std::filesystem::path temp_dir;  ///< parent of the temporary directory; empty: beside output
     store::EncodeOptions encode;
     std::string tool_version = "nave";
 };
 
 struct PreprocessStats {
     std::string source_name, units;
-    uint64_t source_triangles = 0;     ///< triangles read from the input (after skipped bad faces)
-    uint64_t stored_triangles = 0;     ///< triangles in bricks (crossing triangles once per brick)
-    uint64_t duplicated_triangles = 0; ///< references beyond the first of triangles crossing cells
-    uint64_t collapsed_triangles = 0;  ///< dropped because the grid snapped two corners together
+    uint64_t source_triangles = 0;      ///< triangles read from the input (after skipped bad faces)
+    uint64_t stored_triangles = 0;      ///< triangles in bricks (crossing triangles once per brick)
+    uint64_t duplicated_triangles = 0;  ///< references beyond the first of triangles crossing cells
+    uint64_t collapsed_triangles = 0;   ///< dropped because the grid snapped two corners together
     uint64_t bricks = 0, empty_cells = 0, oversized_bricks = 0;
     uint64_t output_bytes = 0, peak_temp_bytes = 0;
     double grid_step = 0, max_error = 0;
@@ -41,8 +41,9 @@ struct PreprocessStats {
     std::vector<std::string> warnings;
 };
 
-/// Runs the whole preprocess. Errors: bad input (with file and line), a budget too small (with the numbers
-/// and the option to change), I/O, Cancelled on SIGINT/SIGTERM. On any error nothing is left behind.
+/// Runs the whole preprocess. Errors: bad input (with file and line), a budget too small (with the
+/// numbers and the option to change), I/O, Cancelled on SIGINT/SIGTERM. On any error nothing is
+/// left behind.
 StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options);
 
 /// The end-of-run summary, several lines.

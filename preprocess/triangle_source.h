@@ -1,7 +1,7 @@
 #pragma once
-// The one interface every model producer implements: importers (OBJ, PLY, STL, glTF, Assimp), the procedural
-// abbey and the merge of several inputs. The partitioner pulls batches of triangles from it in one forward
-// pass, so a producer never has to hold the whole model.
+// The one interface every model producer implements: importers (OBJ, PLY, STL, glTF, Assimp), the
+// procedural abbey and the merge of several inputs. The partitioner pulls batches of triangles from
+// it in one forward pass, so a producer never has to hold the whole model.
 
 #include <array>
 #include <cstdint>
@@ -16,12 +16,13 @@
 
 namespace nave::preprocess {
 
-/// One triangle as a source produces it. Corners are counter-clockwise seen from the front (outside).
+/// One triangle as a source produces it. Corners are counter-clockwise seen from the front
+/// (outside).
 struct Triangle {
-    std::array<Vec3f, 3> p;                        ///< positions, in the model's units
-    std::array<Vec3f, 3> n{};                      ///< shading normals (valid when has_normals)
-    std::array<std::array<float, 2>, 3> uv{};      ///< texture coordinates (valid when has_uvs)
-    uint32_t material = 0;                         ///< index into the source's materials()
+    std::array<Vec3f, 3> p;                    ///< positions, in the model's units
+    std::array<Vec3f, 3> n{};                  ///< shading normals (valid when has_normals)
+    std::array<std::array<float, 2>, 3> uv{};  ///< texture coordinates (valid when has_uvs)
+    uint32_t material = 0;                     ///< index into the source's materials()
     bool has_normals = false;
     bool has_uvs = false;
 };
@@ -31,28 +32,29 @@ class TriangleSource {
   public:
     virtual ~TriangleSource() = default;
 
-    /// Clears `batch` and fills it with up to `max_triangles` triangles. Returns false (and an empty batch)
-    /// once the stream is exhausted. Errors name the file and the line or byte offset.
+    /// Clears `batch` and fills it with up to `max_triangles` triangles. Returns false (and an
+    /// empty batch) once the stream is exhausted. Errors name the file and the line or byte offset.
     virtual StatusOr<bool> Next(std::vector<Triangle>& batch, size_t max_triangles) = 0;
 
-    /// The material table. Triangle::material indexes it. It may grow while streaming (an OBJ `usemtl` of a
-    /// name no MTL defined adds a default material); complete once Next() returned false.
+    /// The material table. Triangle::material indexes it. It may grow while streaming (an OBJ
+    /// `usemtl` of a name no MTL defined adds a default material); complete once Next() returned
+    /// false.
     virtual const std::vector<store::MaterialRecord>& materials() const = 0;
 
     /// What the source reads ("bunny.ply", "abbey:detail=1"), for messages and provenance.
     virtual std::string name() const = 0;
 
-    /// The model's length unit as far as the source knows it: "m" (glTF, the abbey) or "unknown" (OBJ, PLY,
-    /// STL carry no unit). Positions are never converted.
+    /// The model's length unit as far as the source knows it: "m" (glTF, the abbey) or "unknown"
+    /// (OBJ, PLY, STL carry no unit). Positions are never converted.
     virtual std::string units() const { return "unknown"; }
 
-    /// Progress in source-specific units (bytes read for files, parts generated for the abbey) and the total
-    /// (0 if unknown), for progress bars.
+    /// Progress in source-specific units (bytes read for files, parts generated for the abbey) and
+    /// the total (0 if unknown), for progress bars.
     virtual uint64_t progress_done() const = 0;
     virtual uint64_t progress_total() const = 0;
 
-    /// Memory the source itself holds (OBJ and PLY vertex arrays grow with the input; glTF and Assimp hold the
-    /// whole model), in bytes, for the memory budget and the summary.
+    /// Memory the source itself holds (OBJ and PLY vertex arrays grow with the input; glTF and
+    /// Assimp hold the whole model), in bytes, for the memory budget and the summary.
     virtual uint64_t memory_bytes() const { return 0; }
 
     /// Problems the source skipped over (degenerate faces, missing textures...), counted.

@@ -1,12 +1,12 @@
 #include "preprocess/abbey/abbey_source.h"
 
+#include <fmt/format.h>
+
 #include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <thread>
-
-#include <fmt/format.h>
 
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/materials.h"
@@ -48,7 +48,8 @@ class AbbeySource final : public TriangleSource {
                 changed_.notify_all();
             }
             size_t n = std::min(max_triangles - batch.size(), pending_.size() - pending_pos_);
-            batch.insert(batch.end(), pending_.begin() + pending_pos_, pending_.begin() + pending_pos_ + n);
+            batch.insert(batch.end(), pending_.begin() + pending_pos_,
+                         pending_.begin() + pending_pos_ + n);
             pending_pos_ += n;
         }
         return !batch.empty();
@@ -59,7 +60,9 @@ class AbbeySource final : public TriangleSource {
     std::string units() const override { return "m"; }
     uint64_t progress_done() const override { return parts_done_.load(); }
     uint64_t progress_total() const override { return parts_total_; }
-    uint64_t memory_bytes() const override { return (kQueueBatches + 3) * kBatchTriangles * sizeof(Triangle); }
+    uint64_t memory_bytes() const override {
+        return (kQueueBatches + 3) * kBatchTriangles * sizeof(Triangle);
+    }
     const ImportWarnings& warnings() const override { return warnings_; }
 
   private:
@@ -115,18 +118,21 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGenerator(const std::string& spec)
     auto colon = text.find(':');
     std::string_view name = text.substr(0, colon);
     if (name != "abbey") {
-        return InvalidArgumentError("generator '{}': unknown; expected 'abbey' or 'abbey:detail=D'", spec);
+        return InvalidArgumentError("generator '{}': unknown; expected 'abbey' or 'abbey:detail=D'",
+                                    spec);
     }
     double detail = 1.0;
     if (colon != std::string_view::npos) {
         std::string_view option = text.substr(colon + 1);
         if (option.substr(0, 7) != "detail=") {
-            return InvalidArgumentError("generator '{}': unknown option '{}'; expected detail=D", spec, option);
+            return InvalidArgumentError("generator '{}': unknown option '{}'; expected detail=D",
+                                        spec, option);
         }
         float value = 0;
         if (!ParseFloat(option.substr(7), value) || !(value > 0) || value > 1e5) {
-            return InvalidArgumentError("generator '{}': detail '{}' must be a number in (0, 100000]", spec,
-                                        option.substr(7));
+            return InvalidArgumentError(
+                "generator '{}': detail '{}' must be a number in (0, 100000]", spec,
+                option.substr(7));
         }
         detail = value;
     }

@@ -1,8 +1,8 @@
 #pragma once
-// How the abbey's detail parameter D turns into tessellation. Triangles grow about linearly with D: stone
-// faces, slates and tiles are n x n grids with n = round(sqrt(D)) (tooled relief), curves are divided into
-// about sqrt(D) times more segments in each direction. Below D = 1 the masonry units grow instead (fewer
-// stones), for small test models.
+// How the abbey's detail parameter D turns into tessellation. Triangles grow about linearly with D:
+// stone faces, slates and tiles are n x n grids with n = round(sqrt(D)) (tooled relief), curves are
+// divided into about sqrt(D) times more segments in each direction. Below D = 1 the masonry units
+// grow instead (fewer stones), for small test models.
 
 #include <algorithm>
 #include <cmath>

@@ -5,6 +5,8 @@
 namespace nave::preprocess::abbey {
 
 void Emitter::Push(Triangle& t) {
+    if (!IsFinite(t.p[0]) || !IsFinite(t.p[1]) || !IsFinite(t.p[2]))
+        return;  // a primitive's degenerate case
     batch_.push_back(t);
     ++emitted_;
     if (batch_.size() >= batch_triangles_) Flush();
@@ -16,7 +18,8 @@ void Emitter::Flush() {
     batch_.clear();
 }
 
-void Emitter::Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material) {
+void Emitter::Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward,
+                  uint32_t material) {
     Vec3d n = Cross(b - a, c - a);
     Triangle t;
     t.material = material;
@@ -48,7 +51,10 @@ void Emitter::TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& 
     auto orient = [&](const Vec3d& v) {
         Vec3d u = Dot(v, face) < 0 ? -v : v;
         double len = Length(u);
-        return len > 0 && std::isfinite(len) ? Vec3f(u / len) : Vec3f(face);
+        // A shading normal (nearly) in the triangle's plane says nothing about its front: use the
+        // face's.
+        if (!(len > 0) || !std::isfinite(len) || Dot(u, face) < 1e-3 * len) return Vec3f(face);
+        return Vec3f(u / len);
     };
     t.n[0] = orient(na);
     t.n[1] = orient(flip ? nc : nb);

@@ -1,8 +1,8 @@
 #pragma once
-// Where the abbey's geometry goes: an Emitter collects triangles and hands them on in batches. Every face is
-// given with the direction it must face ("outward": away from the solid, towards the space a visitor stands
-// in), and the emitter orders the corners so that the winding agrees, which keeps normals consistent
-// without each primitive having to get its vertex order right.
+// Where the abbey's geometry goes: an Emitter collects triangles and hands them on in batches.
+// Every face is given with the direction it must face ("outward": away from the solid, towards the
+// space a visitor stands in), and the emitter orders the corners so that the winding agrees, which
+// keeps normals consistent without each primitive having to get its vertex order right.
 
 #include <cstdint>
 #include <functional>
@@ -21,19 +21,23 @@ class Emitter {
         batch_.reserve(batch_triangles_);
     }
 
-    /// A triangle whose front faces `outward` (corners reordered if needed). Zero-area triangles are dropped.
-    void Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material);
-    /// The same with shading normals (flipped with the corners if needed: normals follow `outward`).
-    void TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& na, const Vec3d& nb, const Vec3d& nc,
-              const Vec3d& outward, uint32_t material);
+    /// A triangle whose front faces `outward` (corners reordered if needed). Zero-area triangles
+    /// are dropped.
+    void Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward,
+             uint32_t material);
+    /// The same with shading normals (flipped with the corners if needed: normals follow
+    /// `outward`).
+    void TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& na, const Vec3d& nb,
+              const Vec3d& nc, const Vec3d& outward, uint32_t material);
     /// A planar-ish quad a b c d (in order around it), split along a-c.
     void Quad(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& outward,
               uint32_t material) {
         Tri(a, b, c, outward, material);
         Tri(a, c, d, outward, material);
     }
-    void QuadN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& na, const Vec3d& nb,
-               const Vec3d& nc, const Vec3d& nd, const Vec3d& outward, uint32_t material) {
+    void QuadN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& na,
+               const Vec3d& nb, const Vec3d& nc, const Vec3d& nd, const Vec3d& outward,
+               uint32_t material) {
         TriN(a, b, c, na, nb, nc, outward, material);
         TriN(a, c, d, na, nc, nd, outward, material);
     }

@@ -10,7 +10,7 @@ namespace nave::preprocess::abbey {
 
 enum Material : uint32_t {
     kLimestone = 0,
-    kLimestoneDark,   ///< capitals, ribs, bosses
+    kLimestoneDark,  ///< capitals, ribs, bosses
     kFloorLight,
     kFloorDark,
     kGlassClear,

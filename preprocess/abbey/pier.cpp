@@ -29,17 +29,17 @@ void EmitPier(Emitter& em, const PierSpec& s, const Detail& detail) {
     const double capital_z = s.top - abacus_h - capital_h;
 
     // Octagonal plinth (limestone).
-    Revolve(em, s.base, {{0, 0}, {r + 0.35, 0}, {r + 0.35, plinth_h}, {0, plinth_h}}, around, kLimestone, 8,
-            kPi / 8);
+    Revolve(em, s.base, {{0, 0}, {r + 0.35, 0}, {r + 0.35, plinth_h}, {0, plinth_h}}, around,
+            kLimestone, 8, kPi / 8);
 
     // Base and shaft in one profile from the plinth's top up to the capital.
     std::vector<Vec2> p;
     double z = plinth_h;
     p.push_back({0, z});
     p.push_back({r + 0.20, z});
-    Arc(p, r + 0.12, z + 0.09, 0.09, -kPi / 2, kPi / 2, arc);             // lower torus
+    Arc(p, r + 0.12, z + 0.09, 0.09, -kPi / 2, kPi / 2, arc);                 // lower torus
     Arc(p, r + 0.14, z + 0.26, 0.08, -kPi / 2 - 0.3, -kPi * 1.5 + 0.3, arc);  // scotia (concave)
-    Arc(p, r + 0.05, z + 0.36, 0.05, -kPi / 2, kPi / 2, arc);             // upper torus
+    Arc(p, r + 0.05, z + 0.36, 0.05, -kPi / 2, kPi / 2, arc);                 // upper torus
     z += base_h;
     p.push_back({r, z});
     // Drums of 0.5 m with small V-shaped joints.
@@ -68,7 +68,8 @@ void EmitPier(Emitter& em, const PierSpec& s, const Detail& detail) {
     // Crockets: small knobs curling out under the abacus, eight round the bell.
     for (int k = 0; k < 8; ++k) {
         double a = kPi / 8 + k * kPi / 4;
-        Vec3d c = s.base + Vec3d(std::cos(a) * (r + 0.26), std::sin(a) * (r + 0.26), capital_z + capital_h - 0.16);
+        Vec3d c = s.base + Vec3d(std::cos(a) * (r + 0.26), std::sin(a) * (r + 0.26),
+                                 capital_z + capital_h - 0.16);
         std::vector<Vec2> knob;
         Arc(knob, 0, 0, 0.1, -kPi / 2, kPi / 2, detail.Seg(4));
         for (auto& q : knob) q.x = std::max(0.0, q.x);
@@ -78,8 +79,8 @@ void EmitPier(Emitter& em, const PierSpec& s, const Detail& detail) {
     // Octagonal abacus with a chamfered upper edge.
     double ab = r + 0.45;
     Revolve(em, s.base + Vec3d(0, 0, capital_z + capital_h),
-            {{0, 0}, {ab, 0}, {ab, abacus_h - 0.06}, {ab - 0.06, abacus_h}, {0, abacus_h}}, around, kLimestoneDark,
-            8, kPi / 8);
+            {{0, 0}, {ab, 0}, {ab, abacus_h - 0.06}, {ab - 0.06, abacus_h}, {0, abacus_h}}, around,
+            kLimestoneDark, 8, kPi / 8);
     (void)s.seed;
 }
 

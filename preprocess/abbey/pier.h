@@ -1,7 +1,7 @@
 #pragma once
-// Round piers in the manner of early Gothic naves: an octagonal plinth, an Attic base (torus, scotia,
-// torus), a shaft built of drums with chamfered joints, an astragal, a bell capital with crockets and an
-// octagonal abacus.
+// Round piers in the manner of early Gothic naves: an octagonal plinth, an Attic base (torus,
+// scotia, torus), a shaft built of drums with chamfered joints, an astragal, a bell capital with
+// crockets and an octagonal abacus.
 
 #include "core/vecmath.h"
 #include "preprocess/abbey/detail.h"
@@ -10,9 +10,9 @@
 namespace nave::preprocess::abbey {
 
 struct PierSpec {
-    Vec3d base;              ///< centre of the plinth's bottom (on the floor)
-    double radius = 0.8;     ///< shaft radius, metres
-    double top = 8.75;       ///< height of the abacus top (where the arches spring), metres
+    Vec3d base;           ///< centre of the plinth's bottom (on the floor)
+    double radius = 0.8;  ///< shaft radius, metres
+    double top = 8.75;    ///< height of the abacus top (where the arches spring), metres
     uint64_t seed = 0;
 };
 

@@ -28,7 +28,8 @@ void Box(Emitter& em, const Vec3d& lo, const Vec3d& hi, uint32_t m) {
     OrientedBox(em, c, Vec3d(h.x, 0, 0), Vec3d(0, h.y, 0), Vec3d(0, 0, h.z), m);
 }
 
-void OrientedBox(Emitter& em, const Vec3d& o, const Vec3d& a, const Vec3d& b, const Vec3d& c, uint32_t m) {
+void OrientedBox(Emitter& em, const Vec3d& o, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                 uint32_t m) {
     const Vec3d* axes[3] = {&a, &b, &c};
     for (int k = 0; k < 3; ++k) {
         const Vec3d& n = *axes[k];
@@ -41,7 +42,8 @@ void OrientedBox(Emitter& em, const Vec3d& o, const Vec3d& a, const Vec3d& b, co
     }
 }
 
-void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& s, uint64_t seed, uint32_t m) {
+void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& s, uint64_t seed,
+           uint32_t m_) {
     double j = s.joint, c = std::min({s.chamfer, lu * 0.25, lv * 0.25});
     double u0 = j, u1 = lu - j, v0 = j, v1 = lv - j;
     if (u1 - u0 <= 2 * c || v1 - v0 <= 2 * c) return;
@@ -56,31 +58,53 @@ void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& 
     };
     for (int k = 0; k < n; ++k) {
         for (int i = 0; i < n; ++i) {
-            em.Quad(front(i, k), front(i + 1, k), front(i + 1, k + 1), front(i, k + 1), f.w, m);
+            em.Quad(front(i, k), front(i + 1, k), front(i + 1, k + 1), front(i, k + 1), f.w, m_);
         }
     }
-    // Chamfers: from the face border down to the wall face at the stone's edge, n segments per side.
-    auto base = [&](double x, double y) { return f.At(x, y, 0); };
-    for (int i = 0; i < n; ++i) {
-        double a = double(i) / n, b = double(i + 1) / n;
-        double xa = u0 + (u1 - u0) * a, xb = u0 + (u1 - u0) * b;
-        double ya = v0 + (v1 - v0) * a, yb = v0 + (v1 - v0) * b;
-        // Bottom (v0) and top (v1) edges.
-        em.Quad(base(xa, v0), base(xb, v0), front(i + 1, 0), front(i, 0), f.w - f.v, m);
-        em.Quad(base(xa, v1), base(xb, v1), front(i + 1, n), front(i, n), f.w + f.v, m);
-        // Left (u0) and right (u1) edges.
-        em.Quad(base(u0, ya), base(u0, yb), front(0, i + 1), front(0, i), f.w - f.u, m);
-        em.Quad(base(u1, ya), base(u1, yb), front(n, i + 1), front(n, i), f.w + f.u, m);
+    // Rounded arrises: from the wall face at the stone's edge up to the face border, n segments
+    // along each side and m = n / 2 across (a quarter round; m = 1 is a plain chamfer).
+    const int m = std::max(1, n / 2);
+    const double kHalfPi = 1.5707963267948966;
+    // Point on the arris of side (du, dv) at position `along` in [0, 1] and `across` in [0, 1].
+    auto arris = [&](int side, double along, double across) {
+        double inset = c * (1 - std::cos(across * kHalfPi)),
+               z = s.relief * std::sin(across * kHalfPi);
+        if (m == 1) inset = c * across, z = s.relief * across;
+        double x0 = u0 + inset, x1 = u1 - inset, y0 = v0 + inset, y1 = v1 - inset;
+        switch (side) {
+            case 0:
+                return f.At(x0 + (x1 - x0) * along, y0, z);  // bottom edge
+            case 1:
+                return f.At(x0 + (x1 - x0) * along, y1, z);  // top
+            case 2:
+                return f.At(x0, y0 + (y1 - y0) * along, z);  // left
+            default:
+                return f.At(x1, y0 + (y1 - y0) * along, z);  // right
+        }
+    };
+    const Vec3d outs[4] = {f.w - f.v, f.w + f.v, f.w - f.u, f.w + f.u};
+    for (int side = 0; side < 4; ++side) {
+        for (int i = 0; i < n; ++i) {
+            double a = double(i) / n, b = double(i + 1) / n;
+            for (int k = 0; k < m; ++k) {
+                double p = double(k) / m, q = double(k + 1) / m;
+                // The last row meets the tooled face's border vertices exactly (same formula at
+                // across = 1).
+                em.Quad(arris(side, a, p), arris(side, b, p), arris(side, b, q), arris(side, a, q),
+                        outs[side], m_);
+            }
+        }
     }
 }
 
-void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, int segments, uint32_t m, int sides,
-             double phase) {
+void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, int segments,
+             uint32_t m, int sides, double phase) {
     const double kTwoPi = 6.283185307179586;
     auto dir = [&](int i) {
         double a = phase + kTwoPi * i / segments;
         if (sides > 0) {
-            // A regular polygon: the radius is scaled so that the apothem equals the profile radius.
+            // A regular polygon: the radius is scaled so that the apothem equals the profile
+            // radius.
             double sector = kTwoPi / sides;
             double local = std::fmod(a - phase, sector) - sector / 2;
             double scale = std::cos(sector / 2) / std::cos(local) / std::cos(sector / 2);
@@ -93,11 +117,14 @@ void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, i
         double dr = p1.x - p0.x, dz = p1.y - p0.y;
         double len = std::hypot(dr, dz);
         if (len == 0) continue;
-        double nr = dz / len, nz = -dr / len;  // the profile's right-hand normal: outward for an upward profile
+        double nr = dz / len,
+               nz = -dr / len;  // the profile's right-hand normal: outward for an upward profile
         for (int i = 0; i < segments; ++i) {
             Vec3d d0 = dir(i), d1 = dir(i + 1);
-            Vec3d a = base + d0 * p0.x + Vec3d(0, 0, p0.y), b = base + d1 * p0.x + Vec3d(0, 0, p0.y);
-            Vec3d c = base + d1 * p1.x + Vec3d(0, 0, p1.y), d = base + d0 * p1.x + Vec3d(0, 0, p1.y);
+            Vec3d a = base + d0 * p0.x + Vec3d(0, 0, p0.y),
+                  b = base + d1 * p0.x + Vec3d(0, 0, p0.y);
+            Vec3d c = base + d1 * p1.x + Vec3d(0, 0, p1.y),
+                  d = base + d0 * p1.x + Vec3d(0, 0, p1.y);
             Vec3d n0 = Normalize(Vec3d(d0.x, d0.y, 0)) * nr + Vec3d(0, 0, nz);
             Vec3d n1 = Normalize(Vec3d(d1.x, d1.y, 0)) * nr + Vec3d(0, 0, nz);
             Vec3d out = (n0 + n1) * 0.5;
@@ -110,8 +137,13 @@ void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, i
     }
 }
 
-void Sweep(Emitter& em, const std::vector<Vec3d>& path, const Vec3d& side, const std::vector<Vec2>& profile,
-           uint32_t m, bool caps) {
+void Sweep(Emitter& em, const std::vector<Vec3d>& raw_path, const Vec3d& side,
+           const std::vector<Vec2>& profile, uint32_t m, bool caps) {
+    // Repeated points (an arch whose springing is also the jamb's top) have no tangent: drop them.
+    std::vector<Vec3d> path;
+    for (const Vec3d& p : raw_path) {
+        if (path.empty() || Length(p - path.back()) > 1e-9) path.push_back(p);
+    }
     size_t np = path.size(), nq = profile.size();
     if (np < 2 || nq < 3) return;
     std::vector<Vec3d> ring_prev(nq), ring(nq);

@@ -15,8 +15,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 Vec3d Plan(const VaultBay& b, double u, double v) {
     double s = (u + 1) * 0.5, t = (v + 1) * 0.5;
-    return b.corners[0] * ((1 - s) * (1 - t)) + b.corners[1] * (s * (1 - t)) + b.corners[2] * (s * t) +
-           b.corners[3] * ((1 - s) * t);
+    return b.corners[0] * ((1 - s) * (1 - t)) + b.corners[1] * (s * (1 - t)) +
+           b.corners[2] * (s * t) + b.corners[3] * ((1 - s) * t);
 }
 
 Vec3d Intrados(const VaultBay& b, double u, double v) {
@@ -36,9 +36,10 @@ std::vector<Vec2> RibProfile(double half_width, double depth, int n) {
     return p;
 }
 
-void Rib(Emitter& em, const std::vector<Vec3d>& path, double half_width, double depth, const Detail& detail) {
-    // Side vector: horizontal, perpendicular to the rib's plan direction, oriented so that the profile's n
-    // axis points up at the crown (see Sweep).
+void Rib(Emitter& em, const std::vector<Vec3d>& path, double half_width, double depth,
+         const Detail& detail) {
+    // Side vector: horizontal, perpendicular to the rib's plan direction, oriented so that the
+    // profile's n axis points up at the crown (see Sweep).
     Vec3d d = path.back() - path.front();
     d.z = 0;
     Vec3d side = Normalize(Cross(d, Vec3d(0, 0, 1)));
@@ -66,15 +67,20 @@ void EmitVaultBay(Emitter& em, const VaultBay& b, const Detail& detail) {
     for (int k = 0; k < 4; ++k) {
         const double* a = corner_uv[k];
         const double* c = corner_uv[(k + 1) % 4];
-        // Severy k: the triangle (centre, corner k, corner k+1), s from the centre out, t along the edge.
+        // Severy k: the triangle (centre, corner k, corner k+1), s from the centre out, t along the
+        // edge.
         auto intrados = [&](double s, double t) {
             double u = s * (a[0] + (c[0] - a[0]) * t), v = s * (a[1] + (c[1] - a[1]) * t);
             return Intrados(b, u, v);
         };
-        ParamGrid(em, intrados, n, n, [&](const Vec3d& p) { return axis - p; }, kLimestone);
-        auto extrados = [&](double s, double t) { return intrados(s, t) + Vec3d(0, 0, b.thickness); };
-        ParamGrid(em, extrados, std::max(2, n / 2), std::max(2, n / 2),
-                  [&](const Vec3d& p) { return p - axis; }, kLimestone);
+        ParamGrid(
+            em, intrados, n, n, [&](const Vec3d& p) { return axis - p; }, kLimestone);
+        // The extrados as finely divided as the intrados: coarser chords would sag below it.
+        auto extrados = [&](double s, double t) {
+            return intrados(s, t) + Vec3d(0, 0, b.thickness);
+        };
+        ParamGrid(
+            em, extrados, n, n, [&](const Vec3d& p) { return p - axis; }, kLimestone);
     }
     // Diagonal ribs along u = v and u = -v, transverse arches along u = -1 / +1.
     int m = detail.Seg(24);
@@ -96,9 +102,10 @@ void EmitVaultBay(Emitter& em, const VaultBay& b, const Detail& detail) {
     Boss(em, Intrados(b, 0, 0), detail);
 }
 
-void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius, double spring, double rise,
-                  int ribs, const Detail& detail) {
-    Vec3d side = Cross(Vec3d(0, 0, 1), axis);  // the half circle runs from -side through axis to +side
+void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius, double spring,
+                  double rise, int ribs, const Detail& detail) {
+    Vec3d side =
+        Cross(Vec3d(0, 0, 1), axis);  // the half circle runs from -side through axis to +side
     auto plan = [&](double angle) { return side * -std::cos(angle) + axis * std::sin(angle); };
     auto point = [&](double s, double angle) {
         Vec3d p = c + plan(angle) * (radius * s);
@@ -110,10 +117,11 @@ void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius,
     for (int k = 0; k < sectors; ++k) {
         double a0 = kPi * k / sectors, a1 = kPi * (k + 1) / sectors;
         auto intrados = [&](double s, double t) { return point(s, a0 + (a1 - a0) * t); };
-        ParamGrid(em, intrados, n, n, [&](const Vec3d& p) { return centre - p; }, kLimestone);
+        ParamGrid(
+            em, intrados, n, n, [&](const Vec3d& p) { return centre - p; }, kLimestone);
         auto extrados = [&](double s, double t) { return intrados(s, t) + Vec3d(0, 0, 0.3); };
-        ParamGrid(em, extrados, std::max(2, n / 2), std::max(2, n / 2),
-                  [&](const Vec3d& p) { return p - centre; }, kLimestone);
+        ParamGrid(
+            em, extrados, n, n, [&](const Vec3d& p) { return p - centre; }, kLimestone);
     }
     int m = detail.Seg(16);
     for (int k = 1; k <= ribs; ++k) {

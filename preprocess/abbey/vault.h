@@ -1,8 +1,9 @@
 #pragma once
 // Rib vaults. A quadripartite bay is modelled as two intersecting pointed barrels: over the bay's
-// parameter square (u, v) in [-1, 1]^2 the intrados is at z = spring + rise * PointedArch(min(|u|, |v|)),
-// so the groins fall exactly on the diagonals, where the diagonal ribs run; transverse arches run along
-// u = +-1. Apses and chapels get ribbed half-domes with the same pointed profile along each radius.
+// parameter square (u, v) in [-1, 1]^2 the intrados is at z = spring + rise * PointedArch(min(|u|,
+// |v|)), so the groins fall exactly on the diagonals, where the diagonal ribs run; transverse
+// arches run along u = +-1. Apses and chapels get ribbed half-domes with the same pointed profile
+// along each radius.
 
 #include <array>
 
@@ -13,7 +14,8 @@
 namespace nave::preprocess::abbey {
 
 struct VaultBay {
-    /// Plan corners at (u, v) = (-1, -1), (1, -1), (1, 1), (-1, 1); bilinear in between (trapezoids allowed).
+    /// Plan corners at (u, v) = (-1, -1), (1, -1), (1, 1), (-1, 1); bilinear in between (trapezoids
+    /// allowed).
     std::array<Vec3d, 4> corners;  ///< z ignored
     double spring = 20, rise = 8, thickness = 0.3;
     bool rib_u_min = true, rib_u_max = false;  ///< transverse arches at u = -1 / +1
@@ -22,9 +24,9 @@ struct VaultBay {
 
 void EmitVaultBay(Emitter& em, const VaultBay& bay, const Detail& detail);
 
-/// A ribbed half-dome over the half-disc of `radius` round `center` (z = 0) facing `axis` (unit, horizontal),
-/// `ribs` radial ribs evenly spread over the half circle (ends excluded).
-void EmitHalfDome(Emitter& em, const Vec3d& center, const Vec3d& axis, double radius, double spring, double rise,
-                  int ribs, const Detail& detail);
+/// A ribbed half-dome over the half-disc of `radius` round `center` (z = 0) facing `axis` (unit,
+/// horizontal), `ribs` radial ribs evenly spread over the half circle (ends excluded).
+void EmitHalfDome(Emitter& em, const Vec3d& center, const Vec3d& axis, double radius, double spring,
+                  double rise, int ribs, const Detail& detail);
 
 }  // namespace nave::preprocess::abbey

@@ -35,7 +35,8 @@ struct WallGeom {
 // Samples of an opening's arch from one springing to the other.
 std::vector<double> ArchSamples(const Opening& o, int segments) {
     std::vector<double> xs;
-    for (int i = 0; i <= segments; ++i) xs.push_back(o.center - o.half_width + 2 * o.half_width * i / segments);
+    for (int i = 0; i <= segments; ++i)
+        xs.push_back(o.center - o.half_width + 2 * o.half_width * i / segments);
     return xs;
 }
 
@@ -44,7 +45,8 @@ void EmitFace(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, in
     double cursor = 0;
     auto rect = [&](double u0, double u1, double z0, double z1) {
         if (u1 - u0 <= 1e-9 || z1 - z0 <= 1e-9) return;
-        em.Quad(g.P(u0, z0, depth), g.P(u1, z0, depth), g.P(u1, z1, depth), g.P(u0, z1, depth), out, w.material);
+        em.Quad(g.P(u0, z0, depth), g.P(u1, z0, depth), g.P(u1, z1, depth), g.P(u0, z1, depth), out,
+                w.material);
     };
     for (const Opening& o : w.openings) {
         double a = o.center - o.half_width, b = o.center + o.half_width;
@@ -91,7 +93,8 @@ void EmitMoulding(Emitter& em, const WallGeom& g, const Opening& o, double depth
     Sweep(em, path, out, CircleProfile(0.07, detail.Seg(6), 0.0), kLimestoneDark);
 }
 
-void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail& detail, uint64_t seed) {
+void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail& detail,
+                 uint64_t seed) {
     const WallSpec& w = g.w;
     double mid = w.thickness * 0.5;
     double piece = 0.45 / std::pow(std::max(detail.d, 1.0), 0.25);
@@ -100,7 +103,7 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
     int cols = std::max(2, int(std::lround((b - a) / piece)));
     int rows = std::max(2, int(std::lround((apex - o.sill) / (piece * 1.3))));
     double dx = (b - a) / cols, dz = (apex - o.sill) / rows;
-    const uint32_t palette[] = {kGlassClear, kGlassClear, kGlassClear, kGlassBlue, kGlassBlue,
+    const uint32_t palette[] = {kGlassClear, kGlassClear, kGlassClear,  kGlassBlue,  kGlassBlue,
                                 kGlassRed,   kGlassRed,   kGlassYellow, kGlassGreen, kGlassClear};
     const double kHalfGlass = 0.003;
     for (int r = 0; r < rows; ++r) {
@@ -168,8 +171,8 @@ bool StoneHitsOpening(const WallSpec& w, double u0, double u1, double z0, double
     return false;
 }
 
-void EmitStones(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, const Detail& detail,
-                uint64_t seed) {
+void EmitStones(Emitter& em, const WallGeom& g, double depth, const Vec3d& out,
+                const Detail& detail, uint64_t seed) {
     const WallSpec& w = g.w;
     double scale = detail.UnitScale();
     double course = 0.34 * scale, unit = 0.62 * scale;
@@ -187,8 +190,8 @@ void EmitStones(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, 
             ++col;
             if (u1 - u0 < 0.08 || StoneHitsOpening(w, u0, u1, z, z1)) continue;
             Frame f{g.P(u0, z, depth), w.along, kUp, out};
-            Stone(em, f, u1 - u0, z1 - z, style, seed * 1000003 + uint64_t(row) * 4099 + uint64_t(col),
-                  w.material);
+            Stone(em, f, u1 - u0, z1 - z, style,
+                  seed * 1000003 + uint64_t(row) * 4099 + uint64_t(col), w.material);
         }
     }
 }
@@ -206,20 +209,23 @@ void EmitWall(Emitter& em, const WallSpec& w, const Detail& detail) {
             EmitMoulding(em, g, o, 0, w.inward, detail);
             EmitMoulding(em, g, o, w.thickness, -w.inward, detail);
         }
-        if (o.kind == OpeningKind::kWindow) EmitGlazing(em, g, o, detail, w.seed * 31 + uint64_t(o.center * 100));
+        if (o.kind == OpeningKind::kWindow)
+            EmitGlazing(em, g, o, detail, w.seed * 31 + uint64_t(o.center * 100));
         if (o.kind == OpeningKind::kDoor) EmitDoor(em, g, o, detail);
     }
     double t = w.thickness;
     if (w.close_ends) {
         for (double u : {0.0, w.length}) {
             Vec3d out = u == 0 ? -w.along : w.along;
-            em.Quad(g.P(u, w.z0, 0), g.P(u, w.z1, 0), g.P(u, w.z1, t), g.P(u, w.z0, t), out, w.material);
+            em.Quad(g.P(u, w.z0, 0), g.P(u, w.z1, 0), g.P(u, w.z1, t), g.P(u, w.z0, t), out,
+                    w.material);
         }
     }
-    em.Quad(g.P(0, w.z1, 0), g.P(w.length, w.z1, 0), g.P(w.length, w.z1, t), g.P(0, w.z1, t), kUp, w.material);
+    em.Quad(g.P(0, w.z1, 0), g.P(w.length, w.z1, 0), g.P(w.length, w.z1, t), g.P(0, w.z1, t), kUp,
+            w.material);
     if (w.z0 > 0) {
-        em.Quad(g.P(0, w.z0, 0), g.P(w.length, w.z0, 0), g.P(w.length, w.z0, t), g.P(0, w.z0, t), -kUp,
-                w.material);
+        em.Quad(g.P(0, w.z0, 0), g.P(w.length, w.z0, 0), g.P(w.length, w.z0, t), g.P(0, w.z0, t),
+                -kUp, w.material);
     }
     if (w.stones_inside) EmitStones(em, g, 0, w.inward, detail, w.seed * 2 + 1);
     if (w.stones_outside) EmitStones(em, g, t, -w.inward, detail, w.seed * 2 + 2);

@@ -1,7 +1,8 @@
 #pragma once
-// Masonry walls with pointed-arch openings: arcades (open to the floor or to the springing), lancet windows
-// glazed with stained-glass panes in lead cames, portals with wooden doors. Both faces are laid in ashlar
-// courses of individual chamfered stones; the reveals, sills and soffits are cut through the thickness.
+// Masonry walls with pointed-arch openings: arcades (open to the floor or to the springing), lancet
+// windows glazed with stained-glass panes in lead cames, portals with wooden doors. Both faces are
+// laid in ashlar courses of individual chamfered stones; the reveals, sills and soffits are cut
+// through the thickness.
 
 #include <cstdint>
 #include <vector>
@@ -14,28 +15,31 @@ namespace nave::preprocess::abbey {
 
 enum class OpeningKind { kOpen, kWindow, kDoor };
 
-/// An opening [center - half_width, center + half_width] along the wall, from `sill` up to a pointed arch
-/// springing at `spring` and rising `rise` more. All in metres (center along the wall from its start).
+/// An opening [center - half_width, center + half_width] along the wall, from `sill` up to a
+/// pointed arch springing at `spring` and rising `rise` more. All in metres (center along the wall
+/// from its start).
 struct Opening {
     double center = 0, half_width = 1, sill = 0, spring = 2, rise = 1;
     OpeningKind kind = OpeningKind::kOpen;
-    bool moulded = true;   ///< a roll moulding round the arch on both faces
-    double rho = 2.0;      ///< arch radius over half-span (2: equilateral)
+    bool moulded = true;  ///< a roll moulding round the arch on both faces
+    double rho = 2.0;     ///< arch radius over half-span (2: equilateral)
     double Top(double u) const;
     /// Half the opening's width at height z (0 above the apex).
     double HalfWidthAt(double z) const;
 };
 
 struct WallSpec {
-    Vec3d origin;              ///< interior face, at the wall's start, at z = 0
-    Vec3d along;               ///< unit, horizontal
-    Vec3d inward;              ///< unit, horizontal: the interior face faces this way
+    Vec3d origin;  ///< interior face, at the wall's start, at z = 0
+    Vec3d along;   ///< unit, horizontal
+    Vec3d inward;  ///< unit, horizontal: the interior face faces this way
     double length = 1, z0 = 0, z1 = 1, thickness = 1;
-    std::vector<Opening> openings;  ///< sorted by center, disjoint, within the wall
+    std::vector<Opening>
+        openings;  ///< sorted by center, within the wall, at most one per column (their
+                   ///< horizontal spans disjoint: stack storeys as separate walls)
     bool stones_inside = true, stones_outside = true;
     bool close_ends = true;
     uint32_t material = 0;
-    uint64_t seed = 0;         ///< varies stone lengths and glass colours
+    uint64_t seed = 0;  ///< varies stone lengths and glass colours
 };
 
 void EmitWall(Emitter& em, const WallSpec& wall, const Detail& detail);

@@ -19,10 +19,12 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
     // Triangulate polygons, bake node transforms into world-space meshes, drop points and lines.
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
+    const unsigned flags =
+        aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
     const aiScene* scene = aiImportFile(path.c_str(), flags);
     if (scene == nullptr) {
-        return InvalidArgumentError("{}: Assimp cannot read it: {}", path.string(), aiGetErrorString());
+        return InvalidArgumentError("{}: Assimp cannot read it: {}", path.string(),
+                                    aiGetErrorString());
     }
     struct Release {
         const aiScene* s;
@@ -39,16 +41,21 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
                      ? std::string(name.C_Str())
                      : fmt::format("material_{}", i);
         aiColor4D c;
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_DIFFUSE, &c) == AI_SUCCESS) m.diffuse = {c.r, c.g, c.b};
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_SPECULAR, &c) == AI_SUCCESS) m.specular = {c.r, c.g, c.b};
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_EMISSIVE, &c) == AI_SUCCESS) m.emission = {c.r, c.g, c.b};
+        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_DIFFUSE, &c) == AI_SUCCESS)
+            m.diffuse = {c.r, c.g, c.b};
+        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_SPECULAR, &c) == AI_SUCCESS)
+            m.specular = {c.r, c.g, c.b};
+        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_EMISSIVE, &c) == AI_SUCCESS)
+            m.emission = {c.r, c.g, c.b};
         float f = 0;
         if (aiGetMaterialFloat(src, AI_MATKEY_OPACITY, &f) == AI_SUCCESS) m.opacity = f;
         if (aiGetMaterialFloat(src, AI_MATKEY_SHININESS, &f) == AI_SUCCESS) m.shininess = f;
         if (aiGetMaterialFloat(src, AI_MATKEY_REFRACTI, &f) == AI_SUCCESS) m.ior = f;
         aiString tex;
-        if (aiGetMaterialTexture(src, aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS) m.textures["map_Kd"] = tex.C_Str();
-        if (aiGetMaterialTexture(src, aiTextureType_NORMALS, 0, &tex) == AI_SUCCESS) m.textures["norm"] = tex.C_Str();
+        if (aiGetMaterialTexture(src, aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS)
+            m.textures["map_Kd"] = tex.C_Str();
+        if (aiGetMaterialTexture(src, aiTextureType_NORMALS, 0, &tex) == AI_SUCCESS)
+            m.textures["norm"] = tex.C_Str();
         materials.push_back(std::move(m));
     }
     std::vector<IndexedMesh> meshes;
@@ -77,12 +84,13 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
         for (unsigned f = 0; f < src->mNumFaces; ++f) {
             const aiFace& face = src->mFaces[f];
             if (face.mNumIndices != 3) continue;
-            out.indices.insert(out.indices.end(), {face.mIndices[0], face.mIndices[1], face.mIndices[2]});
+            out.indices.insert(out.indices.end(),
+                               {face.mIndices[0], face.mIndices[1], face.mIndices[2]});
         }
         meshes.push_back(std::move(out));
     }
-    return std::unique_ptr<TriangleSource>(
-        new IndexedMeshSource(file, "unknown", std::move(meshes), std::move(materials), std::move(warnings)));
+    return std::unique_ptr<TriangleSource>(new IndexedMeshSource(
+        file, "unknown", std::move(meshes), std::move(materials), std::move(warnings)));
 }
 
 }  // namespace nave::preprocess

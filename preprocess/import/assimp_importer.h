@@ -1,5 +1,6 @@
 #pragma once
-// Every other format Assimp reads (FBX, DAE, 3DS, ...). Loaded whole, triangulated, node transforms baked.
+// Every other format Assimp reads (FBX, DAE, 3DS, ...). Loaded whole, triangulated, node transforms
+// baked.
 
 #include <filesystem>
 #include <memory>

@@ -1,10 +1,10 @@
 #include "preprocess/import/gltf_importer.h"
 
-#include <array>
-#include <cstring>
-
 #include <fmt/format.h>
 #include <tiny_gltf.h>
+
+#include <array>
+#include <cstring>
 
 #include "preprocess/import/indexed_mesh_source.h"
 
@@ -41,11 +41,24 @@ Mat4 NodeMatrix(const tinygltf::Node& node) {
         t[14] = node.translation[2];
     }
     if (node.rotation.size() == 4) {
-        double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
-        r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
-             2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
-             2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
-             0, 0, 0, 1};
+        double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2],
+               w = node.rotation[3];
+        r = {1 - 2 * (y * y + z * z),
+             2 * (x * y + z * w),
+             2 * (x * z - y * w),
+             0,
+             2 * (x * y - z * w),
+             1 - 2 * (x * x + z * z),
+             2 * (y * z + x * w),
+             0,
+             2 * (x * z + y * w),
+             2 * (y * z - x * w),
+             1 - 2 * (x * x + y * y),
+             0,
+             0,
+             0,
+             0,
+             1};
     }
     if (node.scale.size() == 3) {
         s[0] = node.scale[0];
@@ -61,15 +74,16 @@ Vec3f TransformPoint(const Mat4& m, const Vec3f& p) {
                  float(m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]));
 }
 
-// Normals transform by the inverse transpose of the upper 3x3 (cofactor matrix, up to a positive scale
-// when the determinant is positive; the sign of the determinant is applied so normals keep pointing out).
+// Normals transform by the inverse transpose of the upper 3x3 (cofactor matrix, up to a positive
+// scale when the determinant is positive; the sign of the determinant is applied so normals keep
+// pointing out).
 struct NormalMatrix {
     double m[9];
     bool flips = false;
 };
 NormalMatrix MakeNormalMatrix(const Mat4& a) {
-    double a00 = a[0], a10 = a[1], a20 = a[2], a01 = a[4], a11 = a[5], a21 = a[6], a02 = a[8], a12 = a[9],
-           a22 = a[10];
+    double a00 = a[0], a10 = a[1], a20 = a[2], a01 = a[4], a11 = a[5], a21 = a[6], a02 = a[8],
+           a12 = a[9], a22 = a[10];
     NormalMatrix n;
     // Cofactors: row-major n.m[row * 3 + col].
     n.m[0] = a11 * a22 - a12 * a21;
@@ -94,21 +108,24 @@ Vec3f TransformNormal(const NormalMatrix& n, const Vec3f& v) {
     return len > 0 ? Vec3f(r / len) : Vec3f(0, 0, 1);
 }
 
-bool SkipImageData(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                   void*) {
+bool SkipImageData(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                   const unsigned char*, int, void*) {
     return true;  // nave keeps texture names only; the renderer loads images itself
 }
 
 class GltfReader {
   public:
-    GltfReader(const tinygltf::Model& model, std::string file) : model_(model), file_(std::move(file)) {}
+    GltfReader(const tinygltf::Model& model, std::string file)
+        : model_(model), file_(std::move(file)) {}
 
-    // Reads accessor `index` as `components` floats per element (VEC2/VEC3, float or normalized ints).
+    // Reads accessor `index` as `components` floats per element (VEC2/VEC3, float or normalized
+    // ints).
     StatusOr<std::vector<float>> ReadFloats(int index, int components) {
         NAVE_ASSIGN_OR_RETURN(const tinygltf::Accessor* acc, Accessor(index));
         if (tinygltf::GetNumComponentsInType(acc->type) != components) {
-            return InvalidArgumentError("{}: accessor {} has {} components per element, expected {}", file_, index,
-                                        tinygltf::GetNumComponentsInType(acc->type), components);
+            return InvalidArgumentError(
+                "{}: accessor {} has {} components per element, expected {}", file_, index,
+                tinygltf::GetNumComponentsInType(acc->type), components);
         }
         std::vector<float> out(acc->count * components);
         NAVE_RETURN_IF_ERROR(Walk(*acc, index, [&](const unsigned char* p, size_t i) {
@@ -121,15 +138,26 @@ class GltfReader {
         NAVE_ASSIGN_OR_RETURN(const tinygltf::Accessor* acc, Accessor(index));
         std::vector<uint32_t> out(acc->count);
         int type = acc->componentType;
-        if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
             type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-            return InvalidArgumentError("{}: index accessor {} has component type {}: expected an unsigned "
-                                        "integer type", file_, index, type);
+            return InvalidArgumentError(
+                "{}: index accessor {} has component type {}: expected an unsigned "
+                "integer type",
+                file_, index, type);
         }
         NAVE_RETURN_IF_ERROR(Walk(*acc, index, [&](const unsigned char* p, size_t i) {
-            if (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) out[i] = p[0];
-            else if (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) { uint16_t v; std::memcpy(&v, p, 2); out[i] = v; }
-            else { uint32_t v; std::memcpy(&v, p, 4); out[i] = v; }
+            if (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
+                out[i] = p[0];
+            else if (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+                uint16_t v;
+                std::memcpy(&v, p, 2);
+                out[i] = v;
+            } else {
+                uint32_t v;
+                std::memcpy(&v, p, 4);
+                out[i] = v;
+            }
         }));
         return out;
     }
@@ -137,7 +165,8 @@ class GltfReader {
   private:
     StatusOr<const tinygltf::Accessor*> Accessor(int index) {
         if (index < 0 || size_t(index) >= model_.accessors.size()) {
-            return InvalidArgumentError("{}: accessor {} out of range [0, {})", file_, index, model_.accessors.size());
+            return InvalidArgumentError("{}: accessor {} out of range [0, {})", file_, index,
+                                        model_.accessors.size());
         }
         return &model_.accessors[index];
     }
@@ -145,13 +174,15 @@ class GltfReader {
     template <typename F>
     Status Walk(const tinygltf::Accessor& acc, int index, F&& f) {
         if (acc.bufferView < 0 || size_t(acc.bufferView) >= model_.bufferViews.size()) {
-            return InvalidArgumentError("{}: accessor {} has no valid bufferView (sparse-only accessors are not "
-                                        "supported)", file_, index);
+            return InvalidArgumentError(
+                "{}: accessor {} has no valid bufferView (sparse-only accessors are not "
+                "supported)",
+                file_, index);
         }
         const tinygltf::BufferView& view = model_.bufferViews[acc.bufferView];
         if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size()) {
-            return InvalidArgumentError("{}: bufferView {} names buffer {}, out of range", file_, acc.bufferView,
-                                        view.buffer);
+            return InvalidArgumentError("{}: bufferView {} names buffer {}, out of range", file_,
+                                        acc.bufferView, view.buffer);
         }
         const std::vector<unsigned char>& data = model_.buffers[view.buffer].data;
         size_t elem = size_t(tinygltf::GetComponentSizeInBytes(acc.componentType)) *
@@ -159,9 +190,10 @@ class GltfReader {
         size_t stride = view.byteStride > 0 ? view.byteStride : elem;
         size_t start = view.byteOffset + acc.byteOffset;
         if (acc.count > 0 && start + stride * (acc.count - 1) + elem > data.size()) {
-            return DataLossError("{}: accessor {} reads {} elements of {} bytes at offset {} of buffer {} "
-                                 "({} bytes): out of range", file_, index, acc.count, elem, start, view.buffer,
-                                 data.size());
+            return DataLossError(
+                "{}: accessor {} reads {} elements of {} bytes at offset {} of buffer {} "
+                "({} bytes): out of range",
+                file_, index, acc.count, elem, start, view.buffer, data.size());
         }
         for (size_t i = 0; i < acc.count; ++i) f(data.data() + start + i * stride, i);
         return Status::Ok();
@@ -169,12 +201,27 @@ class GltfReader {
 
     static float Component(const tinygltf::Accessor& acc, const unsigned char* p, int c) {
         switch (acc.componentType) {
-            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p + 4 * c, 4); return v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[c] / 255.f;
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p + 2 * c, 2); return v / 65535.f; }
-            case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(int8_t(p[c]) / 127.f, -1.f);
-            case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p + 2 * c, 2); return std::max(v / 32767.f, -1.f); }
-            default: return 0.f;
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+                float v;
+                std::memcpy(&v, p + 4 * c, 4);
+                return v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+                return p[c] / 255.f;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                uint16_t v;
+                std::memcpy(&v, p + 2 * c, 2);
+                return v / 65535.f;
+            }
+            case TINYGLTF_COMPONENT_TYPE_BYTE:
+                return std::max(int8_t(p[c]) / 127.f, -1.f);
+            case TINYGLTF_COMPONENT_TYPE_SHORT: {
+                int16_t v;
+                std::memcpy(&v, p + 2 * c, 2);
+                return std::max(v / 32767.f, -1.f);
+            }
+            default:
+                return 0.f;
         }
     }
 
@@ -243,7 +290,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
 
     GltfReader reader(model, file);
     std::vector<IndexedMesh> meshes;
-    // Iterative walk of the scene graph (a malformed file could nest deeply), guarding against cycles.
+    // Iterative walk of the scene graph (a malformed file could nest deeply), guarding against
+    // cycles.
     std::vector<std::pair<int, Mat4>> stack;
     std::vector<int> visits(model.nodes.size(), 0);
     int scene = model.defaultScene >= 0 ? model.defaultScene : 0;
@@ -256,18 +304,21 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         auto [node_index, parent] = stack.back();
         stack.pop_back();
         if (node_index < 0 || size_t(node_index) >= model.nodes.size()) {
-            return InvalidArgumentError("{}: node {} out of range [0, {})", file, node_index, model.nodes.size());
+            return InvalidArgumentError("{}: node {} out of range [0, {})", file, node_index,
+                                        model.nodes.size());
         }
         if (++visits[node_index] > 1000) {
-            return InvalidArgumentError("{}: node {} reached more than 1000 times: the node graph has a cycle",
-                                        file, node_index);
+            return InvalidArgumentError(
+                "{}: node {} reached more than 1000 times: the node graph has a cycle", file,
+                node_index);
         }
         const tinygltf::Node& node = model.nodes[node_index];
         Mat4 world = Mul(parent, NodeMatrix(node));
         for (int child : node.children) stack.push_back({child, world});
         if (node.mesh < 0) continue;
         if (size_t(node.mesh) >= model.meshes.size()) {
-            return InvalidArgumentError("{}: node {} names mesh {}, out of range", file, node_index, node.mesh);
+            return InvalidArgumentError("{}: node {} names mesh {}, out of range", file, node_index,
+                                        node.mesh);
         }
         NormalMatrix normal_matrix = MakeNormalMatrix(world);
         const tinygltf::Mesh& mesh = model.meshes[node.mesh];
@@ -290,15 +341,16 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
             NAVE_ASSIGN_OR_RETURN(std::vector<float> pos, reader.ReadFloats(pos_it->second, 3));
             out.positions.resize(pos.size() / 3);
             for (size_t v = 0; v < out.positions.size(); ++v) {
-                out.positions[v] = TransformPoint(world, Vec3f(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]));
+                out.positions[v] =
+                    TransformPoint(world, Vec3f(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]));
             }
             if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
                 NAVE_ASSIGN_OR_RETURN(std::vector<float> nrm, reader.ReadFloats(it->second, 3));
                 if (nrm.size() == pos.size()) {
                     out.normals.resize(out.positions.size());
                     for (size_t v = 0; v < out.normals.size(); ++v) {
-                        out.normals[v] =
-                            TransformNormal(normal_matrix, Vec3f(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
+                        out.normals[v] = TransformNormal(
+                            normal_matrix, Vec3f(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
                     }
                 }
             }
@@ -306,7 +358,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
                 NAVE_ASSIGN_OR_RETURN(std::vector<float> uv, reader.ReadFloats(it->second, 2));
                 if (uv.size() / 2 == out.positions.size()) {
                     out.uvs.resize(out.positions.size());
-                    for (size_t v = 0; v < out.uvs.size(); ++v) out.uvs[v] = {uv[2 * v], uv[2 * v + 1]};
+                    for (size_t v = 0; v < out.uvs.size(); ++v)
+                        out.uvs[v] = {uv[2 * v], uv[2 * v + 1]};
                 }
             }
             std::vector<uint32_t> idx;
@@ -330,9 +383,11 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
                     }
                 }
             }
-            // A negative determinant mirrors the mesh: swap two corners to keep counter-clockwise fronts.
+            // A negative determinant mirrors the mesh: swap two corners to keep counter-clockwise
+            // fronts.
             if (normal_matrix.flips) {
-                for (size_t t = 0; t + 2 < out.indices.size(); t += 3) std::swap(out.indices[t + 1], out.indices[t + 2]);
+                for (size_t t = 0; t + 2 < out.indices.size(); t += 3)
+                    std::swap(out.indices[t + 1], out.indices[t + 2]);
             }
             if (prim.material >= 0 && size_t(prim.material) < materials.size()) {
                 out.material = uint32_t(prim.material);
@@ -348,8 +403,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         m.name = "default";
         materials.push_back(m);
     }
-    return std::unique_ptr<TriangleSource>(
-        new IndexedMeshSource(file, "m", std::move(meshes), std::move(materials), std::move(warnings)));
+    return std::unique_ptr<TriangleSource>(new IndexedMeshSource(
+        file, "m", std::move(meshes), std::move(materials), std::move(warnings)));
 }
 
 }  // namespace nave::preprocess

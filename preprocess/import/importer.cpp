@@ -46,11 +46,14 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path&
     if (head.rfind("ply", 0) == 0) return OpenPly(path);
     if (head.rfind("glTF", 0) == 0) return OpenGltf(path);
     if (!ext.empty() && AssimpSupports(path)) return OpenWithAssimp(path);
-    return UnsupportedError("{}: unknown model format '{}': nave reads .obj, .ply, .stl, .gltf, .glb and what "
-                            "Assimp reads (.fbx, .dae, .3ds, ...)", path.string(), ext.empty() ? "(none)" : ext);
+    return UnsupportedError(
+        "{}: unknown model format '{}': nave reads .obj, .ply, .stl, .gltf, .glb and what "
+        "Assimp reads (.fbx, .dae, .3ds, ...)",
+        path.string(), ext.empty() ? "(none)" : ext);
 }
 
-StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths) {
+StatusOr<std::unique_ptr<TriangleSource>> OpenModels(
+    const std::vector<std::filesystem::path>& paths) {
     if (paths.empty()) return InvalidArgumentError("no input model given");
     std::vector<std::unique_ptr<TriangleSource>> sources;
     for (const auto& p : paths) {

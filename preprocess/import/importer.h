@@ -1,6 +1,6 @@
 #pragma once
-// Opening model files: the format is chosen by extension (and, for files without a known extension, by the
-// first bytes), and several inputs become one merged source.
+// Opening model files: the format is chosen by extension (and, for files without a known extension,
+// by the first bytes), and several inputs become one merged source.
 
 #include <filesystem>
 #include <memory>
@@ -14,7 +14,8 @@ namespace nave::preprocess {
 /// Errors: NotFound, Unsupported (unknown format, naming the extension and the formats nave reads).
 StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path);
 
-/// Opens every input and merges them (material names made unique). One input is returned as is.
-StatusOr<std::unique_ptr<TriangleSource>> OpenModels(const std::vector<std::filesystem::path>& paths);
+/// Opens every input and merges them (material names made unique).
+StatusOr<std::unique_ptr<TriangleSource>> OpenModels(
+    const std::vector<std::filesystem::path>& paths);
 
 }  // namespace nave::preprocess

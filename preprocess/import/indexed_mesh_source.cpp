@@ -6,10 +6,15 @@
 
 namespace nave::preprocess {
 
-IndexedMeshSource::IndexedMeshSource(std::string name, std::string units, std::vector<IndexedMesh> meshes,
-                                     std::vector<store::MaterialRecord> materials, ImportWarnings warnings)
-    : name_(std::move(name)), units_(std::move(units)), meshes_(std::move(meshes)),
-      materials_(std::move(materials)), warnings_(std::move(warnings)) {
+IndexedMeshSource::IndexedMeshSource(std::string name, std::string units,
+                                     std::vector<IndexedMesh> meshes,
+                                     std::vector<store::MaterialRecord> materials,
+                                     ImportWarnings warnings)
+    : name_(std::move(name)),
+      units_(std::move(units)),
+      meshes_(std::move(meshes)),
+      materials_(std::move(materials)),
+      warnings_(std::move(warnings)) {
     if (materials_.empty()) {
         store::MaterialRecord m;
         m.name = "default";

@@ -1,7 +1,7 @@
 #pragma once
-// A model already in memory as indexed meshes (what glTF and Assimp give), served as a TriangleSource.
-// These formats are not streamed: their libraries load the whole file, so they suit models that fit in
-// memory (memory_bytes() says how much they hold).
+// A model already in memory as indexed meshes (what glTF and Assimp give), served as a
+// TriangleSource. These formats are not streamed: their libraries load the whole file, so they suit
+// models that fit in memory (memory_bytes() says how much they hold).
 
 #include <array>
 #include <string>
@@ -14,11 +14,11 @@ namespace nave::preprocess {
 /// One mesh in world space: positions already transformed by its node, one material.
 struct IndexedMesh {
     std::vector<Vec3f> positions;
-    std::vector<Vec3f> normals;                  ///< empty or one per position
-    std::vector<std::array<float, 2>> uvs;       ///< empty or one per position
-    std::vector<uint32_t> indices;               ///< 3 per triangle
+    std::vector<Vec3f> normals;             ///< empty or one per position
+    std::vector<std::array<float, 2>> uvs;  ///< empty or one per position
+    std::vector<uint32_t> indices;          ///< 3 per triangle
     uint32_t material = 0;
-    std::string where;                           ///< "helmet.gltf mesh 0 primitive 1", for warnings
+    std::string where;  ///< "helmet.gltf mesh 0 primitive 1", for warnings
 };
 
 class IndexedMeshSource final : public TriangleSource {

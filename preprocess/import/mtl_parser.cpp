@@ -17,8 +17,8 @@ Status ParseFloats(std::string_view rest, float* out, int count, const StreamRea
             return Status::Ok();
         }
         if (!ParseFloat(token, out[i])) {
-            return InvalidArgumentError("{}: '{}' expects {} numbers, found '{}'", reader.Where(), keyword,
-                                        count, token);
+            return InvalidArgumentError("{}: '{}' expects {} numbers, found '{}'", reader.Where(),
+                                        keyword, count, token);
         }
     }
     return Status::Ok();
@@ -40,7 +40,8 @@ StatusOr<std::vector<store::MaterialRecord>> ParseMtl(const std::filesystem::pat
         if (keyword == "newmtl") {
             store::MaterialRecord m;
             m.name = std::string(Trim(rest));
-            if (m.name.empty()) return InvalidArgumentError("{}: 'newmtl' without a name", reader.Where());
+            if (m.name.empty())
+                return InvalidArgumentError("{}: 'newmtl' without a name", reader.Where());
             materials.push_back(std::move(m));
             continue;
         }

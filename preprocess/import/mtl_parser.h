@@ -10,9 +10,9 @@
 
 namespace nave::preprocess {
 
-/// Parses an MTL library. Texture paths are kept as written (relative to the MTL's directory); a texture
-/// file that does not exist is counted as a warning (the material stays, the renderer uses its colour).
-/// Unknown statements are ignored. Errors: a malformed number, naming file:line.
+/// Parses an MTL library. Texture paths are kept as written (relative to the MTL's directory); a
+/// texture file that does not exist is counted as a warning (the material stays, the renderer uses
+/// its colour). Unknown statements are ignored. Errors: a malformed number, naming file:line.
 StatusOr<std::vector<store::MaterialRecord>> ParseMtl(const std::filesystem::path& path,
                                                       ImportWarnings& warnings);
 

@@ -8,6 +8,7 @@
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
+#include "preprocess/import/triangulate.h"
 
 namespace nave::preprocess {
 namespace {
@@ -38,9 +39,9 @@ class ObjSource final : public TriangleSource {
         if (batch.empty() && !finished_) {
             finished_ = true;
             if (triangles_ == 0) {
-                return InvalidArgumentError("{}: no faces found ({} lines, {} vertices): expected 'f' lines",
-                                            reader_.path().string(), reader_.line_number(),
-                                            positions_.size());
+                return InvalidArgumentError(
+                    "{}: no faces found ({} lines, {} vertices): expected 'f' lines",
+                    reader_.path().string(), reader_.line_number(), positions_.size());
             }
         }
         return !batch.empty();
@@ -75,17 +76,19 @@ class ObjSource final : public TriangleSource {
     StatusOr<int64_t> ResolveIndex(std::string_view token, size_t count, const char* what) {
         int64_t i = 0;
         if (!ParseInt(token, i)) {
-            return InvalidArgumentError("{}: face {} index '{}' is not an integer", reader_.Where(), what, token);
+            return InvalidArgumentError("{}: face {} index '{}' is not an integer", reader_.Where(),
+                                        what, token);
         }
         if (i == 0) {
-            return InvalidArgumentError("{}: face {} index 0: OBJ indices start at 1 (or are negative)",
-                                        reader_.Where(), what);
+            return InvalidArgumentError(
+                "{}: face {} index 0: OBJ indices start at 1 (or are negative)", reader_.Where(),
+                what);
         }
         int64_t resolved = i > 0 ? i - 1 : int64_t(count) + i;
         if (resolved < 0 || resolved >= int64_t(count)) {
             return InvalidArgumentError(
-                "{}: face {} index {} out of range: {} defined so far (valid 1..{} or -1..-{})", reader_.Where(),
-                what, i, count, count, count);
+                "{}: face {} index {} out of range: {} defined so far (valid 1..{} or -1..-{})",
+                reader_.Where(), what, i, count, count, count);
         }
         return resolved;
     }
@@ -119,8 +122,12 @@ class ObjSource final : public TriangleSource {
             return Status::Ok();
         }
         uint32_t material = CurrentMaterial();
-        for (size_t k = 1; k + 1 < corners_.size(); ++k) {
-            const Corner* c[3] = {&corners_[0], &corners_[k], &corners_[k + 1]};
+        polygon_.clear();
+        for (const Corner& c : corners_) polygon_.push_back(positions_[c.v]);
+        fan_.clear();
+        TriangulatePolygon(polygon_, fan_);
+        for (const auto& tri : fan_) {
+            const Corner* c[3] = {&corners_[tri[0]], &corners_[tri[1]], &corners_[tri[2]]};
             Triangle t;
             t.material = material;
             t.has_normals = c[0]->vn >= 0 && c[1]->vn >= 0 && c[2]->vn >= 0;
@@ -159,7 +166,8 @@ class ObjSource final : public TriangleSource {
         if (keyword.empty() || keyword[0] == '#') return Status::Ok();
         if (keyword == "v") {
             Vec3f p;
-            NAVE_RETURN_IF_ERROR(ParseVec(rest, &p.x, 3, keyword));  // an optional 4th (w or colour) ignored
+            NAVE_RETURN_IF_ERROR(
+                ParseVec(rest, &p.x, 3, keyword));  // an optional 4th (w or colour) ignored
             positions_.push_back(p);
         } else if (keyword == "vt") {
             std::array<float, 2> uv;
@@ -192,13 +200,15 @@ class ObjSource final : public TriangleSource {
                 NAVE_ASSIGN_OR_RETURN(auto records, ParseMtl(mtl, warnings_));
                 for (auto& r : records) library_.emplace(r.name, r);
             }
-        } else if (keyword == "g" || keyword == "o" || keyword == "s" || keyword == "l" || keyword == "p" ||
-                   keyword == "vp" || keyword == "cstype" || keyword == "usemap") {
+        } else if (keyword == "g" || keyword == "o" || keyword == "s" || keyword == "l" ||
+                   keyword == "p" || keyword == "vp" || keyword == "cstype" ||
+                   keyword == "usemap") {
             // Groups, objects, smoothing groups, lines and points carry no triangles.
         } else {
             if (line.find('\0') != std::string_view::npos || reader_.line_number() == 1) {
-                return InvalidArgumentError("{}: '{}' is not an OBJ statement: expected v, vt, vn, f, usemtl...",
-                                            reader_.Where(), std::string(keyword.substr(0, 32)));
+                return InvalidArgumentError(
+                    "{}: '{}' is not an OBJ statement: expected v, vt, vn, f, usemtl...",
+                    reader_.Where(), std::string(keyword.substr(0, 32)));
             }
             warnings_.Add("unknown OBJ statements ignored", reader_.Where());
         }
@@ -209,6 +219,8 @@ class ObjSource final : public TriangleSource {
     std::vector<Vec3f> positions_, normals_;
     std::vector<std::array<float, 2>> uvs_;
     std::vector<Corner> corners_;
+    std::vector<Vec3f> polygon_;
+    std::vector<std::array<uint32_t, 3>> fan_;
     std::vector<store::MaterialRecord> materials_;
     std::unordered_map<std::string, int64_t> material_index_;
     std::unordered_map<std::string, store::MaterialRecord> library_;

@@ -9,6 +9,7 @@
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
+#include "preprocess/import/triangulate.h"
 
 namespace nave::preprocess {
 namespace {
@@ -18,10 +19,11 @@ enum class Type : uint8_t { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFl
 
 bool ParseType(std::string_view name, Type& type) {
     static constexpr std::pair<const char*, Type> kNames[] = {
-        {"char", Type::kInt8},     {"int8", Type::kInt8},     {"uchar", Type::kUint8},  {"uint8", Type::kUint8},
-        {"short", Type::kInt16},   {"int16", Type::kInt16},   {"ushort", Type::kUint16}, {"uint16", Type::kUint16},
-        {"int", Type::kInt32},     {"int32", Type::kInt32},   {"uint", Type::kUint32},  {"uint32", Type::kUint32},
-        {"float", Type::kFloat32}, {"float32", Type::kFloat32}, {"double", Type::kFloat64},
+        {"char", Type::kInt8},      {"int8", Type::kInt8},       {"uchar", Type::kUint8},
+        {"uint8", Type::kUint8},    {"short", Type::kInt16},     {"int16", Type::kInt16},
+        {"ushort", Type::kUint16},  {"uint16", Type::kUint16},   {"int", Type::kInt32},
+        {"int32", Type::kInt32},    {"uint", Type::kUint32},     {"uint32", Type::kUint32},
+        {"float", Type::kFloat32},  {"float32", Type::kFloat32}, {"double", Type::kFloat64},
         {"float64", Type::kFloat64}};
     for (const auto& [n, t] : kNames) {
         if (name == n) {
@@ -34,10 +36,18 @@ bool ParseType(std::string_view name, Type& type) {
 
 size_t TypeSize(Type t) {
     switch (t) {
-        case Type::kInt8: case Type::kUint8: return 1;
-        case Type::kInt16: case Type::kUint16: return 2;
-        case Type::kInt32: case Type::kUint32: case Type::kFloat32: return 4;
-        case Type::kFloat64: return 8;
+        case Type::kInt8:
+        case Type::kUint8:
+            return 1;
+        case Type::kInt16:
+        case Type::kUint16:
+            return 2;
+        case Type::kInt32:
+        case Type::kUint32:
+        case Type::kFloat32:
+            return 4;
+        case Type::kFloat64:
+            return 8;
     }
     return 0;
 }
@@ -59,8 +69,9 @@ struct Element {
 constexpr int kSlotCount = 8;
 int VertexSlot(const std::string& name) {
     static constexpr std::pair<const char*, int> kNames[] = {
-        {"x", 0}, {"y", 1}, {"z", 2}, {"nx", 3}, {"ny", 4}, {"nz", 5}, {"u", 6}, {"s", 6},
-        {"texture_u", 6}, {"texture_s", 6}, {"v", 7}, {"t", 7}, {"texture_v", 7}, {"texture_t", 7}};
+        {"x", 0},  {"y", 1}, {"z", 2},         {"nx", 3},        {"ny", 4},
+        {"nz", 5}, {"u", 6}, {"s", 6},         {"texture_u", 6}, {"texture_s", 6},
+        {"v", 7},  {"t", 7}, {"texture_v", 7}, {"texture_t", 7}};
     for (const auto& [n, s] : kNames) {
         if (name == n) return s;
     }
@@ -89,8 +100,10 @@ class PlySource final : public TriangleSource {
                 NAVE_RETURN_IF_ERROR(ReadVertices(e));
             } else if (e.name == "face" || e.name == "tristrips") {
                 if (!vertices_read_) {
-                    return UnsupportedError("{}: element '{}' comes before 'vertex': nave streams faces and "
-                                            "needs the vertices first", reader_.path().string(), e.name);
+                    return UnsupportedError(
+                        "{}: element '{}' comes before 'vertex': nave streams faces and "
+                        "needs the vertices first",
+                        reader_.path().string(), e.name);
                 }
                 while (record_ < e.count && batch.size() < max_triangles) {
                     NAVE_RETURN_IF_ERROR(ReadFaceRecord(e, e.name == "tristrips", batch));
@@ -103,8 +116,10 @@ class PlySource final : public TriangleSource {
         if (batch.empty() && !finished_) {
             finished_ = true;
             if (triangles_ == 0) {
-                return InvalidArgumentError("{}: no faces: expected a 'face' or 'tristrips' element with "
-                                            "vertex_indices", reader_.path().string());
+                return InvalidArgumentError(
+                    "{}: no faces: expected a 'face' or 'tristrips' element with "
+                    "vertex_indices",
+                    reader_.path().string());
             }
         }
         return !batch.empty();
@@ -132,9 +147,9 @@ class PlySource final : public TriangleSource {
             std::string_view line;
             NAVE_ASSIGN_OR_RETURN(bool more, reader_.NextLine(line));
             if (!more) {
-                return DataLossError("{}: truncated: expected more values for element '{}' record {} of {}",
-                                     reader_.Where(), elements_[element_].name, record_,
-                                     elements_[element_].count);
+                return DataLossError(
+                    "{}: truncated: expected more values for element '{}' record {} of {}",
+                    reader_.Where(), elements_[element_].name, record_, elements_[element_].count);
             }
             line_rest_ = line;
         }
@@ -146,13 +161,15 @@ class PlySource final : public TriangleSource {
             if (type == Type::kFloat32 || type == Type::kFloat64) {
                 float f = 0;
                 if (!ParseFloat(token, f)) {
-                    return InvalidArgumentError("{}: expected a number, found '{}'", reader_.Where(), token);
+                    return InvalidArgumentError("{}: expected a number, found '{}'",
+                                                reader_.Where(), token);
                 }
                 return double(f);
             }
             int64_t i = 0;
             if (!ParseInt(token, i)) {
-                return InvalidArgumentError("{}: expected an integer, found '{}'", reader_.Where(), token);
+                return InvalidArgumentError("{}: expected an integer, found '{}'", reader_.Where(),
+                                            token);
             }
             return double(i);
         }
@@ -164,14 +181,40 @@ class PlySource final : public TriangleSource {
             for (size_t i = 0; i < size / 2; ++i) std::swap(bytes[i], bytes[size - 1 - i]);
         }
         switch (type) {
-            case Type::kInt8: return double(int8_t(bytes[0]));
-            case Type::kUint8: return double(bytes[0]);
-            case Type::kInt16: { int16_t v; std::memcpy(&v, bytes, 2); return double(v); }
-            case Type::kUint16: { uint16_t v; std::memcpy(&v, bytes, 2); return double(v); }
-            case Type::kInt32: { int32_t v; std::memcpy(&v, bytes, 4); return double(v); }
-            case Type::kUint32: { uint32_t v; std::memcpy(&v, bytes, 4); return double(v); }
-            case Type::kFloat32: { float v; std::memcpy(&v, bytes, 4); return double(v); }
-            case Type::kFloat64: { double v; std::memcpy(&v, bytes, 8); return v; }
+            case Type::kInt8:
+                return double(int8_t(bytes[0]));
+            case Type::kUint8:
+                return double(bytes[0]);
+            case Type::kInt16: {
+                int16_t v;
+                std::memcpy(&v, bytes, 2);
+                return double(v);
+            }
+            case Type::kUint16: {
+                uint16_t v;
+                std::memcpy(&v, bytes, 2);
+                return double(v);
+            }
+            case Type::kInt32: {
+                int32_t v;
+                std::memcpy(&v, bytes, 4);
+                return double(v);
+            }
+            case Type::kUint32: {
+                uint32_t v;
+                std::memcpy(&v, bytes, 4);
+                return double(v);
+            }
+            case Type::kFloat32: {
+                float v;
+                std::memcpy(&v, bytes, 4);
+                return double(v);
+            }
+            case Type::kFloat64: {
+                double v;
+                std::memcpy(&v, bytes, 8);
+                return v;
+            }
         }
         return 0.0;
     }
@@ -179,7 +222,8 @@ class PlySource final : public TriangleSource {
     StatusOr<uint64_t> ReadListCount(const Property& p) {
         NAVE_ASSIGN_OR_RETURN(double count, ReadValue(p.count_type));
         if (count < 0 || count > 1e9) {
-            return InvalidArgumentError("{}: list '{}' has count {}: expected 0..1e9", Where(), p.name, count);
+            return InvalidArgumentError("{}: list '{}' has count {}: expected 0..1e9", Where(),
+                                        p.name, count);
         }
         return uint64_t(count);
     }
@@ -205,7 +249,8 @@ class PlySource final : public TriangleSource {
             if (s >= 0) has[s] = true;
         }
         if (!has[0] || !has[1] || !has[2]) {
-            return InvalidArgumentError("{}: element 'vertex' lacks x, y or z properties", reader_.path().string());
+            return InvalidArgumentError("{}: element 'vertex' lacks x, y or z properties",
+                                        reader_.path().string());
         }
         bool normals = has[3] && has[4] && has[5];
         bool uvs = has[6] && has[7];
@@ -218,7 +263,8 @@ class PlySource final : public TriangleSource {
                 const Property& p = e.properties[k];
                 if (p.is_list) {
                     NAVE_ASSIGN_OR_RETURN(uint64_t n, ReadListCount(p));
-                    for (uint64_t i = 0; i < n; ++i) NAVE_RETURN_IF_ERROR(ReadValue(p.type).status());
+                    for (uint64_t i = 0; i < n; ++i)
+                        NAVE_RETURN_IF_ERROR(ReadValue(p.type).status());
                     continue;
                 }
                 NAVE_ASSIGN_OR_RETURN(double value, ReadValue(p.type));
@@ -233,7 +279,8 @@ class PlySource final : public TriangleSource {
         return Status::Ok();
     }
 
-    Status EmitTriangle(int64_t a, int64_t b, int64_t c, std::vector<Triangle>& batch, const std::string& where) {
+    Status EmitTriangle(int64_t a, int64_t b, int64_t c, std::vector<Triangle>& batch,
+                        const std::string& where) {
         Triangle t;
         int64_t idx[3] = {a, b, c};
         t.has_normals = !normals_.empty();
@@ -257,8 +304,8 @@ class PlySource final : public TriangleSource {
             std::string_view line;
             NAVE_ASSIGN_OR_RETURN(bool more, reader_.NextLine(line));
             if (!more) {
-                return DataLossError("{}: truncated: expected {} '{}' records, found {}", reader_.path().string(),
-                                     e.count, e.name, record_);
+                return DataLossError("{}: truncated: expected {} '{}' records, found {}",
+                                     reader_.path().string(), e.count, e.name, record_);
             }
             line_rest_ = line;
             where = reader_.Where();
@@ -284,8 +331,8 @@ class PlySource final : public TriangleSource {
                     continue;
                 }
                 if (index < 0 || index >= int64_t(positions_.size())) {
-                    return InvalidArgumentError("{}: {} {} vertex index {} out of range [0, {})", where, e.name,
-                                                record_, index, positions_.size());
+                    return InvalidArgumentError("{}: {} {} vertex index {} out of range [0, {})",
+                                                where, e.name, record_, index, positions_.size());
                 }
                 indices_.push_back(index);
             }
@@ -303,13 +350,19 @@ class PlySource final : public TriangleSource {
                 warnings_.Add("faces with fewer than 3 vertices skipped", where);
                 return Status::Ok();
             }
-            for (size_t k = 1; k + 1 < indices_.size(); ++k) {
-                NAVE_RETURN_IF_ERROR(EmitTriangle(indices_[0], indices_[k], indices_[k + 1], batch, where));
+            polygon_.clear();
+            for (int64_t i : indices_) polygon_.push_back(positions_[i]);
+            fan_.clear();
+            TriangulatePolygon(polygon_, fan_);
+            for (const auto& tri : fan_) {
+                NAVE_RETURN_IF_ERROR(EmitTriangle(indices_[tri[0]], indices_[tri[1]],
+                                                  indices_[tri[2]], batch, where));
             }
             return Status::Ok();
         }
-        // Triangle strips: triangle i of a run is (i, i+1, i+2), every other one flipped to keep the winding;
-        // -1 restarts a run. Triangles with a repeated vertex join runs on purpose and are dropped silently.
+        // Triangle strips: triangle i of a run is (i, i+1, i+2), every other one flipped to keep
+        // the winding; -1 restarts a run. Triangles with a repeated vertex join runs on purpose and
+        // are dropped silently.
         size_t run_start = 0;
         for (size_t i = 0; i < indices_.size(); ++i) {
             if (indices_[i] == -1) {
@@ -337,6 +390,8 @@ class PlySource final : public TriangleSource {
     std::vector<Vec3f> positions_, normals_;
     std::vector<std::array<float, 2>> uvs_;
     std::vector<int64_t> indices_;
+    std::vector<Vec3f> polygon_;
+    std::vector<std::array<uint32_t, 3>> fan_;
     std::vector<store::MaterialRecord> materials_;
     ImportWarnings warnings_;
 };
@@ -348,8 +403,9 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenPly(const std::filesystem::path& p
     std::string_view line;
     NAVE_ASSIGN_OR_RETURN(bool more, reader.NextLine(line));
     if (!more || Trim(line) != "ply") {
-        return InvalidArgumentError("{}:1: expected 'ply' as the first line, found '{}'", path.string(),
-                                    more ? std::string(line.substr(0, 32)) : std::string("end of file"));
+        return InvalidArgumentError(
+            "{}:1: expected 'ply' as the first line, found '{}'", path.string(),
+            more ? std::string(line.substr(0, 32)) : std::string("end of file"));
     }
     std::optional<Format> format;
     std::vector<Element> elements;
@@ -362,35 +418,46 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenPly(const std::filesystem::path& p
         if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
         if (keyword == "format") {
             std::string_view f = NextToken(rest);
-            if (f == "ascii") format = Format::kAscii;
-            else if (f == "binary_little_endian") format = Format::kBinaryLittle;
-            else if (f == "binary_big_endian") format = Format::kBinaryBig;
-            else return UnsupportedError("{}: format '{}': expected ascii, binary_little_endian or "
-                                         "binary_big_endian", reader.Where(), f);
+            if (f == "ascii")
+                format = Format::kAscii;
+            else if (f == "binary_little_endian")
+                format = Format::kBinaryLittle;
+            else if (f == "binary_big_endian")
+                format = Format::kBinaryBig;
+            else
+                return UnsupportedError(
+                    "{}: format '{}': expected ascii, binary_little_endian or "
+                    "binary_big_endian",
+                    reader.Where(), f);
         } else if (keyword == "element") {
             Element e;
             e.name = std::string(NextToken(rest));
             int64_t count = 0;
             if (!ParseInt(NextToken(rest), count) || count < 0) {
-                return InvalidArgumentError("{}: 'element {}' needs a non-negative count", reader.Where(), e.name);
+                return InvalidArgumentError("{}: 'element {}' needs a non-negative count",
+                                            reader.Where(), e.name);
             }
             e.count = uint64_t(count);
             elements.push_back(std::move(e));
         } else if (keyword == "property") {
-            if (elements.empty()) return InvalidArgumentError("{}: 'property' before any 'element'", reader.Where());
+            if (elements.empty())
+                return InvalidArgumentError("{}: 'property' before any 'element'", reader.Where());
             Property p;
             std::string_view type = NextToken(rest);
             if (type == "list") {
                 p.is_list = true;
-                if (!ParseType(NextToken(rest), p.count_type) ||
-                    p.count_type == Type::kFloat32 || p.count_type == Type::kFloat64) {
-                    return InvalidArgumentError("{}: list count type: expected an integer type", reader.Where());
+                if (!ParseType(NextToken(rest), p.count_type) || p.count_type == Type::kFloat32 ||
+                    p.count_type == Type::kFloat64) {
+                    return InvalidArgumentError("{}: list count type: expected an integer type",
+                                                reader.Where());
                 }
                 type = NextToken(rest);
             }
             if (!ParseType(type, p.type)) {
-                return InvalidArgumentError("{}: unknown property type '{}': expected char, uchar, short, ushort, "
-                                            "int, uint, float, double", reader.Where(), type);
+                return InvalidArgumentError(
+                    "{}: unknown property type '{}': expected char, uchar, short, ushort, "
+                    "int, uint, float, double",
+                    reader.Where(), type);
             }
             p.name = std::string(NextToken(rest));
             elements.back().properties.push_back(std::move(p));
@@ -400,7 +467,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenPly(const std::filesystem::path& p
         }
     }
     if (!format) return InvalidArgumentError("{}: header has no 'format' line", path.string());
-    return std::unique_ptr<TriangleSource>(new PlySource(std::move(reader), *format, std::move(elements)));
+    return std::unique_ptr<TriangleSource>(
+        new PlySource(std::move(reader), *format, std::move(elements)));
 }
 
 }  // namespace nave::preprocess

@@ -1,10 +1,11 @@
 #pragma once
-// Stanford PLY: ASCII, binary little and big endian. Faces are lists of any length (triangulated as fans);
-// `tristrips` elements (lists with -1 restarts, as 3D scanners write) become triangles with alternating
-// winding; properties nave does not use (colours, confidence...) are read and ignored.
+// Stanford PLY: ASCII, binary little and big endian. Faces are lists of any length (triangulated as
+// in import/triangulate.h); `tristrips` elements (lists with -1 restarts, as 3D scanners write)
+// become triangles with alternating winding; properties nave does not use (colours, confidence...)
+// are read and ignored.
 //
-// Memory: faces index into the vertex element, which therefore must come first and is kept in memory
-// (12 bytes per vertex, 24 with normals, 32 with texture coordinates). Faces stream.
+// Memory: faces index into the vertex element, which therefore must come first and is kept in
+// memory (12 bytes per vertex, 24 with normals, 32 with texture coordinates). Faces stream.
 
 #include <filesystem>
 #include <memory>

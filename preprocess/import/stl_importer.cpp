@@ -30,7 +30,8 @@ class StlSource final : public TriangleSource {
         if (batch.empty() && !finished_) {
             finished_ = true;
             if (triangles_ == 0) {
-                return InvalidArgumentError("{}: no usable facets ({} read)", reader_.path().string(), facets_);
+                return InvalidArgumentError("{}: no usable facets ({} read)",
+                                            reader_.path().string(), facets_);
             }
         }
         return !batch.empty();
@@ -61,7 +62,8 @@ class StlSource final : public TriangleSource {
                 float xyz[3];
                 std::memcpy(xyz, record + 12 + 12 * j, 12);
                 if constexpr (std::endian::native == std::endian::big) {
-                    for (float& f : xyz) f = std::bit_cast<float>(__builtin_bswap32(std::bit_cast<uint32_t>(f)));
+                    for (float& f : xyz)
+                        f = std::bit_cast<float>(__builtin_bswap32(std::bit_cast<uint32_t>(f)));
                 }
                 t.p[j] = Vec3f(xyz[0], xyz[1], xyz[2]);
             }
@@ -76,8 +78,9 @@ class StlSource final : public TriangleSource {
             NAVE_ASSIGN_OR_RETURN(bool more, reader_.NextLine(line));
             if (!more) {
                 if (corner_ != 0) {
-                    return DataLossError("{}: truncated inside a facet: expected 3 'vertex' lines, found {}",
-                                         reader_.Where(), corner_);
+                    return DataLossError(
+                        "{}: truncated inside a facet: expected 3 'vertex' lines, found {}",
+                        reader_.Where(), corner_);
                 }
                 break;
             }
@@ -85,15 +88,15 @@ class StlSource final : public TriangleSource {
             std::string_view keyword = NextToken(rest);
             if (keyword == "vertex") {
                 if (corner_ == 3) {
-                    return InvalidArgumentError("{}: a 4th 'vertex' in one facet: expected 'endloop'",
-                                                reader_.Where());
+                    return InvalidArgumentError(
+                        "{}: a 4th 'vertex' in one facet: expected 'endloop'", reader_.Where());
                 }
                 Vec3f& p = current_.p[corner_];
                 for (int k = 0; k < 3; ++k) {
                     std::string_view token = NextToken(rest);
                     if (!ParseFloat(token, (&p.x)[k])) {
-                        return InvalidArgumentError("{}: 'vertex' expects 3 numbers, found '{}'", reader_.Where(),
-                                                    token);
+                        return InvalidArgumentError("{}: 'vertex' expects 3 numbers, found '{}'",
+                                                    reader_.Where(), token);
                     }
                 }
                 if (corner_ == 0) facet_where_ = reader_.Where();
@@ -101,19 +104,20 @@ class StlSource final : public TriangleSource {
             } else if (keyword == "endloop" || keyword == "endfacet") {
                 if (keyword == "endloop") {
                     if (corner_ != 3) {
-                        return InvalidArgumentError("{}: facet with {} vertices: expected 3", reader_.Where(),
-                                                    corner_);
+                        return InvalidArgumentError("{}: facet with {} vertices: expected 3",
+                                                    reader_.Where(), corner_);
                     }
                     Emit(current_, batch, facet_where_);
                     corner_ = 0;
                 }
-            } else if (keyword == "facet" || keyword == "outer" || keyword == "solid" || keyword == "endsolid" ||
-                       keyword.empty()) {
+            } else if (keyword == "facet" || keyword == "outer" || keyword == "solid" ||
+                       keyword == "endsolid" || keyword.empty()) {
                 // Structure only.
             } else {
-                return InvalidArgumentError("{}: '{}' is not an ASCII STL keyword: expected facet, outer loop, "
-                                            "vertex, endloop, endfacet", reader_.Where(),
-                                            std::string(keyword.substr(0, 32)));
+                return InvalidArgumentError(
+                    "{}: '{}' is not an ASCII STL keyword: expected facet, outer loop, "
+                    "vertex, endloop, endfacet",
+                    reader_.Where(), std::string(keyword.substr(0, 32)));
             }
         }
         return Status::Ok();
@@ -136,7 +140,8 @@ class StlSource final : public TriangleSource {
 StatusOr<std::unique_ptr<TriangleSource>> OpenStl(const std::filesystem::path& path) {
     NAVE_ASSIGN_OR_RETURN(StreamReader reader, StreamReader::Open(path));
     uint64_t size = reader.file_size();
-    if (size == 0) return InvalidArgumentError("{}: empty file: expected an STL model", path.string());
+    if (size == 0)
+        return InvalidArgumentError("{}: empty file: expected an STL model", path.string());
     unsigned char header[84] = {};
     NAVE_ASSIGN_OR_RETURN(size_t got, reader.ReadSome(header, 84));
     uint32_t count = 0;
@@ -144,11 +149,12 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenStl(const std::filesystem::path& p
     if constexpr (std::endian::native == std::endian::big) count = __builtin_bswap32(count);
     bool starts_solid = got >= 5 && std::memcmp(header, "solid", 5) == 0;
     bool size_matches = got == 84 && size == 84 + 50 * uint64_t(count);
-    // The size test decides: a binary STL's size is exact, and an ASCII file matching it by chance would
-    // also need its bytes 80..83 to spell that count.
-    if (size_matches) return std::unique_ptr<TriangleSource>(new StlSource(std::move(reader), true, count));
-    // "solid" followed by text is ASCII; followed by binary bytes (the triangle count, a float) it is a
-    // binary file of the wrong size.
+    // The size test decides: a binary STL's size is exact, and an ASCII file matching it by chance
+    // would also need its bytes 80..83 to spell that count.
+    if (size_matches)
+        return std::unique_ptr<TriangleSource>(new StlSource(std::move(reader), true, count));
+    // "solid" followed by text is ASCII; followed by binary bytes (the triangle count, a float) it
+    // is a binary file of the wrong size.
     bool text_header = true;
     for (size_t i = 0; i < got; ++i) {
         unsigned char c = header[i];
@@ -159,8 +165,10 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenStl(const std::filesystem::path& p
         return std::unique_ptr<TriangleSource>(new StlSource(std::move(text), false, 0));
     }
     if (got < 84) {
-        return DataLossError("{}: {} bytes: too short for a binary STL (84-byte header) and not ASCII "
-                             "(no 'solid')", path.string(), size);
+        return DataLossError(
+            "{}: {} bytes: too short for a binary STL (84-byte header) and not ASCII "
+            "(no 'solid')",
+            path.string(), size);
     }
     return DataLossError("{}: binary STL header says {} triangles, so {} bytes expected, found {}",
                          path.string(), count, 84 + 50 * uint64_t(count), size);

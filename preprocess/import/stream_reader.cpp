@@ -1,10 +1,10 @@
 #include "preprocess/import/stream_reader.h"
 
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <cstring>
 #include <utility>
-
-#include <fmt/format.h>
 
 namespace nave::preprocess {
 namespace {
@@ -63,7 +63,8 @@ Status StreamReader::Fill() {
     if (end_ == buffer_.size()) buffer_.resize(buffer_.size() * 2);
     size_t got = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
     if (got == 0) {
-        if (std::ferror(file_)) return IoError("{}: read error at byte {}", path_.string(), consumed_offset_);
+        if (std::ferror(file_))
+            return IoError("{}: read error at byte {}", path_.string(), consumed_offset_);
         eof_ = true;
     }
     end_ += got;
@@ -95,8 +96,8 @@ StatusOr<bool> StreamReader::NextLine(std::string_view& line) {
             return true;
         }
         if (end_ - begin_ > kMaxLineBytes) {
-            return DataLossError("{}:{}: line longer than {} bytes: expected a text file", path_.string(),
-                                 line_number_ + 1, kMaxLineBytes);
+            return DataLossError("{}:{}: line longer than {} bytes: expected a text file",
+                                 path_.string(), line_number_ + 1, kMaxLineBytes);
         }
         size_t scanned = end_ - begin_;
         NAVE_RETURN_IF_ERROR(Fill());

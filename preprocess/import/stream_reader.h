@@ -1,6 +1,7 @@
 #pragma once
-// Forward-only buffered reading of a file of any size in bounded memory: lines (text formats, CRLF or LF)
-// and raw bytes (binary formats), with the line number and byte offset that error messages need.
+// Forward-only buffered reading of a file of any size in bounded memory: lines (text formats, CRLF
+// or LF) and raw bytes (binary formats), with the line number and byte offset that error messages
+// need.
 
 #include <cstdint>
 #include <cstdio>
@@ -23,8 +24,8 @@ class StreamReader {
     StreamReader& operator=(const StreamReader&) = delete;
     ~StreamReader();
 
-    /// Next line without its "\n" or "\r\n", valid until the next call. Returns false at the end of the
-    /// file. Lines longer than 64 MiB are an error (a binary file read as text).
+    /// Next line without its "\n" or "\r\n", valid until the next call. Returns false at the end of
+    /// the file. Lines longer than 64 MiB are an error (a binary file read as text).
     StatusOr<bool> NextLine(std::string_view& line);
     /// Reads exactly `size` bytes; a short read is DataLoss naming the file, offset and sizes.
     Status ReadBytes(void* out, size_t size);
@@ -50,7 +51,7 @@ class StreamReader {
     std::FILE* file_ = nullptr;
     uint64_t file_size_ = 0;
     std::vector<char> buffer_;
-    size_t begin_ = 0, end_ = 0;   // unread bytes are buffer_[begin_, end_)
+    size_t begin_ = 0, end_ = 0;  // unread bytes are buffer_[begin_, end_)
     bool eof_ = false;
     uint64_t consumed_offset_ = 0;
     uint64_t line_number_ = 0;

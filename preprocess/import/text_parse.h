@@ -26,7 +26,8 @@ inline std::string_view Trim(std::string_view text) {
     return text;
 }
 
-/// Parses a whole token as a float ("1e-3", "-0.5", "nan" and "inf" are accepted: callers check finiteness).
+/// Parses a whole token as a float ("1e-3", "-0.5", "nan" and "inf" are accepted: callers check
+/// finiteness).
 inline bool ParseFloat(std::string_view token, float& out) {
     if (token.empty()) return false;
     if (token.front() == '+') token.remove_prefix(1);

@@ -1,6 +1,6 @@
 #pragma once
-// The checks every importer applies to a triangle before passing it on: finite coordinates and a non-zero
-// area. A failing triangle is skipped and counted (the model stays usable).
+// The checks every importer applies to a triangle before passing it on: finite coordinates and a
+// non-zero area. A failing triangle is skipped and counted (the model stays usable).
 
 #include <string>
 
@@ -9,7 +9,8 @@
 
 namespace nave::preprocess {
 
-inline constexpr const char* kWarnDegenerate = "degenerate faces skipped (zero area or repeated vertex)";
+inline constexpr const char* kWarnDegenerate =
+    "degenerate faces skipped (zero area or repeated vertex)";
 inline constexpr const char* kWarnNonFinite = "faces with NaN or infinite coordinates skipped";
 
 /// True if `t` can be used; otherwise counts a warning at `where` and returns false.

@@ -1,9 +1,9 @@
 #include "preprocess/partition/bin_file.h"
 
+#include <lz4.h>
+
 #include <cerrno>
 #include <cstring>
-
-#include <lz4.h>
 
 namespace nave::preprocess {
 namespace {
@@ -17,11 +17,15 @@ void Put(std::string& out, const T& v) {
 
 }  // namespace
 
-size_t BinRecordBytes(const Triangle& t) { return 40 + (t.has_normals ? 36 : 0) + (t.has_uvs ? 24 : 0); }
+size_t BinRecordBytes(const Triangle& t) {
+    return 40 + (t.has_normals ? 36 : 0) + (t.has_uvs ? 24 : 0);
+}
 
-StatusOr<std::unique_ptr<BinWriter>> BinWriter::Create(const std::filesystem::path& path, size_t block_bytes) {
+StatusOr<std::unique_ptr<BinWriter>> BinWriter::Create(const std::filesystem::path& path,
+                                                       size_t block_bytes) {
     std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (f == nullptr) return IoError("{}: cannot create temporary bin: {}", path.string(), std::strerror(errno));
+    if (f == nullptr)
+        return IoError("{}: cannot create temporary bin: {}", path.string(), std::strerror(errno));
     return std::unique_ptr<BinWriter>(new BinWriter(path, f, block_bytes));
 }
 
@@ -35,7 +39,8 @@ BinWriter::~BinWriter() {
 Status BinWriter::Append(const Triangle& t) {
     if (raw_.capacity() < block_bytes_ + 128) raw_.reserve(block_bytes_ + 128);
     Put(raw_, t.p);
-    uint32_t tag = (t.material & kMaterialMask) | (t.has_normals ? kHasNormals : 0) | (t.has_uvs ? kHasUvs : 0);
+    uint32_t tag = (t.material & kMaterialMask) | (t.has_normals ? kHasNormals : 0) |
+                   (t.has_uvs ? kHasUvs : 0);
     Put(raw_, tag);
     if (t.has_normals) Put(raw_, t.n);
     if (t.has_uvs) Put(raw_, t.uv);
@@ -49,9 +54,12 @@ Status BinWriter::FlushBlock() {
     int bound = LZ4_compressBound(int(raw_.size()));
     if (compressed_.size() < size_t(bound)) compressed_.resize(bound);
     int n = LZ4_compress_default(raw_.data(), compressed_.data(), int(raw_.size()), bound);
-    if (n <= 0) return InternalError("{}: LZ4 compression failed ({}) on a {}-byte block", path_.string(), n, raw_.size());
+    if (n <= 0)
+        return InternalError("{}: LZ4 compression failed ({}) on a {}-byte block", path_.string(),
+                             n, raw_.size());
     uint32_t header[2] = {uint32_t(raw_.size()), uint32_t(n)};
-    if (std::fwrite(header, sizeof(header), 1, file_) != 1 || std::fwrite(compressed_.data(), n, 1, file_) != 1) {
+    if (std::fwrite(header, sizeof(header), 1, file_) != 1 ||
+        std::fwrite(compressed_.data(), n, 1, file_) != 1) {
         return IoError("{}: write failed at byte {}: {} (disk full?)", path_.string(), file_bytes_,
                        std::strerror(errno));
     }
@@ -74,7 +82,8 @@ Status BinWriter::Close() {
 
 StatusOr<std::unique_ptr<BinReader>> BinReader::Open(const std::filesystem::path& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (f == nullptr) return IoError("{}: cannot open temporary bin: {}", path.string(), std::strerror(errno));
+    if (f == nullptr)
+        return IoError("{}: cannot open temporary bin: {}", path.string(), std::strerror(errno));
     return std::unique_ptr<BinReader>(new BinReader(path, f));
 }
 
@@ -90,7 +99,8 @@ Status BinReader::NextBlock() {
         pos_ = 0;
         return Status::Ok();
     }
-    if (got != sizeof(header) || header[0] > (1u << 30) || header[1] > uint32_t(LZ4_compressBound(int(header[0])))) {
+    if (got != sizeof(header) || header[0] > (1u << 30) ||
+        header[1] > uint32_t(LZ4_compressBound(int(header[0])))) {
         return DataLossError("{} @{}: corrupt bin block header", path_.string(), offset_);
     }
     compressed_.resize(header[1]);
@@ -100,8 +110,8 @@ Status BinReader::NextBlock() {
     }
     int n = LZ4_decompress_safe(compressed_.data(), raw_.data(), int(header[1]), int(header[0]));
     if (n != int(header[0])) {
-        return DataLossError("{} @{}: LZ4 block decodes to {} bytes, expected {}", path_.string(), offset_, n,
-                             header[0]);
+        return DataLossError("{} @{}: LZ4 block decodes to {} bytes, expected {}", path_.string(),
+                             offset_, n, header[0]);
     }
     offset_ += sizeof(header) + header[1];
     pos_ = 0;
@@ -132,7 +142,8 @@ StatusOr<bool> BinReader::Read(std::vector<Triangle>& out, size_t max) {
             std::memcpy(&t.uv, raw_.data() + pos_, sizeof(t.uv));
             pos_ += sizeof(t.uv);
         }
-        if (pos_ > raw_.size()) return DataLossError("{} @{}: record runs past its block", path_.string(), offset_);
+        if (pos_ > raw_.size())
+            return DataLossError("{} @{}: record runs past its block", path_.string(), offset_);
         out.push_back(t);
         ++added;
     }

@@ -1,7 +1,8 @@
 #pragma once
-// Temporary triangle bins: triangles appended in LZ4-compressed blocks to a file, read back in order.
-// Each record is 40 bytes (9 floats + material and flags) plus 36 for normals and 24 for texture
-// coordinates when present. Blocks: [u32 raw size][u32 compressed size][bytes]. LZ4 errors become Status.
+// Temporary triangle bins: triangles appended in LZ4-compressed blocks to a file, read back in
+// order. Each record is 40 bytes (9 floats + material and flags) plus 36 for normals and 24 for
+// texture coordinates when present. Blocks: [u32 raw size][u32 compressed size][bytes]. LZ4 errors
+// become Status.
 
 #include <cstdint>
 #include <cstdio>
@@ -16,8 +17,10 @@ namespace nave::preprocess {
 
 class BinWriter {
   public:
-    /// Creates (truncates) `path`. `block_bytes` is the uncompressed block size (memory held: about twice).
-    static StatusOr<std::unique_ptr<BinWriter>> Create(const std::filesystem::path& path, size_t block_bytes);
+    /// Creates (truncates) `path`. `block_bytes` is the uncompressed block size (memory held: about
+    /// twice).
+    static StatusOr<std::unique_ptr<BinWriter>> Create(const std::filesystem::path& path,
+                                                       size_t block_bytes);
     ~BinWriter();
 
     Status Append(const Triangle& t);

@@ -7,78 +7,77 @@
 namespace nave::preprocess {
 namespace {
 
-struct VertexKey {
-    Vec3i q;
-    uint32_t n[3];
-    uint32_t uv[2];
-    bool operator==(const VertexKey& o) const { return std::memcmp(this, &o, sizeof(VertexKey)) == 0; }
-};
-
-uint64_t HashKey(const VertexKey& k) {
-    uint64_t h = 0x9E3779B97F4A7C15ull;
-    auto mix = [&](uint32_t v) {
-        h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
-        h *= 0xBF58476D1CE4E5B9ull;
-    };
-    mix(uint32_t(k.q.x));
-    mix(uint32_t(k.q.y));
-    mix(uint32_t(k.q.z));
-    for (uint32_t v : k.n) mix(v);
-    mix(k.uv[0]);
-    mix(k.uv[1]);
-    return h ^ (h >> 29);
+template <typename Key>
+bool SameKey(const Key& a, const Key& b) {
+    return std::memcmp(&a, &b, sizeof(Key)) == 0;
 }
 
-// Open addressing, linear probing; slots hold vertex index + 1 (0 = empty).
-class VertexTable {
-  public:
-    explicit VertexTable(size_t expected) {
-        size_t cap = 16;
-        while (cap < expected * 2) cap <<= 1;
-        slots_.assign(cap, 0);
-        mask_ = cap - 1;
+template <typename Key>
+uint64_t HashKey(const Key& k) {
+    uint32_t words[sizeof(Key) / 4];
+    std::memcpy(words, &k, sizeof(Key));
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (uint32_t v : words) {
+        h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+        h *= 0xBF58476D1CE4E5B9ull;
     }
-    // Returns the index of `key`, inserting `next` if absent (then *inserted = true).
-    uint32_t Find(const VertexKey& key, const std::vector<VertexKey>& keys, uint32_t next, bool* inserted) {
-        size_t i = HashKey(key) & mask_;
-        while (true) {
-            uint32_t s = slots_[i];
-            if (s == 0) {
-                slots_[i] = next + 1;
-                *inserted = true;
-                return next;
-            }
-            if (keys[s - 1] == key) {
-                *inserted = false;
-                return s - 1;
-            }
-            i = (i + 1) & mask_;
-        }
-    }
-
-  private:
-    std::vector<uint32_t> slots_;
-    size_t mask_ = 0;
-};
+    return h ^ (h >> 29);
+}
 
 }  // namespace
 
 BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid) {
-    BuiltBrick out;
+    BrickBuilder builder;
+    return builder.Build(triangles, grid);
+}
+
+const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
+                                      const store::GlobalGrid& grid) {
+    BuiltBrick& out = out_;
+    out.bounds = Bounds3f();
+    out.collapsed_triangles = 0;
     bool normals = false, uvs = false;
     for (const Triangle& t : triangles) {
         normals |= t.has_normals;
         uvs |= t.has_uvs;
     }
     store::BrickMesh& mesh = out.mesh;
-    std::vector<VertexKey> keys;
-    keys.reserve(triangles.size());
+    mesh.positions.clear();
+    mesh.normals.clear();
+    mesh.uvs.clear();
+    mesh.indices.clear();
+    mesh.material_ids.clear();
+    keys_.clear();
+    keys_.reserve(triangles.size());
     mesh.positions.reserve(triangles.size());
     if (normals) mesh.normals.reserve(triangles.size());
     if (uvs) mesh.uvs.reserve(triangles.size());
     mesh.indices.reserve(triangles.size() * 3);
     mesh.material_ids.reserve(triangles.size());
-    VertexTable table(triangles.size() + 16);
+    // Open addressing with linear probing; slots hold vertex index + 1 (0: empty). At most three
+    // vertices per triangle, so the table is at most half full.
+    size_t cap = 16;
+    while (cap < 6 * triangles.size() + 32) cap <<= 1;
+    slots_.assign(cap, 0);
+    const size_t mask = cap - 1;
+    auto find = [&](const VertexKey& key, bool* inserted) -> uint32_t {
+        size_t i = HashKey(key) & mask;
+        while (true) {
+            uint32_t s = slots_[i];
+            if (s == 0) {
+                uint32_t next = uint32_t(keys_.size());
+                slots_[i] = next + 1;
+                keys_.push_back(key);
+                *inserted = true;
+                return next;
+            }
+            if (SameKey(keys_[s - 1], key)) {
+                *inserted = false;
+                return s - 1;
+            }
+            i = (i + 1) & mask;
+        }
+    };
     for (const Triangle& t : triangles) {
         Vec3f face_normal(0, 0, 1);
         if (normals) {
@@ -92,7 +91,8 @@ BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::G
             k.q = grid.Quantize(t.p[j]);
             Vec3f n = normals ? (t.has_normals ? t.n[j] : face_normal) : Vec3f();
             if (normals && t.has_normals) {
-                // Bad input normals (zero, NaN, not unit) are replaced or renormalised, not passed on.
+                // Bad input normals (zero, NaN, not unit) are replaced or renormalised, not passed
+                // on.
                 float len = Length(n);
                 n = (len > 1e-12f && std::isfinite(len)) ? n / len : face_normal;
             }
@@ -107,10 +107,8 @@ BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::G
                 k.uv[1] = std::bit_cast<uint32_t>(uv[1]);
             }
             bool inserted = false;
-            uint32_t next = uint32_t(keys.size());
-            idx[j] = table.Find(k, keys, next, &inserted);
+            idx[j] = find(k, &inserted);
             if (inserted) {
-                keys.push_back(k);
                 Vec3f p = grid.Dequantize(k.q);
                 mesh.positions.push_back(p);
                 out.bounds.Extend(p);
@@ -118,7 +116,8 @@ BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::G
                 if (uvs) mesh.uvs.push_back(uv);
             }
         }
-        if (keys[idx[0]].q == keys[idx[1]].q || keys[idx[1]].q == keys[idx[2]].q || keys[idx[0]].q == keys[idx[2]].q) {
+        const Vec3i &a = keys_[idx[0]].q, &b = keys_[idx[1]].q, &c = keys_[idx[2]].q;
+        if (a == b || b == c || a == c) {
             ++out.collapsed_triangles;
             continue;
         }

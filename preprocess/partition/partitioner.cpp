@@ -44,7 +44,8 @@ Vec3f Centroid(const Triangle& t) { return (t.p[0] + t.p[1] + t.p[2]) * (1.f / 3
 Vec3f ClampTo(const Vec3f& p, const Bounds3f& b) { return Max(b.min, Min(b.max, p)); }
 
 Bounds3d Grow(const Bounds3f& b, double margin) {
-    return Bounds3d(Vec3d(b.min) - Vec3d(margin, margin, margin), Vec3d(b.max) + Vec3d(margin, margin, margin));
+    return Bounds3d(Vec3d(b.min) - Vec3d(margin, margin, margin),
+                    Vec3d(b.max) + Vec3d(margin, margin, margin));
 }
 
 // The kd-tree built from a bin's sample, before it joins the brick tree.
@@ -72,7 +73,8 @@ std::filesystem::path Partitioner::NewBinPath() {
 void Partitioner::AddTempBytes(int64_t delta) {
     int64_t now = temp_bytes_.fetch_add(delta) + delta;
     uint64_t peak = peak_temp_bytes_.load();
-    while (now > 0 && uint64_t(now) > peak && !peak_temp_bytes_.compare_exchange_weak(peak, uint64_t(now))) {
+    while (now > 0 && uint64_t(now) > peak &&
+           !peak_temp_bytes_.compare_exchange_weak(peak, uint64_t(now))) {
     }
 }
 
@@ -163,12 +165,13 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     const uint64_t leaf_max = config_.brick_triangles + config_.brick_triangles / 4;
     if (task.triangles <= leaf_max || task.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
         std::lock_guard<std::mutex> lock(mutex_);
-        leaves_.push_back({task.file, task.cell, task.triangles, task.node, task.triangles > leaf_max});
+        leaves_.push_back(
+            {task.file, task.cell, task.triangles, task.node, task.triangles > leaf_max});
         return Status::Ok();
     }
 
-    // The local kd-tree: split the leaf with the largest estimate at the sample's median along its longest
-    // axis, until every estimate is under the target or the fan-out limit is reached.
+    // The local kd-tree: split the leaf with the largest estimate at the sample's median along its
+    // longest axis, until every estimate is under the target or the fan-out limit is reached.
     std::vector<LocalNode> lnodes(1);
     std::vector<LocalLeaf> lleaves(1);
     lleaves[0].cell = task.cell;
@@ -211,8 +214,10 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         above.cell.min[axis] = split;
         for (const Vec3f& p : pts) (p[axis] < split ? below.points : above.points).push_back(p);
         double total = double(pts.size());
-        below.estimate = total > 0 ? leaf.estimate * below.points.size() / total : leaf.estimate / 2;
-        above.estimate = total > 0 ? leaf.estimate * above.points.size() / total : leaf.estimate / 2;
+        below.estimate =
+            total > 0 ? leaf.estimate * below.points.size() / total : leaf.estimate / 2;
+        above.estimate =
+            total > 0 ? leaf.estimate * above.points.size() / total : leaf.estimate / 2;
         // Triangles crossing the plane go to both sides; never let an estimate vanish entirely.
         below.estimate = std::max(below.estimate, 1.0);
         above.estimate = std::max(above.estimate, 1.0);
@@ -241,7 +246,8 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
 
     // One pass over the bin: each triangle to every leaf cell it overlaps.
     const size_t fanout = lleaves.size();
-    size_t block = std::max<size_t>(16 << 10, std::min(config_.block_bytes, (size_t(64) << 20) / fanout));
+    size_t block =
+        std::max<size_t>(16 << 10, std::min(config_.block_bytes, (size_t(64) << 20) / fanout));
     std::vector<std::unique_ptr<BinWriter>> writers(fanout);
     std::vector<Reservoir> samples;
     std::vector<Bounds3d> grown(fanout);
@@ -254,7 +260,6 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::vector<Triangle> batch;
     std::vector<int> candidates, stack;
     const float m = float(margin_);
-    uint64_t processed = 0;
     while (true) {
         batch.clear();
         NAVE_ASSIGN_OR_RETURN(bool more, reader->Read(batch, 1 << 14));
@@ -283,11 +288,11 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
                 placed = true;
             }
             if (!placed && !candidates.empty()) {
-                // Only rounding can get here (the triangle touches the parent cell): keep it somewhere near.
+                // Only rounding can get here (the triangle touches the parent cell): keep it
+                // somewhere near.
                 NAVE_RETURN_IF_ERROR(writers[candidates[0]]->Append(t));
             }
         }
-        processed += batch.size();
         progress_->Add(batch.size());
     }
     reader.reset();
@@ -297,7 +302,6 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::filesystem::remove(task.file, ec);
     AddTempBytes(-parent_bytes);
     int64_t child_bytes = 0;
-    (void)processed;
 
     std::lock_guard<std::mutex> lock(mutex_);
     // Graft the local tree onto the brick tree: the task's leaf becomes the local root.

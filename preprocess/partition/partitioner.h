@@ -1,17 +1,18 @@
 #pragma once
 // Out-of-core kd partition of a triangle stream into bricks.
 //
-// Phase 1 (Bin): the source is streamed once into an LZ4-compressed temporary bin, while its bounds, its
-// triangle count and a reservoir sample of triangle centroids are gathered.
-// Phase 2 (Split): a bin with more triangles than a brick may hold is split: the sample gives a small
-// kd-tree (median of the sample along the cell's longest axis, repeated until each leaf's estimated count
-// is under the target, at most 64 leaves), then one pass over the bin sends each triangle to every leaf cell
-// it overlaps (exact triangle/box test, cells grown by the grid step so that snapping cannot move a
-// triangle out of a cell that needs it). Children still too big are split again. Empty cells get no brick.
-// The result is the tree's nodes and the leaf bins, ready to be encoded.
+// Phase 1 (Bin): the source is streamed once into an LZ4-compressed temporary bin, while its
+// bounds, its triangle count and a reservoir sample of triangle centroids are gathered. Phase 2
+// (Split): a bin with more triangles than a brick may hold is split: the sample gives a small
+// kd-tree (median of the sample along the cell's longest axis, repeated until each leaf's estimated
+// count is under the target, at most 64 leaves), then one pass over the bin sends each triangle to
+// every leaf cell it overlaps (exact triangle/box test, cells grown by the grid step so that
+// snapping cannot move a triangle out of a cell that needs it). Children still too big are split
+// again. Empty cells get no brick. The result is the tree's nodes and the leaf bins, ready to be
+// encoded.
 //
-// Memory: the sample (12 bytes per point), one block buffer per open bin (2 x block_bytes) per thread;
-// never the triangles themselves.
+// Memory: the sample (12 bytes per point), one block buffer per open bin (2 x block_bytes) per
+// thread; never the triangles themselves.
 
 #include <atomic>
 #include <cstdint>
@@ -31,8 +32,8 @@ struct PartitionConfig {
     uint64_t brick_triangles = 1'000'000;  ///< target per brick; a leaf may hold up to 5/4 of it
     size_t block_bytes = 256 << 10;        ///< bin block size (uncompressed)
     int threads = 1;
-    size_t root_sample = 1 << 18;          ///< centroids sampled from the whole input
-    size_t child_sample = 1 << 14;         ///< per child bin
+    size_t root_sample = 1 << 18;   ///< centroids sampled from the whole input
+    size_t child_sample = 1 << 12;  ///< per child bin (64 children: 3 MiB per splitting thread)
     int max_fanout = 64;
 };
 
@@ -41,8 +42,9 @@ struct LeafBin {
     std::filesystem::path file;
     Bounds3f cell;
     uint64_t triangles = 0;
-    uint32_t node = 0;       ///< index of its leaf in nodes()
-    bool oversized = false;  ///< could not be split below the target (overlapping or huge triangles)
+    uint32_t node = 0;  ///< index of its leaf in nodes()
+    bool oversized =
+        false;  ///< could not be split below the target (overlapping or huge triangles)
 };
 
 class Partitioner {
@@ -55,13 +57,14 @@ class Partitioner {
     const Bounds3d& bounds() const { return bounds_; }
     uint64_t source_triangles() const { return source_triangles_; }
 
-    /// Phase 2. `margin` is how much cells grow for the overlap test (the grid step); `root` the tree's box.
-    /// `progress` counts triangles distributed.
+    /// Phase 2. `margin` is how much cells grow for the overlap test (the grid step); `root` the
+    /// tree's box. `progress` counts triangles distributed.
     Status Split(const Bounds3f& root, double margin, ProgressBar& progress);
 
     const std::vector<LeafBin>& leaves() const { return leaves_; }
     std::vector<store::BrickTreeNode>& nodes() { return nodes_; }
-    /// Triangle references in leaf bins minus source triangles (triangles counted once per cell they cross).
+    /// Triangle references in leaf bins minus source triangles (triangles counted once per cell
+    /// they cross).
     uint64_t duplicated_triangles() const;
     /// Largest bin bytes on disk at any one time (approximately), for the summary.
     uint64_t peak_temp_bytes() const { return peak_temp_bytes_.load(); }

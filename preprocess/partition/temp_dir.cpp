@@ -45,13 +45,16 @@ StatusOr<TempDir> TempDir::Create(const std::filesystem::path& parent) {
     for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
         std::string name = entry.path().filename().string();
         long pid = PidAfter(name, prefix);
-        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid)) std::filesystem::remove_all(entry.path(), ec);
+        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid))
+            std::filesystem::remove_all(entry.path(), ec);
     }
     static std::atomic<int> counter{0};
     for (int attempt = 0; attempt < 100; ++attempt) {
         auto path = dir / (prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
         if (std::filesystem::create_directory(path, ec)) return TempDir(path);
-        if (ec) return IoError("{}: cannot create temporary directory: {}", path.string(), ec.message());
+        if (ec)
+            return IoError("{}: cannot create temporary directory: {}", path.string(),
+                           ec.message());
     }
     return IoError("{}: cannot create a temporary directory", dir.string());
 }
@@ -64,11 +67,13 @@ TempDir::~TempDir() {
 
 void RemoveStaleOutputTemporaries(const std::filesystem::path& output) {
     std::error_code ec;
-    std::filesystem::path dir = output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
+    std::filesystem::path dir =
+        output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
     const std::string prefix = output.filename().string() + ".tmp-";
     for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
         long pid = PidAfter(entry.path().filename().string(), prefix);
-        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid)) std::filesystem::remove(entry.path(), ec);
+        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid))
+            std::filesystem::remove(entry.path(), ec);
     }
 }
 

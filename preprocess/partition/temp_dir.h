@@ -1,9 +1,9 @@
 #pragma once
-// The temporary directory of one preprocess run, and interruption. The directory is removed when the run
-// ends, succeeds or fails. SIGINT and SIGTERM set a flag that the work loops poll (Cancelled()), so the run
-// unwinds normally and removes its files; a second signal ends the process at once. Leftovers of a run that
-// was killed outright (SIGKILL, power loss) are removed by the next run in the same place: their names
-// carry the dead process's id.
+// The temporary directory of one preprocess run, and interruption. The directory is removed when
+// the run ends, succeeds or fails. SIGINT and SIGTERM set a flag that the work loops poll
+// (Cancelled()), so the run unwinds normally and removes its files; a second signal ends the
+// process at once. Leftovers of a run that was killed outright (SIGKILL, power loss) are removed by
+// the next run in the same place: their names carry the dead process's id.
 
 #include <filesystem>
 #include <string>
@@ -30,7 +30,8 @@ class TempDir {
     std::filesystem::path path_;
 };
 
-/// Removes `<output>.tmp-<pid>-*` files (AtomicFile temporaries) left by dead processes next to `output`.
+/// Removes `<output>.tmp-<pid>-*` files (AtomicFile temporaries) left by dead processes next to
+/// `output`.
 void RemoveStaleOutputTemporaries(const std::filesystem::path& output);
 
 /// Installs the SIGINT / SIGTERM handlers (idempotent).

@@ -10,7 +10,8 @@ bool TriangleOverlapsBox(const std::array<Vec3f, 3>& tri, const Bounds3d& box) {
     Vec3d v[3] = {Vec3d(tri[0]) - c, Vec3d(tri[1]) - c, Vec3d(tri[2]) - c};
     // Box face normals: the triangle's extent against the box's along each axis.
     for (int a = 0; a < 3; ++a) {
-        double lo = std::min({v[0][a], v[1][a], v[2][a]}), hi = std::max({v[0][a], v[1][a], v[2][a]});
+        double lo = std::min({v[0][a], v[1][a], v[2][a]}),
+               hi = std::max({v[0][a], v[1][a], v[2][a]});
         if (lo > h[a] || hi < -h[a]) return false;
     }
     Vec3d e[3] = {v[1] - v[0], v[2] - v[1], v[0] - v[2]};

@@ -10,26 +10,33 @@ namespace nave::cli {
 
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand(
-        "preprocess", "Cut models (OBJ, PLY, STL, glTF, Assimp formats) into a brick store (.nave)");
+        "preprocess",
+        "Cut models (OBJ, PLY, STL, glTF, Assimp formats) into a brick store (.nave)");
     struct Options {
         std::vector<std::string> inputs;
         std::string generate, output, memory, temp_dir;
         uint64_t brick_triangles = 1'000'000;
         double precision = 0;
         int threads = 0;
-        int draco_speed = 5;
+        int draco_speed = store::EncodeOptions{}.draco_speed;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("inputs", opt->inputs, "Model files; several are merged into one model");
-    cmd->add_option("--generate", opt->generate, "Use a generator instead of files: abbey or abbey:detail=D");
+    cmd->add_option("--generate", opt->generate,
+                    "Use a generator instead of files: abbey or abbey:detail=D");
     cmd->add_option("-o,--output", opt->output, "Output store (.nave)")->required();
-    cmd->add_option("--memory", opt->memory, "Memory budget, e.g. 4G (default: a quarter of physical memory)");
-    cmd->add_option("--brick-triangles", opt->brick_triangles, "Target triangles per brick (default 1000000)");
-    cmd->add_option("--precision", opt->precision,
-                    "Grid step in model units (default: bounds diagonal / 2^20; max error step * sqrt(3) / 2)");
+    cmd->add_option("--memory", opt->memory,
+                    "Memory budget, e.g. 4G (default: a quarter of physical memory)");
+    cmd->add_option("--brick-triangles", opt->brick_triangles,
+                    "Target triangles per brick (default 1000000)");
+    cmd->add_option(
+        "--precision", opt->precision,
+        "Grid step in model units (default: bounds diagonal / 2^20; max error step * sqrt(3) / 2)");
     cmd->add_option("--threads", opt->threads, "Threads (default: all hardware threads)");
-    cmd->add_option("--temp-dir", opt->temp_dir, "Where to put temporary files (default: beside the output)");
-    cmd->add_option("--draco-speed", opt->draco_speed, "Draco encoder speed 0 (smallest) .. 10 (fastest)")
+    cmd->add_option("--temp-dir", opt->temp_dir,
+                    "Where to put temporary files (default: beside the output)");
+    cmd->add_option("--draco-speed", opt->draco_speed,
+                    "Draco encoder speed 0 (smallest) .. 10 (fastest)")
         ->check(CLI::Range(0, 10));
     cmd->callback([&run, opt] {
         run = [opt]() -> Status {
@@ -37,15 +44,17 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             for (const auto& in : opt->inputs) o.inputs.emplace_back(in);
             o.generate = opt->generate;
             if (o.inputs.empty() == o.generate.empty()) {
-                return InvalidArgumentError("give either input files or --generate abbey[:detail=D], not {}",
-                                            o.inputs.empty() ? "neither" : "both");
+                return InvalidArgumentError(
+                    "give either input files or --generate abbey[:detail=D], not {}",
+                    o.inputs.empty() ? "neither" : "both");
             }
             o.output = opt->output;
             if (!opt->memory.empty()) {
                 NAVE_ASSIGN_OR_RETURN(o.memory_bytes, ParseByteSize(opt->memory));
             }
             o.brick_triangles = opt->brick_triangles;
-            if (opt->precision < 0) return InvalidArgumentError("--precision {}: must be positive", opt->precision);
+            if (opt->precision < 0)
+                return InvalidArgumentError("--precision {}: must be positive", opt->precision);
             o.precision = opt->precision;
             o.threads = opt->threads;
             o.temp_dir = opt->temp_dir;

@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "core/color.h"
+#include "render/sun/sky.h"
 #include "render/sun/sun.h"
 
 namespace nave::cli {
@@ -59,6 +60,9 @@ Status RunSun(const SunOptions& o) {
         lit ? XYZToChromaticity(SpectrumToXYZ(sun.direct_normal_irradiance)) : Chromaticity{};
     double cct = lit ? CctRobertson(xy) : NAN;
     double cct_mccamy = lit ? CctMcCamy(xy) : NAN;
+    // Clear-sky zenith luminance of the Preetham et al. (1999) sky for the same sun and turbidity.
+    double sky_zenith =
+        lit ? PreethamSky(sun.direction, float(o.turbidity)).zenith_luminance() : NAN;
 
     if (o.spectrum && !o.json) {
         std::printf("wavelength_nm,direct_normal_irradiance_w_m2_nm,extraterrestrial_w_m2_nm\n");
@@ -92,6 +96,7 @@ Status RunSun(const SunOptions& o) {
         out += fmt::format("  \"direct_normal_irradiance_360_830_w_m2\": {},\n", JsonNumber(watts));
         out += fmt::format("  \"cct_kelvin\": {},\n  \"cct_mccamy_kelvin\": {},\n", JsonNumber(cct),
                            JsonNumber(cct_mccamy));
+        out += fmt::format("  \"sky_zenith_luminance_cd_m2\": {},\n", JsonNumber(sky_zenith));
         out += fmt::format("  \"chromaticity\": {{\"x\": {}, \"y\": {}}}",
                            lit ? JsonNumber(xy.x) : "null", lit ? JsonNumber(xy.y) : "null");
         if (o.spectrum) {
@@ -130,6 +135,8 @@ Status RunSun(const SunOptions& o) {
     std::printf("chromaticity              x %.4f, y %.4f\n", xy.x, xy.y);
     std::printf("correlated colour temp.   %.0f K (Robertson 1968; McCamy 1992: %.0f K)\n", cct,
                 cct_mccamy);
+    std::printf("sky zenith luminance      %.0f cd/m² (clear sky, Preetham et al. 1999)\n",
+                sky_zenith);
     return Status::Ok();
 }
 

@@ -127,6 +127,8 @@ class BrickSource {
     /// the default policy never calls it.
     bool Evict(uint32_t id);
     BrickSourceStats stats() const;
+    /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon portals).
+    EmbreeDevice& device() const { return *device_; }
 
   protected:
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,

@@ -59,10 +59,6 @@ Vec3d Film::SumXYZ(uint32_t pixel) const {
             xyz_[3 * size_t(pixel) + 2].load(std::memory_order_relaxed)};
 }
 
-void Film::SetPixelXYZ(uint32_t pixel, const Vec3d& xyz) {
-    for (int c = 0; c < 3; ++c) xyz_[3 * size_t(pixel) + c].store(xyz[c] * spp_, std::memory_order_relaxed);
-}
-
 std::vector<float> Film::LinearRgb() const {
     Mat3d m = OutputMatrix(output_.white_balance);
     std::vector<float> rgb(pixel_count() * 3);

@@ -43,8 +43,6 @@ class Film {
     double samples_per_pixel() const { return spp_; }
     /// The estimate of `pixel` in XYZ: sum / spp.
     Vec3d PixelXYZ(uint32_t pixel) const { return SumXYZ(pixel) * (1.0 / spp_); }
-    /// Overwrites a pixel's XYZ estimate (for estimators that are not running sums, like SPPM).
-    void SetPixelXYZ(uint32_t pixel, const Vec3d& xyz);
 
     /// Writes linear RGB (plus AOV channels) as EXR with `metadata`, and a tone-mapped sRGB PNG beside it
     /// (same name, .png). Both through temp name + rename.

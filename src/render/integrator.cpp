@@ -103,16 +103,20 @@ class Engine {
     /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
     bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
     void SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
-                     const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick, Outbox& out,
+                     const RayRecord& r, const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out,
                      LocalCounters& c);
     void Escape(const RayRecord& r);
+    /// Next-event estimation of the uniform sky: a uniform direction on the sphere (its pdf does not depend on
+    /// the vertex, so an escaping path can weigh itself against it), power heuristic with the BSDF.
+    void SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r, const VertexRng& rng,
+                   bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
     /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin glass
     /// (windows) lets it through, scaled by the pane's transmittance at that angle: panes do not bend rays.
     bool ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, LocalCounters& c) const;
     /// A straight pass through thin glass: the path continues in the same direction, and this is not a
     /// scattering event (depth, MIS state unchanged), as for shadow rays.
     static bool IsPassThrough(const SurfaceMaterial& m, const BsdfSample& bs) {
-        return m.kind == MaterialConfig::Kind::kThinDielectric && bs.IsTransmission();
+        return m.thin_glass() != nullptr && bs.IsTransmission();
     }
     void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
     SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
@@ -129,7 +133,7 @@ class Engine {
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
     bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
-        return m.kind == MaterialConfig::Kind::kThinDielectric;
+        return m.thin_glass() != nullptr;
     });
     std::unique_ptr<VisiblePoints> visible_;  // photon mode
 
@@ -143,6 +147,12 @@ class Engine {
         int portal = -1;      // kLight (sun, directional): index in portals_ when aiming at windows
     };
     std::vector<PortalProjection> portals_;
+    // Sky photons aimed at the portals: every portal triangle in one Embree scene, to count the portals a
+    // photon's line crosses (the balance-heuristic weight), and the area CDF to pick start points.
+    std::unique_ptr<ResidentBrick> portal_scene_;
+    std::vector<std::array<Vec3f, 3>> portal_triangles_;
+    std::vector<double> portal_area_cdf_;
+    double portal_area_ = 0;
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     Vec3f scene_center_;
@@ -168,7 +178,7 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
     uint32_t mat = m.material_ids[hit.triangle];
     static const SurfaceMaterial kBlack = [] {
         SurfaceMaterial s;
-        s.kind = MaterialConfig::Kind::kBlack;
+        s.black = true;
         return s;
     }();
     h.material = mat < scene_.materials.size() ? &scene_.materials[mat] : &kBlack;
@@ -178,7 +188,12 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
 void Engine::Escape(const RayRecord& r) {
     if (r.kind != kPathRay) return;  // photons leaving the model carry nothing back
     SampledSpectrum L;
-    if (scene_.sky) L += scene_.sky_radiance.Sample(r.lambda);
+    if (scene_.sky) {
+        // The sky is also next-event estimated (uniform directions): weight the BSDF-sampled escape.
+        float w = 1;
+        if (r.depth > 0 && !(r.flags & kSpecularBounce)) w = PowerHeuristic(r.prev_pdf, UniformSpherePdf());
+        L += scene_.SkyRadiance(r.dir, r.lambda) * w;
+    }
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
         if (Dot(r.dir, sun.to_light) >= sun.cos_sun) {
@@ -203,9 +218,10 @@ bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float 
         if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
         SurfaceHit h = MakeSurfaceHit(brick, hit);
         const SurfaceMaterial& m = *h.material;
-        if (m.kind != MaterialConfig::Kind::kThinDielectric) return false;
+        const ThinGlassMaterial* glass = m.thin_glass();
+        if (glass == nullptr) return false;
         SampledSpectrum reflected, transmitted;
-        ThinDielectricBxdf(m.eta.Sample(r.lambda), m.transmittance.Sample(r.lambda))
+        ThinDielectricBxdf(glass->eta.Sample(r.lambda), glass->internal_transmittance.Sample(r.lambda))
             .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
         r.beta *= transmitted;
         if (r.beta.IsZero()) return false;
@@ -233,7 +249,7 @@ void Engine::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& 
 }
 
 void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
-                         const RayRecord& r, const VertexRng& rng, uint32_t b, const ResidentBrick& brick,
+                         const RayRecord& r, const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick,
                          Outbox& out, LocalCounters& c) {
     Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
     Vec3f wi;
@@ -277,13 +293,31 @@ void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, con
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return;
     float w = 1;
-    if (light_pdf > 0) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
+    if (light_pdf > 0 && mis) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = t_max;
     s.beta = r.beta * f * Li * w;
+    Spawn(s, b, &brick, out, c);
+}
+
+void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r,
+                       const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c) {
+    const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
+    Vec3f wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+    SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
+    if (f.IsZero()) return;
+    const float light_pdf = UniformSpherePdf();
+    float w = mis ? PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda)) : 1.f;
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.dir = wi;
+    s.t_max = kInfinity;
+    s.beta = r.beta * f * scene_.SkyRadiance(wi, r.lambda) * (w / light_pdf);
+    if (s.beta.IsZero()) return;
     Spawn(s, b, &brick, out, c);
 }
 
@@ -305,12 +339,16 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     if (flags == kBxdfUnset) return false;
     VertexRng rng(Key(r, kStreamPath));
     const bool non_specular = flags & (kBxdfDiffuse | kBxdfGlossy);
+    // In photon mode the path stops at its first diffuse vertex: no BSDF-sampled direction will find the
+    // lights from here, so next-event estimation takes the full weight.
+    const bool visible_point = scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse);
     if (non_specular) {
         for (size_t i = 0; i < scene_.lights.size(); ++i) {
-            SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, b, brick, out, c);
+            SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, !visible_point, b, brick, out, c);
         }
+        if (scene_.sky) SampleSky(h, bsdf, wo, r, rng, !visible_point, b, brick, out, c);
     }
-    if (scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse)) {
+    if (visible_point) {
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from photons.
         visible_->Add(r.pixel, h.p, h.ns, wo, mat, r.beta);
         return false;
@@ -605,11 +643,41 @@ Status Engine::BuildEmitters() {
         emitters_.push_back(e);
         weights.push_back(w);
     }
+    if (scene_.sky && want_portals && !portal_triangles.empty()) {
+        store::BrickMesh mesh;
+        portal_area_cdf_.push_back(0);
+        for (const auto& t : portal_triangles) {
+            uint32_t base = uint32_t(mesh.positions.size());
+            mesh.positions.insert(mesh.positions.end(), {t[0], t[1], t[2]});
+            mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+            mesh.material_ids.push_back(0);
+            portal_area_ += 0.5 * double(Length(Cross(t[1] - t[0], t[2] - t[0])));
+            portal_area_cdf_.push_back(portal_area_);
+        }
+        for (double& c : portal_area_cdf_) c /= portal_area_;
+        portal_triangles_ = portal_triangles;
+        NAVE_ASSIGN_OR_RETURN(portal_scene_,
+                              ResidentBrick::Build(scene_.source->device(), 0, bounds, std::move(mesh)));
+    }
     if (scene_.sky) {
         Emitter e;
         e.kind = Emitter::Kind::kSky;
         emitters_.push_back(e);
-        weights.push_back(MeanVisible(scene_.sky_radiance) * 4 * kPiF * disk_area);
+        // Mean radiance over the sphere of directions (a fixed 256-direction Fibonacci set for a sky model).
+        double mean = 0;
+        if (scene_.preetham) {
+            const int n = 256;
+            for (int i = 0; i < n; ++i) {
+                float z = 1 - 2 * (float(i) + 0.5f) / float(n), phi = 2.39996323f * float(i);
+                float rxy = std::sqrt(std::max(0.f, 1 - z * z));
+                mean += MeanVisible(scene_.preetham->RadianceSpectrum(Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
+            }
+            mean = mean / n * scene_.sky_scale;
+        } else {
+            mean = MeanVisible(scene_.sky_radiance);
+        }
+        // Through portals: lines cross them with measure 2 pi A_portals (both sides), through the bounds 4 pi A_disc.
+        weights.push_back(mean * (portal_scene_ ? 2 * kPiF * portal_area_ : 4 * kPiF * disk_area));
     }
     emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
     weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
@@ -696,12 +764,34 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                         break;
                     }
                 }
+            } else if (e.kind == Emitter::Kind::kSky && portal_scene_) {
+                // A point uniform on the portals' area, a cosine-weighted direction on a random side: the
+                // line's density is count / (2 pi A) in the measure dA_perp dw, count = portals the line
+                // crosses (Veach's balance heuristic over the portals), so the power is L 2 pi A / count.
+                size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(),
+                                                   double(rng.Uniform(6))) - (portal_area_cdf_.begin() + 1));
+                const auto& t = portal_triangles_[std::min(i, portal_triangles_.size() - 1)];
+                float su = std::sqrt(u1.x);
+                Vec3f p = t[0] * (1 - su) + t[1] * (su * (1 - u1.y)) + t[2] * (su * u1.y);
+                Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
+                if (rng.Uniform(5) < 0.5f) n = -n;
+                Vec3f d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                r.origin = p - d * (2 * scene_radius_);
+                r.dir = d;
+                int count = 0;
+                BrickHit hit;
+                for (float t0 = 0; count < 64 && portal_scene_->Intersect(r.origin, d, t0, 4 * scene_radius_, &hit);) {
+                    ++count;
+                    t0 = hit.t + 1e-6f * (1.f + hit.t);
+                }
+                r.beta = scene_.SkyRadiance(-d, lambda) * float(2 * kPiF * portal_area_ / std::max(1, count));
             } else if (e.kind == Emitter::Kind::kSky) {
                 Vec3f to = SampleUniformSphere(u2);
                 r.origin = disc_origin(to);
                 r.dir = -to;
-                r.beta = scene_.sky_radiance.Sample(lambda) * (4 * kPiF * disk_area);
-                r.flags = kFromAreaLight;
+                r.beta = scene_.SkyRadiance(to, lambda) * (4 * kPiF * disk_area);
+                // Direct skylight is next-event estimated at the visible points: sky photons deposit only
+                // after a bounce.
             } else {
                 // Uniform point on the triangle (Turk 1990 square-root parameterisation), cosine-weighted
                 // direction on a side chosen with probability 1/2.

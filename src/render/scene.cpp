@@ -12,34 +12,45 @@ Spectrum ToSpectrum(const SpectrumSpec& spec) {
     return Spectrum::FromFunction([&](double lambda_nm) { return spec.Evaluate(float(lambda_nm)); });
 }
 
-Bsdf SurfaceMaterial::MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
-    const Vec3f no_tangent(0, 0, 0);
-    switch (kind) {
-        case MaterialConfig::Kind::kDiffuse:
-            return Bsdf(ns, no_tangent, DiffuseBxdf(reflectance.Sample(*lambda)));
-        case MaterialConfig::Kind::kConductor: {
-            float a = RoughnessToAlpha(roughness);
-            return Bsdf(ns, no_tangent, ConductorBxdf(TrowbridgeReitz(a, a), eta.Sample(*lambda), k.Sample(*lambda)));
-        }
-        case MaterialConfig::Kind::kDielectric:
-            // A dispersive interface sends each wavelength its own way: keep the hero wavelength only
-            // (pbrt-v4 §10.1.2's treatment; SampledWavelengths::TerminateSecondary keeps the film unbiased).
-            if (dispersive) lambda->TerminateSecondary();
-            return Bsdf(ns, no_tangent, DielectricBxdf(eta.Evaluate(lambda->lambda_nm(0))));
-        case MaterialConfig::Kind::kThinDielectric:
-            return Bsdf(ns, no_tangent, ThinDielectricBxdf(eta.Sample(*lambda), transmittance.Sample(*lambda)));
-        case MaterialConfig::Kind::kBlack: break;
-    }
-    return Bsdf(ns, no_tangent, Bxdf());
+float SurfaceMaterial::AlbedoForAov() const {
+    if (black) return 0;
+    if (const auto* d = std::get_if<DiffuseMaterial>(&material)) return d->albedo.Evaluate(550);
+    return 1;
 }
 
-float SurfaceMaterial::AlbedoForAov() const {
-    switch (kind) {
-        case MaterialConfig::Kind::kDiffuse: return reflectance.Evaluate(550);
-        case MaterialConfig::Kind::kBlack: return 0;
-        default: return 1;
+namespace {
+
+/// The physics material a config table describes.
+StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name) {
+    if (!mc.builtin.empty()) {
+        StatusOr<Material> m = BuiltinMaterial(mc.builtin);
+        if (!m.ok()) return m.status().WithContext(fmt::format("{}: materials.{}.builtin", mc.where, name));
+        return m;
     }
+    switch (mc.kind) {
+        case MaterialConfig::Kind::kDiffuse: return Material(DiffuseMaterial{ToSpectrum(mc.reflectance)});
+        case MaterialConfig::Kind::kConductor: {
+            float a = RoughnessToAlpha(mc.roughness);
+            return Material(ConductorMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.k), a, a});
+        }
+        case MaterialConfig::Kind::kDielectric: {
+            DielectricMaterial d;
+            d.eta = ToSpectrum(mc.eta);
+            d.alpha = RoughnessToAlpha(mc.roughness);
+            return Material(d);
+        }
+        case MaterialConfig::Kind::kThinDielectric:
+            if (mc.total_transmittance) {
+                return Material(ThinGlassMaterial::FromTotalTransmittance(ToSpectrum(mc.eta),
+                                                                          ToSpectrum(*mc.total_transmittance)));
+            }
+            return Material(ThinGlassMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.transmittance)});
+        case MaterialConfig::Kind::kBlack: break;
+    }
+    return Material(DiffuseMaterial{Spectrum::Constant(0.f)});
 }
+
+}  // namespace
 
 StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
     SunState s;
@@ -102,15 +113,10 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         }
         const MaterialConfig& mc = it->second;
         SurfaceMaterial m;
-        m.kind = mc.kind;
         m.name = rec.name;
-        m.reflectance = ToSpectrum(mc.reflectance);
-        m.eta = ToSpectrum(mc.eta);
-        m.k = ToSpectrum(mc.k);
-        m.transmittance = ToSpectrum(mc.transmittance);
-        m.roughness = mc.roughness;
+        NAVE_ASSIGN_OR_RETURN(m.material, ToMaterial(mc, it->first));
+        m.black = mc.builtin.empty() && mc.kind == MaterialConfig::Kind::kBlack;
         m.portal = mc.portal;
-        m.dispersive = mc.kind == MaterialConfig::Kind::kDielectric && !m.eta.IsConstant();
         if (mc.emission) {
             m.emissive = true;
             m.emission = ToSpectrum(*mc.emission);
@@ -167,6 +173,11 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
     if (config.sky.kind == SkyConfig::Kind::kUniform) {
         scene.sky = true;
         scene.sky_radiance = ToSpectrum(config.sky.radiance);
+    } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
+        scene.sky = true;
+        double turbidity = std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
+        scene.preetham = std::make_shared<PreethamSky>(scene.lights[size_t(scene.sun)].to_light, float(turbidity));
+        scene.sky_scale = config.sky.scale;
     }
     return scene;
 }

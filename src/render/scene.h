@@ -14,25 +14,33 @@
 #include "render/brick_source.h"
 #include "render/camera.h"
 #include "render/materials/bxdf.h"
+#include "render/materials/materials.h"
 #include "render/scene_config.h"
+#include "render/sun/sky.h"
 
 namespace nave::render {
 
-/// A spectral material as the integrators use it. Builds a Bsdf per hit for the path's wavelengths.
+/// A spectral material as the integrators use it: the physics engineer's Material (render/materials/
+/// materials.h) plus what the scene adds: emission, the portal flag, and black (absorbs everything).
 struct SurfaceMaterial {
-    MaterialConfig::Kind kind = MaterialConfig::Kind::kDiffuse;
     std::string name;
-    Spectrum reflectance, eta, k, transmittance;
-    float roughness = 0;
+    Material material;           ///< physics: diffuse, conductor, dielectric, thin glass
+    bool black = false;          ///< no scattering at all
     bool emissive = false;
     Spectrum emission;           ///< radiance, W m^-2 sr^-1 nm^-1, both sides
-    bool portal = false;         ///< photons are aimed at it
-    bool dispersive = false;     ///< eta varies with wavelength: refraction keeps the hero wavelength only
+    bool portal = false;         ///< photons are aimed at it (render.photon_target = "portals")
 
     /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the secondary
     /// wavelengths of `lambda`.
-    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const;
-    /// Diffuse albedo at 550 nm, for the albedo AOV.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
+        if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
+        return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
+    }
+    /// The window pane, if this is thin glass (rays cross it without bending).
+    const ThinGlassMaterial* thin_glass() const {
+        return black ? nullptr : std::get_if<ThinGlassMaterial>(&material);
+    }
+    /// Diffuse albedo at 550 nm for the albedo AOV (1 for specular materials, 0 for black).
     float AlbedoForAov() const;
 };
 
@@ -56,7 +64,14 @@ struct RenderScene {
     std::vector<Light> lights;
     int sun = -1;                            ///< index of the sun in `lights`, or -1
     bool sky = false;
-    Spectrum sky_radiance;
+    Spectrum sky_radiance;                   ///< uniform sky
+    std::shared_ptr<const PreethamSky> preetham;  ///< physical sky (physics: render/sun/sky.h), or null
+    float sky_scale = 1;
+    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths.
+    SampledSpectrum SkyRadiance(const Vec3f& w, const SampledWavelengths& lambda) const {
+        if (preetham) return preetham->Radiance(w, lambda) * sky_scale;
+        return sky_radiance.Sample(lambda);
+    }
     RenderSettings settings;
     OutputConfig output;
     std::string sun_description;             ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary

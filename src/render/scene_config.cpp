@@ -331,10 +331,18 @@ Status ParseSky(TableReader& r, SkyConfig* s) {
         s->kind = SkyConfig::Kind::kUniform;
         s->radiance = SpectrumSpec::Constant(1.f);
         NAVE_RETURN_IF_ERROR(r.Spectrum("radiance", &s->radiance));
+    } else if (type == "preetham") {
+        s->kind = SkyConfig::Kind::kPreetham;
+        double t = 0;
+        if (r.Has("turbidity")) {
+            NAVE_RETURN_IF_ERROR(r.Double("turbidity", &t, 1.7, 10));
+            s->turbidity = t;
+        }
+        NAVE_RETURN_IF_ERROR(r.Float("scale", &s->scale, 0, 1e9));
     } else if (type == "none") {
         s->kind = SkyConfig::Kind::kNone;
     } else {
-        return r.RangeError("type", *tn, fmt::format("'{}' is not a sky type (expected uniform or none)", type));
+        return r.RangeError("type", *tn, fmt::format("'{}' is not a sky type (expected uniform, preetham or none)", type));
     }
     return r.Finish();
 }
@@ -374,6 +382,16 @@ Status ParseLight(TableReader& r, LightConfig* l) {
 
 Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     m->where = r.WhereTable();
+    if (r.Has("builtin")) {
+        // A named material of nave's physics library (limestone, glass_blue, gold, bk7...).
+        if (r.Has("type")) {
+            return InvalidArgumentError("{}: {}: give either 'builtin' or 'type', not both", m->where, r.Name(""));
+        }
+        NAVE_RETURN_IF_ERROR(r.String("builtin", &m->builtin));
+        NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
+        NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
+        return r.Finish();
+    }
     std::string type = "diffuse";
     const toml::node* tn = r.Take("type");
     if (tn != nullptr) {
@@ -393,8 +411,15 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     } else if (type == "dielectric" || type == "thin_dielectric") {
         m->kind = type == "dielectric" ? MaterialConfig::Kind::kDielectric : MaterialConfig::Kind::kThinDielectric;
         NAVE_RETURN_IF_ERROR(r.Spectrum("eta", &m->eta));
-        NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
+        if (m->kind == MaterialConfig::Kind::kThinDielectric) {
+            if (r.Has("transmittance") && r.Has("total_transmittance")) {
+                return InvalidArgumentError("{}: {}: give either transmittance (internal) or total_transmittance",
+                                            m->where, r.Name(""));
+            }
+            NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
+            NAVE_ASSIGN_OR_RETURN(m->total_transmittance, r.OptionalSpectrum("total_transmittance"));
+        }
     } else if (type == "black") {
         m->kind = MaterialConfig::Kind::kBlack;
     } else {
@@ -541,6 +566,9 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
     if (render != nullptr) {
         TableReader t(*render, "render", name);
         NAVE_RETURN_IF_ERROR(ParseRender(t, &config.render));
+    }
+    if (config.sky.kind == SkyConfig::Kind::kPreetham && !config.sun.enabled) {
+        return InvalidArgumentError("{}: sky.type = \"preetham\" needs an enabled [sun] (the sky follows it)", name);
     }
     NAVE_ASSIGN_OR_RETURN(const toml::table* output, r.Table("output"));
     if (output != nullptr) {

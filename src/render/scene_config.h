@@ -62,9 +62,11 @@ struct SunConfig {
 };
 
 struct SkyConfig {
-    enum class Kind { kNone, kUniform };
+    enum class Kind { kNone, kUniform, kPreetham };
     Kind kind = Kind::kNone;
     SpectrumSpec radiance;           ///< kUniform: radiance of every direction above and below
+    std::optional<double> turbidity; ///< kPreetham: default the sun's turbidity
+    float scale = 1.f;               ///< kPreetham: multiplies the model's radiance
 };
 
 struct LightConfig {
@@ -83,7 +85,9 @@ struct MaterialConfig {
     SpectrumSpec reflectance = SpectrumSpec::Constant(0.5f);   ///< diffuse albedo
     SpectrumSpec eta = SpectrumSpec::Constant(1.5f);           ///< dielectric index, conductor eta
     SpectrumSpec k = SpectrumSpec::Constant(0.f);              ///< conductor absorption
-    SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< tint of thin glass per pass
+    SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< internal transmittance of thin glass per pass
+    std::optional<SpectrumSpec> total_transmittance;           ///< measured total transmittance of a pane
+    std::string builtin;             ///< a named material of the physics library (BuiltinMaterial)
     float roughness = 0.f;
     std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface
     bool portal = false;             ///< with render.photon_target = "portals", sun photons aim at it

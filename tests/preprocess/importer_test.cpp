@@ -1,18 +1,22 @@
-// Importers on small hand-made fixtures (tests/fixtures/models/make_fixtures.py writes them): every odd case
-// of each format, the triangles they yield, and the errors and warnings bad input gives.
+// Importers on small hand-made fixtures (tests/fixtures/models/make_fixtures.py writes them): every
+// odd case of each format, the triangles they yield, and the errors and warnings bad input gives.
+
+#include "preprocess/import/importer.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "preprocess/import/importer.h"
+#include <random>
+
+#include "core/file.h"
 #include "preprocess/import/triangle_check.h"
 #include "test_util.h"
 
 namespace nave::preprocess {
 namespace {
 
-using ::testing::HasSubstr;
 using testing::Fixture;
+using ::testing::HasSubstr;
 using testing::ReadError;
 using testing::ReadModel;
 
@@ -51,7 +55,22 @@ TEST(ObjImporter, CrlfQuadsNgonsNegativeIndicesAndMaterials) {
     EXPECT_EQ(tris[5].p[2], Vec3f(3, 1, 1));
     for (const auto& t : tris) EXPECT_GT(Normal(t).z, 0.99);  // counter-clockwise seen from +z
     EXPECT_EQ(source->warnings().Count("missing textures (material kept, colour used)"), 1u);
-    EXPECT_EQ(source->warnings().Count("materials used but defined in no MTL (default colour used)"), 1u);
+    EXPECT_EQ(
+        source->warnings().Count("materials used but defined in no MTL (default colour used)"), 1u);
+}
+
+TEST(ObjImporter, ConcavePolygonsAreEarClipped) {
+    auto tris = ReadModel(Fixture("l_shape.obj"));
+    ASSERT_EQ(tris.size(), 4u);
+    double area = 0;
+    for (const auto& t : tris) {
+        area += Area(t);
+        EXPECT_GT(Normal(t).z, 0.99);  // winding kept
+        // Every triangle inside the L: its centroid is not in the missing square [1, 2] x [1, 2].
+        Vec3f c = (t.p[0] + t.p[1] + t.p[2]) * (1.f / 3);
+        EXPECT_FALSE(c.x > 1 && c.y > 1) << "triangle outside the polygon";
+    }
+    EXPECT_NEAR(area, 3.0, 1e-6);  // a fan from corner (2, 1) would give 4
 }
 
 TEST(ObjImporter, MissingMtlIsOneWarningAndADefaultMaterial) {
@@ -64,9 +83,12 @@ TEST(ObjImporter, MissingMtlIsOneWarningAndADefaultMaterial) {
 }
 
 TEST(ObjImporter, BadIndicesNameFileAndLine) {
-    EXPECT_THAT(ReadError(Fixture("bad_index.obj")), HasSubstr("bad_index.obj:5: face vertex index 4 out of range"));
-    EXPECT_THAT(ReadError(Fixture("zero_index.obj")), HasSubstr("zero_index.obj:4: face vertex index 0"));
-    EXPECT_THAT(ReadError(Fixture("malformed.obj")), HasSubstr("malformed.obj:2: 'v' expects 3 numbers, found 'zero'"));
+    EXPECT_THAT(ReadError(Fixture("bad_index.obj")),
+                HasSubstr("bad_index.obj:5: face vertex index 4 out of range"));
+    EXPECT_THAT(ReadError(Fixture("zero_index.obj")),
+                HasSubstr("zero_index.obj:4: face vertex index 0"));
+    EXPECT_THAT(ReadError(Fixture("malformed.obj")),
+                HasSubstr("malformed.obj:2: 'v' expects 3 numbers, found 'zero'"));
 }
 
 TEST(ObjImporter, NanAndDegenerateFacesAreCountedWarnings) {
@@ -104,8 +126,8 @@ TEST(PlyImporter, AsciiWithExtraPropertiesAndQuads) {
 TEST(PlyImporter, BigEndianTriangleStripsWithRestarts) {
     auto tris = ReadModel(Fixture("strips_big.ply"));
     ASSERT_EQ(tris.size(), 4u);
-    // Run 0 1 2 3: (0 1 2), then (1 2 3) flipped to (2 1 3) to keep the winding; run 2 3 4 5 5 after the
-    // restart: (2 3 4), (4 3 5), and (4 5 5) dropped.
+    // Run 0 1 2 3: (0 1 2), then (1 2 3) flipped to (2 1 3) to keep the winding; run 2 3 4 5 5
+    // after the restart: (2 3 4), (4 3 5), and (4 5 5) dropped.
     EXPECT_EQ(tris[0].p[0], Vec3f(0, 0, 0));
     EXPECT_EQ(tris[1].p[0], Vec3f(0, 1, 0));
     EXPECT_EQ(tris[1].p[1], Vec3f(1, 0, 0));
@@ -123,11 +145,14 @@ TEST(PlyImporter, LittleEndianFaces) {
 }
 
 TEST(PlyImporter, ErrorsNameFileAndPlace) {
-    EXPECT_THAT(ReadError(Fixture("bad_index.ply")), HasSubstr("bad_index.ply:13: face 0 vertex index 9 out of range [0, 3)"));
+    EXPECT_THAT(ReadError(Fixture("bad_index.ply")),
+                HasSubstr("bad_index.ply:13: face 0 vertex index 9 out of range [0, 3)"));
     EXPECT_THAT(ReadError(Fixture("truncated.ply")), HasSubstr("truncated.ply @"));
     EXPECT_THAT(ReadError(Fixture("truncated.ply")), HasSubstr("truncated"));
-    EXPECT_THAT(ReadError(Fixture("garbage.obj").replace_filename("strips_big.ply").replace_extension(".ply")),
-                ::testing::IsEmpty());
+    EXPECT_THAT(
+        ReadError(
+            Fixture("garbage.obj").replace_filename("strips_big.ply").replace_extension(".ply")),
+        ::testing::IsEmpty());
 }
 
 TEST(StlImporter, BinaryStartingWithSolidIsReadAsBinary) {
@@ -168,18 +193,80 @@ TEST(GltfImporter, NodeTransformsAndMaterials) {
     EXPECT_EQ(source->units(), "m");
 }
 
+TEST(GltfImporter, BinaryGlbGivesTheSameTriangle) {
+    auto text = ReadModel(Fixture("node_transform.gltf"));
+    auto binary = ReadModel(Fixture("node_transform.glb"));
+    ASSERT_EQ(binary.size(), 1u);
+    EXPECT_EQ(binary[0].p, text[0].p);
+}
+
+TEST(AssimpImporter, OtherFormatsThroughAssimp) {
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(Fixture("square.off"), &source);
+    ASSERT_EQ(tris.size(), 2u);  // the quad, triangulated
+    EXPECT_NEAR(Area(tris[0]) + Area(tris[1]), 1.0, 1e-6);
+    EXPECT_EQ(source->units(), "unknown");
+}
+
 TEST(MergedInputs, MaterialNamesAreMadeUnique) {
-    auto source = OpenModels({Fixture("shapes_crlf.obj"), Fixture("shapes_crlf.obj"), Fixture("ascii.stl")});
+    auto source =
+        OpenModels({Fixture("shapes_crlf.obj"), Fixture("shapes_crlf.obj"), Fixture("ascii.stl")});
     ASSERT_TRUE(source.ok()) << source.status().ToString();
     auto tris = ReadAll(**source);
     ASSERT_TRUE(tris.ok());
     EXPECT_EQ(tris->size(), 6u + 6u + 3u);
     std::vector<std::string> names;
     for (const auto& m : (*source)->materials()) names.push_back(m.name);
-    EXPECT_THAT(names, ::testing::UnorderedElementsAre("red", "blue", "undefined_in_mtl", "red.1", "blue.1",
-                                                       "undefined_in_mtl.1", "default"));
+    EXPECT_THAT(names, ::testing::UnorderedElementsAre("red", "blue", "undefined_in_mtl", "red.1",
+                                                       "blue.1", "undefined_in_mtl.1", "default"));
     EXPECT_EQ((*source)->materials()[(*tris)[6].material].name, "red.1");
     EXPECT_EQ((*source)->warnings().Count("missing textures (material kept, colour used)"), 2u);
+}
+
+}  // namespace
+}  // namespace nave::preprocess
+
+namespace nave::preprocess {
+namespace {
+
+// Garbage and every truncation of valid files: each read ends in an error or a model, never a
+// crash.
+TEST(ImporterRobustness, GarbageAndTruncationsNeverCrash) {
+    auto dir = testing::MakeTempDir("garbage");
+    std::mt19937 rng(99);
+    int errors = 0;
+    for (const char* ext : {".obj", ".ply", ".stl", ".gltf", ".glb"}) {
+        for (int i = 0; i < 12; ++i) {
+            std::string bytes(size_t(rng() % 600), '\0');
+            for (char& c : bytes) c = char(rng());
+            if (i % 4 == 1)
+                bytes =
+                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n" +
+                    bytes;
+            if (i % 4 == 2) bytes = "solid x\n" + bytes;
+            if (i % 4 == 3) bytes = "v 1 2 3\nf 1 1 1\n" + bytes;
+            auto path = dir / (std::to_string(i) + ext);
+            std::FILE* f = std::fopen(path.c_str(), "wb");
+            std::fwrite(bytes.data(), 1, bytes.size(), f);
+            std::fclose(f);
+            if (!ReadError(path).empty()) ++errors;
+        }
+    }
+    EXPECT_GT(errors, 50);  // nearly all garbage is refused with a message
+    for (const char* name : {"faces_little.ply", "strips_big.ply", "solid_binary.stl",
+                             "shapes_crlf.obj", "tetra_ascii.ply", "node_transform.glb"}) {
+        auto bytes = ReadFileToString(Fixture(name));
+        ASSERT_TRUE(bytes.ok());
+        std::string ext = std::filesystem::path(name).extension().string();
+        for (size_t cut = 0; cut < bytes->size(); cut += (cut + 16 < bytes->size() ? 5 : 1)) {
+            auto path = dir / ("cut" + ext);
+            std::FILE* f = std::fopen(path.c_str(), "wb");
+            std::fwrite(bytes->data(), 1, cut, f);
+            std::fclose(f);
+            (void)ReadError(path);  // must return, whatever it says
+        }
+    }
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

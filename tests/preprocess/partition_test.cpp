@@ -1,5 +1,6 @@
-// The partition and the store it writes: the exact triangle/box test, bins round trip, and stores built from
-// closed meshes hold exactly the input's triangles (duplicates aside) and let no ray through between bricks.
+// The partition and the store it writes: the exact triangle/box test, bins round trip, and stores
+// built from closed meshes hold exactly the input's triangles (duplicates aside) and let no ray
+// through between bricks.
 
 #include <embree3/rtcore.h>
 #include <gmock/gmock.h>
@@ -23,16 +24,22 @@ using ::testing::HasSubstr;
 TEST(TriangleBox, SeparatingAxes) {
     Bounds3d box(Vec3d(0, 0, 0), Vec3d(1, 1, 1));
     // Inside, outside on one axis, and touching a face.
-    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(0.2f, 0.2f, 0.5f), Vec3f(0.8f, 0.2f, 0.5f), Vec3f(0.5f, 0.8f, 0.5f)}, box));
+    EXPECT_TRUE(TriangleOverlapsBox(
+        {Vec3f(0.2f, 0.2f, 0.5f), Vec3f(0.8f, 0.2f, 0.5f), Vec3f(0.5f, 0.8f, 0.5f)}, box));
     EXPECT_FALSE(TriangleOverlapsBox({Vec3f(2, 0, 0), Vec3f(3, 0, 0), Vec3f(2, 1, 0)}, box));
     EXPECT_TRUE(TriangleOverlapsBox({Vec3f(1, 0, 0), Vec3f(2, 0, 0), Vec3f(1, 1, 0)}, box));
     // A big triangle through the box with no vertex inside it.
-    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(-10, -10, 0.5f), Vec3f(10, -10, 0.5f), Vec3f(0, 10, 0.5f)}, box));
-    // Its bounding box overlaps the box but the triangle passes by a corner: only an edge axis separates.
-    EXPECT_FALSE(TriangleOverlapsBox({Vec3f(0.9f, 1.6f, 0.5f), Vec3f(1.6f, 0.9f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
-    EXPECT_TRUE(TriangleOverlapsBox({Vec3f(0.3f, 1.6f, 0.5f), Vec3f(1.6f, 0.3f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
+    EXPECT_TRUE(TriangleOverlapsBox(
+        {Vec3f(-10, -10, 0.5f), Vec3f(10, -10, 0.5f), Vec3f(0, 10, 0.5f)}, box));
+    // Its bounding box overlaps the box but the triangle passes by a corner: only an edge axis
+    // separates.
+    EXPECT_FALSE(TriangleOverlapsBox(
+        {Vec3f(0.9f, 1.6f, 0.5f), Vec3f(1.6f, 0.9f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
+    EXPECT_TRUE(TriangleOverlapsBox(
+        {Vec3f(0.3f, 1.6f, 0.5f), Vec3f(1.6f, 0.3f, 0.5f), Vec3f(1.6f, 1.6f, 0.5f)}, box));
     // A tilted plane crossing the box's bounding region but missing the box (plane axis separates).
-    EXPECT_FALSE(TriangleOverlapsBox({Vec3f(-5, -5, 3.5f), Vec3f(5, -5, 13.5f), Vec3f(-5, 5, 3.5f)}, box));
+    EXPECT_FALSE(
+        TriangleOverlapsBox({Vec3f(-5, -5, 3.5f), Vec3f(5, -5, 13.5f), Vec3f(-5, 5, 3.5f)}, box));
 }
 
 TEST(BinFile, RoundTripWithAndWithoutAttributes) {
@@ -80,16 +87,17 @@ TEST(BinFile, RoundTripWithAndWithoutAttributes) {
     std::filesystem::remove_all(dir);
 }
 
-// A closed icosphere of radius `r` subdivided `levels` times (20 * 4^levels triangles), outward winding,
-// written as OBJ.
+// A closed icosphere of radius `r` subdivided `levels` times (20 * 4^levels triangles), outward
+// winding, written as OBJ.
 void WriteIcosphere(const std::filesystem::path& path, int levels, double r) {
     const double t = (1 + std::sqrt(5.0)) / 2;
-    std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                            {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                            {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<std::array<int, 3>> f = {
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     for (auto& p : v) p = Normalize(p);
     for (int l = 0; l < levels; ++l) {
         std::map<std::pair<int, int>, int> mid;
@@ -108,7 +116,8 @@ void WriteIcosphere(const std::filesystem::path& path, int levels, double r) {
         f = std::move(next);
     }
     std::FILE* out = std::fopen(path.c_str(), "w");
-    for (auto& p : v) std::fprintf(out, "v %.9g %.9g %.9g\n", p.x * r + 3, p.y * r - 2, p.z * r + 1);
+    for (auto& p : v)
+        std::fprintf(out, "v %.9g %.9g %.9g\n", p.x * r + 3, p.y * r - 2, p.z * r + 1);
     for (auto [a, b, c] : f) std::fprintf(out, "f %d %d %d\n", a + 1, b + 1, c + 1);
     std::fclose(out);
 }
@@ -167,7 +176,8 @@ std::set<QTri, QTriLess> StoreTriangles(const store::Store& s, uint64_t* referen
         if (!mesh.ok()) continue;
         for (size_t t = 0; t < mesh->TriangleCount(); ++t) {
             QTri q;
-            for (int j = 0; j < 3; ++j) q[j] = s.header().grid.Quantize(mesh->positions[mesh->indices[3 * t + j]]);
+            for (int j = 0; j < 3; ++j)
+                q[j] = s.header().grid.Quantize(mesh->positions[mesh->indices[3 * t + j]]);
             all.insert(Canonical(q));
             ++*references;
         }
@@ -183,7 +193,9 @@ TEST_F(PartitionedSphere, ManyBricksHoldExactlyTheInputTriangles) {
     const auto& grid = (*store)->header().grid;
     auto input = testing::ReadModel(dir_ / "sphere.obj");
     std::set<QTri, QTriLess> expected;
-    for (const auto& t : input) expected.insert(Canonical({grid.Quantize(t.p[0]), grid.Quantize(t.p[1]), grid.Quantize(t.p[2])}));
+    for (const auto& t : input)
+        expected.insert(
+            Canonical({grid.Quantize(t.p[0]), grid.Quantize(t.p[1]), grid.Quantize(t.p[2])}));
     uint64_t refs = 0;
     auto got = StoreTriangles(**store, &refs);
     EXPECT_EQ(got.size(), expected.size());
@@ -210,8 +222,9 @@ TEST_F(PartitionedSphere, SmallBudgetAndOneThreadGiveTheSameTriangles) {
     EXPECT_EQ(a.source_triangles, b.source_triangles);
 }
 
-// Rays from inside the closed sphere, walked brick by brick front to back as the renderer does: each brick
-// intersected only within its own cell's [t_enter, t_exit]. A crack between bricks lets a ray escape.
+// Rays from inside the closed sphere, walked brick by brick front to back as the renderer does:
+// each brick intersected only within its own cell's [t_enter, t_exit]. A crack between bricks lets
+// a ray escape.
 TEST_F(PartitionedSphere, NoRayEscapesBetweenBricks) {
     Run(dir_ / "w.nave", 0, 2);
     auto store = store::Store::Open(dir_ / "w.nave");
@@ -226,15 +239,17 @@ TEST_F(PartitionedSphere, NoRayEscapesBetweenBricks) {
         ASSERT_TRUE(mesh.ok());
         RTCScene scene = rtcNewScene(device);
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                               3 * sizeof(float), mesh->VertexCount()));
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                               mesh->VertexCount()));
         for (size_t i = 0; i < mesh->VertexCount(); ++i) {
             vb[3 * i] = mesh->positions[i].x;
             vb[3 * i + 1] = mesh->positions[i].y;
             vb[3 * i + 2] = mesh->positions[i].z;
         }
-        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                  3 * sizeof(unsigned), mesh->TriangleCount()));
+        auto* ib = static_cast<unsigned*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(unsigned), mesh->TriangleCount()));
         std::copy(mesh->indices.begin(), mesh->indices.end(), ib);
         rtcCommitGeometry(g);
         rtcAttachGeometry(scene, g);

@@ -1,5 +1,5 @@
-// The importers on the real models of ../shared/data/models: triangle counts must equal the table in its
-// README.md. Skipped (with a message) where that directory is absent.
+// The importers on the real models of ../shared/data/models: triangle counts must equal the table
+// in its README.md. Skipped (with a message) where that directory is absent.
 
 #include <gtest/gtest.h>
 
@@ -14,11 +14,13 @@ std::filesystem::path Shared(const std::string& rel) {
 
 void ExpectCount(const std::string& rel, size_t expected) {
     auto path = Shared(rel);
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " absent (NAVE_SHARED_DATA): skipping";
+    if (!std::filesystem::exists(path))
+        GTEST_SKIP() << path << " absent (NAVE_SHARED_DATA): skipping";
     std::unique_ptr<TriangleSource> source;
     auto tris = testing::ReadModel(path, &source);
     EXPECT_EQ(tris.size(), expected) << rel;
-    for (const auto& w : source->warnings().Summary()) std::printf("  %s: %s\n", rel.c_str(), w.c_str());
+    for (const auto& w : source->warnings().Summary())
+        std::printf("  %s: %s\n", rel.c_str(), w.c_str());
 }
 
 TEST(SharedModels, Bunny) { ExpectCount("scans/bun_zipper.ply", 69451); }
@@ -34,19 +36,22 @@ TEST(SharedModels, Helmet) { ExpectCount("gltf-helmet/DamagedHelmet.gltf", 15452
 namespace nave::preprocess {
 namespace {
 
-// Counts from README.md ("285 to 3,732") and, per file, from the file itself read independently of the
-// importer: a binary STL's header count, an ASCII STL's number of "facet normal" lines.
+// Counts from README.md ("285 to 3,732") and, per file, from the file itself read independently of
+// the importer: a binary STL's header count, an ASCII STL's number of "facet normal" lines.
 TEST(SharedModels, StlFiles) {
     struct Case {
         const char* file;
         size_t facets;
     };
-    const Case cases[] = {{"stl/3DSMaxExport.STL", 2000}, {"stl/Spider_ascii.stl", 1368},
-                          {"stl/Spider_binary.stl", 1368}, {"stl/Wuson.stl", 3732},
+    const Case cases[] = {{"stl/3DSMaxExport.STL", 2000},
+                          {"stl/Spider_ascii.stl", 1368},
+                          {"stl/Spider_binary.stl", 1368},
+                          {"stl/Wuson.stl", 3732},
                           {"stl/sphereWithHole.stl", 285}};
     for (const Case& c : cases) {
         auto path = Shared(c.file);
-        if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " absent (NAVE_SHARED_DATA): skipping";
+        if (!std::filesystem::exists(path))
+            GTEST_SKIP() << path << " absent (NAVE_SHARED_DATA): skipping";
         std::unique_ptr<TriangleSource> source;
         auto tris = testing::ReadModel(path, &source);
         EXPECT_EQ(tris.size() + source->warnings().Total(), c.facets) << c.file;

@@ -1,14 +1,14 @@
 #include "test_util.h"
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "preprocess/import/importer.h"
 
 namespace nave::preprocess::testing {
 
-std::vector<Triangle> ReadModel(const std::filesystem::path& path, std::unique_ptr<TriangleSource>* keep) {
+std::vector<Triangle> ReadModel(const std::filesystem::path& path,
+                                std::unique_ptr<TriangleSource>* keep) {
     auto source = OpenModel(path);
     EXPECT_TRUE(source.ok()) << source.status().ToString();
     if (!source.ok()) return {};
@@ -27,8 +27,9 @@ std::string ReadError(const std::filesystem::path& path) {
 
 std::filesystem::path MakeTempDir(const std::string& tag) {
     static int counter = 0;
-    auto dir = std::filesystem::temp_directory_path() /
-               ("nave_test_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    auto dir =
+        std::filesystem::temp_directory_path() /
+        ("nave_test_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

@@ -14,7 +14,8 @@ inline std::filesystem::path Fixture(const std::string& name) {
 }
 
 /// Opens `path` with OpenModel and reads every triangle; fails the test on error.
-std::vector<Triangle> ReadModel(const std::filesystem::path& path, std::unique_ptr<TriangleSource>* keep = nullptr);
+std::vector<Triangle> ReadModel(const std::filesystem::path& path,
+                                std::unique_ptr<TriangleSource>* keep = nullptr);
 
 /// The error message of opening and reading `path` completely ("" if it succeeded).
 std::string ReadError(const std::filesystem::path& path);

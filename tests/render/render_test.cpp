@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/color.h"
+#include "render/sun/sky.h"
 #include "core/progress.h"
 #include "render/procedural_meshes.h"
 #include "render_test_util.h"
@@ -89,6 +90,77 @@ spp = 4
         // weighting of a flat spectrum, which is exact.
         EXPECT_NEAR(MeanY(*t->film), expected, 0.01 * expected) << "elevation " << elevation_deg;
     }
+}
+
+// A diffuse plane under a uniform sky of radiance L: E = pi L from the open hemisphere, so the reflected
+// radiance is R L (Lambert). Both modes (next-event estimation of the sky, weighted against BSDF sampling).
+TEST_F(RenderTest, UniformSkyOnDiffusePlane) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
+    for (const char* mode : {"path", "photon"}) {
+        std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 5]
+look_at = [0.01, 0, 0]
+fov_deg = 20
+resolution = [8, 8]
+[sky]
+radiance = 2.0
+[materials.plane]
+reflectance = 0.6
+[render]
+mode = "{}"
+spp = 64
+iterations = 64
+photons_per_iteration = 1000
+)", mode);
+        auto t = Render(m, {"plane"}, config, 1);
+        ASSERT_TRUE(t);
+        // The 50 m plane seen from 5 m hides a little sky near the horizon from nothing: exact up to noise.
+        EXPECT_NEAR(MeanY(*t->film), 0.6 * 2.0, 0.02 * 1.2) << mode;
+    }
+}
+
+// The Preetham sky (physics) on a diffuse plane: L = R/pi * integral of L_sky cos over the hemisphere,
+// integrated here by a midpoint rule in (cos theta, phi) on the sky's own spectra.
+TEST_F(RenderTest, PreethamSkyOnDiffusePlane) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {500, 0, 0}, {0, 500, 0}, 4, 0);
+    const Vec3f to_sun = Normalize(Vec3f(0.5f, 0.2f, 0.6f));
+    PreethamSky sky(to_sun, 3.0f);
+    double integral = 0;
+    const int nu = 48, nphi = 96;
+    for (int i = 0; i < nu; ++i) {
+        double mu = (i + 0.5) / nu;  // cos theta
+        for (int j = 0; j < nphi; ++j) {
+            double phi = 2 * 3.14159265358979 * (j + 0.5) / nphi;
+            double st = std::sqrt(1 - mu * mu);
+            Vec3f w(float(st * std::cos(phi)), float(st * std::sin(phi)), float(mu));
+            integral += SpectrumToXYZ(sky.RadianceSpectrum(w)).y * mu;
+        }
+    }
+    integral *= (1.0 / nu) * (2 * 3.14159265358979 / nphi);
+    const double expected = 0.6 / 3.14159265358979 * integral;
+    std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 5]
+look_at = [0.01, 0, 0]
+fov_deg = 20
+resolution = [8, 8]
+[sun]
+direction = [{}, {}, {}]
+scale = 0
+turbidity = 3
+[sky]
+type = "preetham"
+[materials.plane]
+reflectance = 0.6
+[render]
+spp = 256
+)", to_sun.x, to_sun.y, to_sun.z);
+    auto t = Render(m, {"plane"}, config, 1);
+    ASSERT_TRUE(t);
+    EXPECT_NEAR(MeanY(*t->film), expected, 0.03 * expected);
 }
 
 // The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
