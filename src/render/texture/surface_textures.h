@@ -12,13 +12,15 @@
 
 #include "core/spectrum.h"
 #include "core/status.h"
+#include "render/scene.h"
 #include "render/texture/texture_cache.h"
 #include "store/material_record.h"
 
 namespace nave::render {
 
-/// Textures of one material. Immutable after construction; thread-safe.
-struct SurfaceTextures {
+/// Textures of one material. Immutable after construction; thread-safe. Attach it to a
+/// SurfaceMaterial (albedo_texture) to replace the diffuse albedo at hits with texture coordinates.
+struct SurfaceTextures : public AlbedoTexture {
     const TextureCache* cache = nullptr;
     /// Linear RGB albedo (map_Kd / baseColorTexture as converted by `nave preprocess`); replaces
     /// the diffuse albedo.
@@ -32,6 +34,12 @@ struct SurfaceTextures {
     /// and gives the neutral 0.5.
     SampledSpectrum Albedo(const std::array<float, 2>& uv, const TextureFootprint& footprint,
                            const SampledWavelengths& lambda) const;
+    /// The integrator's lookup: a point sample of the finest MIP level (the integrator tracks no
+    /// ray cones yet; pixel supersampling does the filtering).
+    SampledSpectrum Albedo(const std::array<float, 2>& uv,
+                           const SampledWavelengths& lambda) const override {
+        return Albedo(uv, TextureFootprint{}, lambda);
+    }
 };
 
 /// Opens the albedo texture named by `record` (slots "map_Kd" or "baseColorTexture") under
