@@ -97,8 +97,20 @@ WallSpec PolygonSide(Vec3d a, Vec3d b, double turn_degrees, double z0, double z1
     return w;
 }
 
-Opening Window(double center, double half_width, double sill, double spring, double rise) {
+// Windows splay 0.6 m to each face of the wall from the glass in its middle: through a 1.2 m wall
+// with straight reveals a 2.6 m lancet would take no sun more than 65 degrees off its normal (the
+// summer morning sun at Royaumont stands 69 degrees off the south walls' normal).
+constexpr double kSplay = 0.6;
+
+// The inner sill slopes down 1.8 m from the glass (a glacis): light falling at 48 degrees drops
+// that much across the inner half of the wall.
+constexpr double kGlacis = 1.8;
+
+Opening Window(double center, double half_width, double sill, double spring, double rise,
+               double splay = kSplay, double glacis = kGlacis) {
     Opening o;
+    o.splay = splay;
+    o.glacis = glacis;
     o.center = center;
     o.half_width = half_width;
     o.sill = sill;
@@ -109,7 +121,7 @@ Opening Window(double center, double half_width, double sill, double spring, dou
 }
 
 Opening Arch(double center, double half_width, double sill, double spring, double rise) {
-    Opening o = Window(center, half_width, sill, spring, rise);
+    Opening o = Window(center, half_width, sill, spring, rise, 0, 0);
     o.kind = OpeningKind::kOpen;
     return o;
 }
@@ -218,7 +230,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         WallSpec up = PolygonSide(a, b, kApseStep, kStorey, kWallTop, kUpperWallT, seed++);
         double c = w.length / 2;
         w.openings.push_back(Arch(c, 0.95, kArcadeSpring, kArcadeSpring + 1.5, 3.6));
-        up.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2));
+        up.openings.push_back(Window(c, 0.55, kVaultSpring, 23.8, 1.2, 0.35));
         add(fmt::format("hemicycle wall {}", k), [=](Emitter& em) {
             EmitWall(em, w, d);
             EmitWall(em, up, d);
@@ -276,7 +288,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         WallSpec upper = w;
         w.z1 = 12.0;
         upper.z0 = 12.0;
-        upper.openings = {Window(mid, 2.4, 13.0, 21.5, 3.6)};
+        upper.openings = {Window(mid, 2.4, 13.0, 21.5, 3.6, kSplay, 0.7)};
         upper.seed = seed++;
         add("west facade", [=](Emitter& em) {
             EmitWall(em, w, d);
@@ -339,7 +351,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
                    a1 = ChapelAngle(k) - 90 + 180.0 * (j + 1) / kSides;
             Vec3d p0 = q + Dir(a0) * kChapelRadius, p1 = q + Dir(a1) * kChapelRadius;
             WallSpec c = PolygonSide(p0, p1, 180.0 / kSides, 0, 11.0, 0.9, seed++);
-            c.openings = {Window(c.length / 2, 0.35, 3.0, 6.2, 1.0)};
+            c.openings = {Window(c.length / 2, 0.35, 3.0, 6.2, 1.0, 0.25)};
             chapel.push_back(c);
         }
         add(fmt::format("ambulatory bay {}", k), [=](Emitter& em) {
@@ -381,8 +393,11 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             Vec3d(x0, kNaveInner, 0), kVaultSpring, kVaultRise, i == 1, "choir vault");
     }
     for (double s : {-1.0, 1.0}) {
-        double mid = 0.5 * (kArcadeY + kTransept);
-        for (auto [y0, y1] : {std::pair{kArcadeY, mid}, std::pair{mid, kTransept}}) {
+        // Three bays per arm: one over the aisle's width, then two of 7 m centred on the arm's
+        // clerestory windows (|y| = 16.5, 23.5), whose lateral cells then rise round them as the
+        // nave's do; two equal bays put a transverse arch right over a window.
+        for (auto [y0, y1] : {std::pair{kArcadeY, kAisleWall}, std::pair{kAisleWall, 20.0},
+                              std::pair{20.0, kTransept}}) {
             bay(Vec3d(kCrossingX1, s * y0, 0), Vec3d(kCrossingX1, s * y1, 0),
                 Vec3d(kCrossingX0, s * y1, 0), Vec3d(kCrossingX0, s * y0, 0), kVaultSpring,
                 kVaultRise, false, "transept vault");
@@ -406,8 +421,13 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
             kArcadeSpring, kAisleRise, k == kApseBays - 1, "ambulatory vault");
     }
     add("apse vault", [=](Emitter& em) {
+        // The hemicycle's windows (0.55 m half width, apex at 25 m; 0.9 m and 25.8 m on the
+        // splayed inner face) stand above the dome's springing line: a lunette round each.
+        Lunette lunette;
+        lunette.half_width = 1.3;
+        lunette.crown = 27.2;
         EmitHalfDome(em, kApse, Vec3d(1, 0, 0), kNaveInner, kVaultSpring, kVaultRise, kApseBays - 1,
-                     d);
+                     d, lunette);
     });
 
     // Roofs: the main roof over nave and choir, the transept roof, the apse's half cone, lean-to

@@ -103,20 +103,35 @@ void EmitVaultBay(Emitter& em, const VaultBay& b, const Detail& detail) {
 }
 
 void EmitHalfDome(Emitter& em, const Vec3d& c, const Vec3d& axis, double radius, double spring,
-                  double rise, int ribs, const Detail& detail) {
+                  double rise, int ribs, const Detail& detail, const Lunette& lunette) {
     Vec3d side =
         Cross(Vec3d(0, 0, 1), axis);  // the half circle runs from -side through axis to +side
     auto plan = [&](double angle) { return side * -std::cos(angle) + axis * std::sin(angle); };
+    int sectors = ribs + 1;
     auto point = [&](double s, double angle) {
         Vec3d p = c + plan(angle) * (radius * s);
-        return Vec3d(p.x, p.y, spring + rise * PointedArch(s, kRho));
+        double z = spring + rise * PointedArch(s, kRho);
+        if (lunette.half_width > 0) {
+            // Distance across from the centre line of this point's sector, in metres.
+            double sector = kPi / sectors;
+            double off = angle - sector * (std::floor(angle / sector) + 0.5);
+            double across = radius * s * std::abs(std::sin(off));
+            double lift =
+                spring + (lunette.crown - spring) * PointedArch(across / lunette.half_width, kRho) -
+                z;
+            double fade = std::clamp((s - lunette.fade_from) / (1 - lunette.fade_from), 0.0, 1.0);
+            z += fade * std::max(0.0, lift);
+        }
+        return Vec3d(p.x, p.y, z);
     };
     Vec3d centre(c.x, c.y, spring);
     int n = detail.Seg(10);
-    int sectors = ribs + 1;
     for (int k = 0; k < sectors; ++k) {
         double a0 = kPi * k / sectors, a1 = kPi * (k + 1) / sectors;
-        auto intrados = [&](double s, double t) { return point(s, a0 + (a1 - a0) * t); };
+        // Just inside the sector, so that its edges (on the ribs) take this sector's lunette.
+        auto intrados = [&](double s, double t) {
+            return point(s, a0 + (a1 - a0) * std::clamp(t, 1e-9, 1 - 1e-9));
+        };
         ParamGrid(
             em, intrados, n, n, [&](const Vec3d& p) { return centre - p; }, kLimestone);
         auto extrados = [&](double s, double t) { return intrados(s, t) + Vec3d(0, 0, 0.3); };

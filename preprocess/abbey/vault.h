@@ -24,9 +24,20 @@ struct VaultBay {
 
 void EmitVaultBay(Emitter& em, const VaultBay& bay, const Detail& detail);
 
+/// A lunette: the web of a half-dome's sector lifted round the clerestory window in the middle of
+/// the sector's wall, as a pointed barrel running from the wall toward the centre (its crown
+/// horizontal), fading into the dome from `fade_from` (a fraction of the radius) outward, so that
+/// light from the window reaches the floor instead of the back of the web.
+struct Lunette {
+    double half_width = 0;  ///< metres, across the sector at its centre line; 0: no lunette
+    double crown = 0;       ///< height of the lunette's crown (its springing is the dome's)
+    double fade_from = 0.4;
+};
+
 /// A ribbed half-dome over the half-disc of `radius` round `center` (z = 0) facing `axis` (unit,
-/// horizontal), `ribs` radial ribs evenly spread over the half circle (ends excluded).
+/// horizontal), `ribs` radial ribs evenly spread over the half circle (ends excluded), each of the
+/// ribs + 1 sectors with `lunette` round its window.
 void EmitHalfDome(Emitter& em, const Vec3d& center, const Vec3d& axis, double radius, double spring,
-                  double rise, int ribs, const Detail& detail);
+                  double rise, int ribs, const Detail& detail, const Lunette& lunette = {});
 
 }  // namespace nave::preprocess::abbey

@@ -21,6 +21,17 @@ double Opening::HalfWidthAt(double z) const {
     return half_width * std::clamp(t, 0.0, 1.0);
 }
 
+Opening Opening::AtFace(bool inner) const {
+    Opening o = *this;
+    double scale = (half_width + splay) / half_width;
+    o.half_width *= scale;
+    o.rise *= scale;
+    o.splay = 0;
+    if (inner) o.sill -= glacis;
+    o.glacis = 0;
+    return o;
+}
+
 namespace {
 
 constexpr Vec3d kUp(0, 0, 1);
@@ -48,7 +59,8 @@ void EmitFace(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, in
         em.Quad(g.P(u0, z0, depth), g.P(u1, z0, depth), g.P(u1, z1, depth), g.P(u0, z1, depth), out,
                 w.material);
     };
-    for (const Opening& o : w.openings) {
+    for (const Opening& in_glass : w.openings) {
+        Opening o = in_glass.AtFace(depth == 0);
         double a = o.center - o.half_width, b = o.center + o.half_width;
         rect(cursor, a, w.z0, w.z1);
         rect(a, b, w.z0, o.sill);
@@ -63,21 +75,49 @@ void EmitFace(Emitter& em, const WallGeom& g, double depth, const Vec3d& out, in
     rect(cursor, w.length, w.z0, w.z1);
 }
 
+// The opening's outline (sill, jambs, arch) scaled by `k` round the centre of its springing line:
+// the outline at a depth of a splayed window.
+// Below the springing the outline is stretched so that the sill falls by `drop` (the glacis).
+Vec3d OutlinePoint(const WallGeom& g, const Opening& o, double u, double z, double k, double drop,
+                   double depth) {
+    double zk = z;
+    if (z > o.spring) {
+        zk = o.spring + (z - o.spring) * k;
+    } else if (drop > 0) {  // (a window with a glacis has its sill below its springing)
+        zk = o.spring - (o.spring - z) * (o.spring - o.sill + drop) / (o.spring - o.sill);
+    }
+    return g.P(o.center + (u - o.center) * k, zk, depth);
+}
+
+// The reveals through the thickness: straight, or for a splayed window two bands, from each face
+// (outline scaled by AtFace) to the glass plane in the middle (the opening itself).
 void EmitReveals(Emitter& em, const WallGeom& g, const Opening& o, int arch_segments) {
     const WallSpec& w = g.w;
     double a = o.center - o.half_width, b = o.center + o.half_width, t = w.thickness;
-    auto through = [&](double u0, double z0, double u1, double z1, const Vec3d& out) {
-        em.Quad(g.P(u0, z0, 0), g.P(u1, z1, 0), g.P(u1, z1, t), g.P(u0, z0, t), out, w.material);
+    double face_k = o.splay > 0 ? (o.half_width + o.splay) / o.half_width : 1.0;
+    auto band = [&](double d0, double k0, double drop0, double d1, double k1) {
+        auto through = [&](double u0, double z0, double u1, double z1, const Vec3d& out) {
+            em.Quad(OutlinePoint(g, o, u0, z0, k0, drop0, d0),
+                    OutlinePoint(g, o, u1, z1, k0, drop0, d0),
+                    OutlinePoint(g, o, u1, z1, k1, 0, d1), OutlinePoint(g, o, u0, z0, k1, 0, d1),
+                    out, w.material);
+        };
+        if (o.sill > w.z0) through(a, o.sill, b, o.sill, kUp);
+        through(a, o.sill, a, o.spring, w.along);
+        through(b, o.sill, b, o.spring, -w.along);
+        std::vector<double> xs = ArchSamples(o, arch_segments);
+        for (size_t i = 0; i + 1 < xs.size(); ++i) {
+            double z0 = o.Top(xs[i]), z1 = o.Top(xs[i + 1]);
+            Vec3d mid = g.P(0.5 * (xs[i] + xs[i + 1]), 0.5 * (z0 + z1), 0);
+            Vec3d axis = g.P(o.center, o.spring, 0);
+            through(xs[i], z0, xs[i + 1], z1, axis - mid);
+        }
     };
-    if (o.sill > w.z0) through(a, o.sill, b, o.sill, kUp);
-    through(a, o.sill, a, o.spring, w.along);
-    through(b, o.sill, b, o.spring, -w.along);
-    std::vector<double> xs = ArchSamples(o, arch_segments);
-    for (size_t i = 0; i + 1 < xs.size(); ++i) {
-        double z0 = o.Top(xs[i]), z1 = o.Top(xs[i + 1]);
-        Vec3d mid = g.P(0.5 * (xs[i] + xs[i + 1]), 0.5 * (z0 + z1), 0);
-        Vec3d axis = g.P(o.center, o.spring, 0);
-        through(xs[i], z0, xs[i + 1], z1, axis - mid);
+    if (face_k == 1.0 && o.glacis <= 0) {
+        band(0, 1, 0, t, 1);
+    } else {
+        band(0, face_k, o.glacis, t * 0.5, 1);
+        band(t, face_k, 0, t * 0.5, 1);
     }
 }
 
@@ -105,7 +145,6 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
     double dx = (b - a) / cols, dz = (apex - o.sill) / rows;
     const uint32_t palette[] = {kGlassClear, kGlassClear, kGlassClear,  kGlassBlue,  kGlassBlue,
                                 kGlassRed,   kGlassRed,   kGlassYellow, kGlassGreen, kGlassClear};
-    const double kHalfGlass = 0.003;
     for (int r = 0; r < rows; ++r) {
         double z0 = o.sill + r * dz, z1 = z0 + dz;
         for (int c = 0; c < cols; ++c) {
@@ -115,11 +154,10 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
             t0 = std::max(t0, z0);
             t1 = std::max(t1, z0);
             uint32_t m = palette[int(Hash01(seed, r, c) * 10) % 10];
-            for (double s : {-1.0, 1.0}) {
-                double d = mid + s * kHalfGlass;
-                Vec3d out = w.inward * (-s);
-                em.Quad(g.P(x0, z0, d), g.P(x1, z0, d), g.P(x1, t1, d), g.P(x0, t0, d), out, m);
-            }
+            // One sheet per pane, facing outward: the renderer's thin-pane material accounts for
+            // both faces of the glass in a single surface, so a closed slab would count them twice.
+            em.Quad(g.P(x0, z0, mid), g.P(x1, z0, mid), g.P(x1, t1, mid), g.P(x0, t0, mid),
+                    -w.inward, m);
         }
     }
     // Lead cames on every line between pieces: 12 mm wide, 20 mm deep boxes.
@@ -163,7 +201,8 @@ void EmitDoor(Emitter& em, const WallGeom& g, const Opening& o, const Detail& de
 
 bool StoneHitsOpening(const WallSpec& w, double u0, double u1, double z0, double z1) {
     const double kMargin = 0.02;
-    for (const Opening& o : w.openings) {
+    for (const Opening& in_glass : w.openings) {
+        Opening o = in_glass.AtFace(true);  // the larger outline: both faces' stones clear it
         double a = o.center - o.half_width - kMargin, b = o.center + o.half_width + kMargin;
         double top = o.spring + o.rise + kMargin;
         if (u1 > a && u0 < b && z1 > o.sill - kMargin && z0 < top) return true;
@@ -206,8 +245,8 @@ void EmitWall(Emitter& em, const WallSpec& w, const Detail& detail) {
     for (const Opening& o : w.openings) {
         EmitReveals(em, g, o, arch_segments);
         if (o.moulded) {
-            EmitMoulding(em, g, o, 0, w.inward, detail);
-            EmitMoulding(em, g, o, w.thickness, -w.inward, detail);
+            EmitMoulding(em, g, o.AtFace(true), 0, w.inward, detail);
+            EmitMoulding(em, g, o.AtFace(false), w.thickness, -w.inward, detail);
         }
         if (o.kind == OpeningKind::kWindow)
             EmitGlazing(em, g, o, detail, w.seed * 31 + uint64_t(o.center * 100));

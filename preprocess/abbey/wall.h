@@ -23,6 +23,17 @@ struct Opening {
     OpeningKind kind = OpeningKind::kOpen;
     bool moulded = true;  ///< a roll moulding round the arch on both faces
     double rho = 2.0;     ///< arch radius over half-span (2: equilateral)
+    /// Windows: how much wider (metres, each side) the opening is on both faces than in the glass
+    /// plane; the jambs and the arch splay out to the faces (a scaled copy of the arch round the
+    /// springing's centre, the sill level), so that slanting sunlight reaches the glass and, past
+    /// it, the floor through a thick wall.
+    double splay = 0;
+    /// Windows: how far (metres) the sill slopes down from the glass to the interior face (a
+    /// glacis), so that light falling steeply through the glass is not stopped by a flat sill.
+    double glacis = 0;
+    /// The opening's outline on the interior (`inner`) or exterior face of the wall: splayed and,
+    /// inside, with the foot of its glacis (the opening itself when neither applies).
+    Opening AtFace(bool inner) const;
     double Top(double u) const;
     /// Half the opening's width at height z (0 above the apex).
     double HalfWidthAt(double z) const;

@@ -9,39 +9,13 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/json_text.h"
 #include "core/memory.h"
 #include "core/progress.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {
 namespace {
-
-std::string JsonString(const std::string& s) {
-    std::string out = "\"";
-    for (const char c : s) {
-        switch (c) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\t':
-                out += "\\t";
-                break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) {
-                    out += fmt::format("\\u{:04x}", int(c));
-                } else {
-                    out += c;
-                }
-        }
-    }
-    return out + "\"";
-}
 
 std::string JsonVec(const Vec3f& v) { return fmt::format("[{}, {}, {}]", v.x, v.y, v.z); }
 std::string JsonVec(const Vec3d& v) { return fmt::format("[{}, {}, {}]", v.x, v.y, v.z); }

@@ -26,7 +26,22 @@ struct RenderOptions {
     std::optional<int> spp, iterations, threads;
     std::optional<uint64_t> seed, photons;
     std::string mode;
+    std::string resolution;  // "WxH"
 };
+
+/// Parses "960x640" into width and height.
+Status ParseResolution(const std::string& text, int* width, int* height) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
+        h <= 0 || w > 32768 || h > 32768) {
+        return InvalidArgumentError("--resolution {}: expected WIDTHxHEIGHT with each in [1, 32768], as in 960x640",
+                                    text);
+    }
+    *width = w;
+    *height = h;
+    return Status::Ok();
+}
 
 std::string ModeName(render::RenderSettings::Mode m) {
     return m == render::RenderSettings::Mode::kPath ? "path" : "photon";
@@ -41,6 +56,9 @@ Status RunRender(const RenderOptions& o) {
         return InvalidArgumentError("-o {}: the output must end in .exr (the PNG is written beside it)", o.output);
     }
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, render::LoadSceneConfig(o.config));
+    if (!o.resolution.empty()) {
+        NAVE_RETURN_IF_ERROR(ParseResolution(o.resolution, &config.camera.width, &config.camera.height));
+    }
     if (o.spp) config.render.spp = *o.spp;
     if (o.iterations) config.render.iterations = *o.iterations;
     if (o.threads) config.render.threads = *o.threads;
@@ -116,6 +134,7 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("-c,--config", opts->config, "Scene config (TOML; keys in configs/README.md)")->required();
     cmd->add_option("-o,--output", opts->output, "Output OpenEXR file; a tone-mapped PNG is written beside it")
         ->required();
+    cmd->add_option("--resolution", opts->resolution, "Override camera.resolution, as WIDTHxHEIGHT (e.g. 960x640)");
     cmd->add_option("--spp", opts->spp, "Override render.spp")->check(CLI::PositiveNumber);
     cmd->add_option("--iterations", opts->iterations, "Override render.iterations")->check(CLI::PositiveNumber);
     cmd->add_option("--photons", opts->photons, "Override render.photons_per_iteration")->check(CLI::PositiveNumber);

@@ -1,6 +1,8 @@
 // End-to-end: the `nave sun` and `nave spectrum` commands, run as the user would (NAVE_BINARY).
 
 #include <gtest/gtest.h>
+
+#include "common/run_nave.h"
 #include <sys/wait.h>
 
 #include <array>
@@ -12,23 +14,9 @@
 namespace nave {
 namespace {
 
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;  // stdout and stderr
-};
+using ::nave::test::CommandResult;
+using ::nave::test::RunNave;
 
-CommandResult RunNave(const std::string& args) {
-    CommandResult r;
-    std::string cmd = std::string(NAVE_BINARY) + " " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-    int status = pclose(p);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 // The SPA paper's example (Reda & Andreas 2004, Table A5.1): zenith 50.11162°, azimuth 194.34024°.
 TEST(CliSunTest, ReferenceExampleEndToEnd) {

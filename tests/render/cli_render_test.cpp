@@ -1,6 +1,8 @@
 // End-to-end: `nave render` as the user runs it (NAVE_BINARY): outputs, metadata, error messages, exit codes.
 
 #include <gtest/gtest.h>
+
+#include "common/run_nave.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,23 +18,9 @@
 namespace nave::render {
 namespace {
 
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;  // stdout and stderr
-};
+using ::nave::test::CommandResult;
+using ::nave::test::RunNave;
 
-CommandResult RunNave(const std::string& args) {
-    CommandResult r;
-    std::string cmd = std::string(NAVE_BINARY) + " " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-    int status = pclose(p);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 class CliRenderTest : public ::testing::Test {
   protected:

@@ -2,6 +2,8 @@
 // damaged copy.
 
 #include <gtest/gtest.h>
+
+#include "common/run_nave.h"
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -16,25 +18,14 @@ namespace nave::store {
 namespace {
 
 using test::ScratchDir;
+using ::nave::test::CommandResult;
+using ::nave::test::Streams;
 
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;  // stdout, or stdout + stderr
-};
-
+/// Stdout only unless `with_stderr` (JSON output is parsed from stdout alone).
 CommandResult RunNave(const std::string& args, bool with_stderr = false) {
-    const std::string command =
-        std::string(NAVE_BINARY) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
-    CommandResult run;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    NAVE_CHECK(pipe != nullptr) << command;
-    char buffer[4096];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
-    const int status = ::pclose(pipe);
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return run;
+    return ::nave::test::RunNave(args, with_stderr ? Streams::kStdoutAndStderr : Streams::kStdoutOnly);
 }
+
 
 class NaveCli : public ::testing::Test {
   protected:
