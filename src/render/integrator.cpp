@@ -60,6 +60,8 @@ using Outbox = std::vector<std::pair<uint32_t, RayRecord>>;
 /// The geometry of a hit, from the brick's mesh.
 struct SurfaceHit {
     Vec3f p, ng, ns;
+    std::array<float, 2> uv{};  ///< [texture] interpolated texture coordinates, when has_uv
+    bool has_uv = false;
     const SurfaceMaterial* material = nullptr;
 };
 
@@ -174,6 +176,10 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
         float len = Length(n);
         if (len > 0) h.ns = n / len;
         if (Dot(h.ns, h.ng) < 0) h.ns = -h.ns;  // winding decides the front; normals only bend it
+    }
+    if (m.HasUvs()) {  // [texture]
+        for (int k = 0; k < 2; ++k) h.uv[k] = m.uvs[i0][k] * w0 + m.uvs[i1][k] * hit.u + m.uvs[i2][k] * hit.v;
+        h.has_uv = true;
     }
     uint32_t mat = m.material_ids[hit.triangle];
     static const SurfaceMaterial kBlack = [] {
@@ -334,7 +340,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
         film_->AddSample(r.pixel, r.beta * mat.emission.Sample(r.lambda), r.lambda);
     }
     if (r.depth >= uint32_t(scene_.settings.max_depth)) return false;
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda);
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(Key(r, kStreamPath));
@@ -387,7 +393,7 @@ bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, c
     SurfaceHit h = MakeSurfaceHit(brick, hit);
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda);
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     // Direct light from the sun and the other delta or disc lights is next-event estimated at the visible

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/log.h"
+#include "core/rgb_to_spectrum.h"
 #include "render/sun/sun.h"
 
 namespace nave::render {
@@ -121,11 +122,11 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
             m.emissive = true;
             m.emission = ToSpectrum(*mc.emission);
         } else if (rec.emission[0] > 0 || rec.emission[1] > 0 || rec.emission[2] > 0) {
-            // The model's own emission (MTL Ke, glTF emissiveFactor) is RGB: keep its luminance as a flat
-            // spectrum (Rec. 709 luma weights, ITU-R BT.709-6 item 3.2); a config emission overrides it.
+            // [texture] The model's own emission (MTL Ke, glTF emissiveFactor) is linear sRGB: lifted to a
+            // spectrum with its chromaticity (core/rgb_to_spectrum.h, Jakob & Hanika 2019 times the D65
+            // white), whose luminance is the Rec. 709 luma of the RGB; a config emission overrides it.
             m.emissive = true;
-            m.emission = Spectrum::Constant(0.2126f * rec.emission[0] + 0.7152f * rec.emission[1] +
-                                            0.0722f * rec.emission[2]);
+            m.emission = RgbEmission(Vec3f(rec.emission[0], rec.emission[1], rec.emission[2])).ToSpectrum();
         }
         scene.materials.push_back(std::move(m));
     }

@@ -3,6 +3,7 @@
 // spectral materials (a name with no mapping is an error naming it, unless a "default" mapping exists),
 // config spectra are tabulated, and the sun's direction and spectrum are computed from date and place.
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,16 @@
 
 namespace nave::render {
 
+// [texture] An albedo texture of a diffuse material. Implemented over OpenImageIO in render/texture/
+// (SurfaceTextures, library nave_texture), which nave_render does not link: the caller attaches it.
+/// The diffuse reflectance of a textured material at mesh texture coordinates `uv` (as the store keeps
+/// them), at a path's wavelengths; at most 1. Thread-safe.
+class AlbedoTexture {
+  public:
+    virtual ~AlbedoTexture() = default;
+    virtual SampledSpectrum Albedo(const std::array<float, 2>& uv, const SampledWavelengths& lambda) const = 0;
+};
+
 /// A spectral material as the integrators use it: the physics engineer's Material (render/materials/
 /// materials.h) plus what the scene adds: emission, the portal flag, and black (absorbs everything).
 struct SurfaceMaterial {
@@ -29,12 +40,20 @@ struct SurfaceMaterial {
     bool emissive = false;
     Spectrum emission;           ///< radiance, W m^-2 sr^-1 nm^-1, both sides
     bool portal = false;         ///< photons are aimed at it (render.photon_target = "portals")
+    /// [texture] Replaces the albedo of a diffuse material at hits with texture coordinates; null: none.
+    std::shared_ptr<const AlbedoTexture> albedo_texture;
 
     /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the secondary
     /// wavelengths of `lambda`.
     Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
         if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
         return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
+    }
+    /// [texture] The BSDF at a hit with texture coordinates `uv` (null when the mesh has none).
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda, const std::array<float, 2>* uv) const {
+        if (albedo_texture && uv != nullptr && !black && std::holds_alternative<DiffuseMaterial>(material))
+            return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(albedo_texture->Albedo(*uv, *lambda))));
+        return MakeBsdf(ns, lambda);
     }
     /// The window pane, if this is thin glass (rays cross it without bending).
     const ThinGlassMaterial* thin_glass() const {

@@ -1,0 +1,142 @@
+#include "render/texture/texture_cache.h"
+
+#include <OpenImageIO/imageio.h>
+#include <OpenImageIO/texture.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "render/texture/oiio_status.h"
+
+namespace nave::render {
+
+using texture_internal::OiioError;
+using texture_internal::TakeError;
+
+struct TextureCache::Entry {
+    OIIO::TextureSystem::TextureHandle* handle = nullptr;
+    TextureInfo info;
+};
+
+namespace {
+
+OIIO::TextureSystem* Ts(void* p) { return static_cast<OIIO::TextureSystem*>(p); }
+
+}  // namespace
+
+TextureFootprint RayConeFootprint(float cone_width_m, float cos_theta, float uv_area,
+                                  float world_area_m2) {
+    if (!(world_area_m2 > 0.f) || !(uv_area > 0.f)) return {};
+    // Ray Tracing Gems ch. 20: LOD = Δ0 + log2(|W| / |n·d|) with Δ0 = ½ log2(t_a / p_a); in
+    // footprint form the width in texture units is sqrt(t_a / p_a) · |W| / |n·d|. |n·d| is kept
+    // away from 0 so grazing hits filter over at most the whole texture instead of overflowing.
+    float cos_abs = std::max(std::abs(cos_theta), 1e-3f);
+    float width = std::sqrt(uv_area / world_area_m2) * std::abs(cone_width_m) / cos_abs;
+    return TextureFootprint::Isotropic(std::min(width, 1.f));
+}
+
+StatusOr<std::unique_ptr<TextureCache>> TextureCache::Create(size_t max_memory_bytes) {
+    std::unique_ptr<TextureCache> cache(new TextureCache());
+    // Not the shared TextureSystem: each cache has its own ImageCache and so its own budget.
+    OIIO::TextureSystem* ts = OIIO::TextureSystem::create(/*shared=*/false);
+    if (ts == nullptr) return InternalError("OpenImageIO: cannot create a texture system");
+    cache->system_ = ts;
+    ts->attribute("max_memory_MB", float(double(max_memory_bytes) / (1024.0 * 1024.0)));
+    // Untiled files (JPEG, PNG, TGA as exported) are read in 64-pixel tiles rather than whole,
+    // and get MIP levels built on demand, so they too stay within the cap.
+    ts->attribute("autotile", 64);
+    ts->attribute("automip", 1);
+    // Errors are returned as Status; OIIO must not print them itself.
+    ts->attribute("max_errors_per_file", 1);
+    float effective_mb = 0.f;
+    if (!ts->getattribute("max_memory_MB", effective_mb))
+        return InternalError("OpenImageIO: cannot read back max_memory_MB");
+    cache->max_memory_bytes_ = size_t(double(effective_mb) * 1024.0 * 1024.0);
+    return cache;
+}
+
+TextureCache::~TextureCache() {
+    if (system_ != nullptr) OIIO::TextureSystem::destroy(Ts(system_));
+}
+
+StatusOr<TextureRef> TextureCache::Open(const std::filesystem::path& path) {
+    OIIO::TextureSystem* ts = Ts(system_);
+    OIIO::ustring name(path.string());
+    OIIO::TextureSystem::TextureHandle* handle = ts->get_texture_handle(name);
+    OIIO::ImageSpec spec;
+    if (handle == nullptr || !ts->good(handle) || !ts->get_imagespec(handle, nullptr, 0, spec))
+        return OiioError(path, "cannot open texture", TakeError(*ts));
+    auto entry = std::make_unique<Entry>();
+    entry->handle = handle;
+    entry->info.path = path;
+    entry->info.width = spec.width;
+    entry->info.height = spec.height;
+    entry->info.channels = spec.nchannels;
+    entry->info.tiled = spec.tile_width > 0;
+    int levels = 1;
+    if (ts->get_texture_info(handle, nullptr, 0, OIIO::ustring("miplevels"), OIIO::TypeInt,
+                             &levels))
+        entry->info.mip_levels = levels;
+    std::lock_guard<std::mutex> lock(mutex_);
+    entries_.push_back(std::move(entry));
+    return TextureRef{entries_.back().get()};
+}
+
+const TextureInfo& TextureCache::info(TextureRef texture) const {
+    NAVE_CHECK(texture.entry != nullptr);
+    return static_cast<const Entry*>(texture.entry)->info;
+}
+
+Status TextureCache::Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
+                            int first_channel, int num_channels, float* result,
+                            TextureWrap wrap) const {
+    NAVE_CHECK(texture.entry != nullptr);
+    const Entry& e = *static_cast<const Entry*>(texture.entry);
+    OIIO::TextureOpt opt;
+    opt.firstchannel = first_channel;
+    opt.interpmode = OIIO::TextureOpt::InterpBilinear;
+    opt.mipmode = OIIO::TextureOpt::MipModeTrilinear;
+    OIIO::TextureOpt::Wrap w = wrap == TextureWrap::kRepeat  ? OIIO::TextureOpt::WrapPeriodic
+                               : wrap == TextureWrap::kClamp ? OIIO::TextureOpt::WrapClamp
+                                                             : OIIO::TextureOpt::WrapBlack;
+    opt.swrap = w;
+    opt.twrap = w;
+    opt.fill = 0.f;
+    OIIO::TextureSystem* ts = Ts(system_);
+    if (!ts->texture(e.handle, nullptr, opt, s, t, footprint.dsdx, footprint.dtdx, footprint.dsdy,
+                     footprint.dtdy, num_channels, result))
+        return OiioError(e.info.path, "texture lookup failed", TakeError(*ts));
+    return Status();
+}
+
+StatusOr<std::string> TextureCache::StringAttribute(TextureRef texture,
+                                                    const std::string& name) const {
+    NAVE_CHECK(texture.entry != nullptr);
+    const Entry& e = *static_cast<const Entry*>(texture.entry);
+    OIIO::TextureSystem* ts = Ts(system_);
+    OIIO::ImageSpec spec;
+    if (!ts->get_imagespec(e.handle, nullptr, 0, spec))
+        return OiioError(e.info.path, "cannot read texture header", TakeError(*ts));
+    const OIIO::ParamValue* p = spec.find_attribute(name, OIIO::TypeString);
+    if (p == nullptr)
+        return NotFoundError("{}: no string attribute \"{}\" in the header", e.info.path.string(),
+                             name);
+    return std::string(p->get_string());
+}
+
+size_t TextureCache::memory_used_bytes() const {
+    int64_t used = 0;
+    Ts(system_)->getattribute("stat:cache_memory_used", OIIO::TypeInt64, &used);
+    return size_t(std::max<int64_t>(used, 0));
+}
+
+uint64_t TextureCache::bytes_read() const {
+    int64_t bytes = 0;
+    Ts(system_)->getattribute("stat:bytes_read", OIIO::TypeInt64, &bytes);
+    return uint64_t(std::max<int64_t>(bytes, 0));
+}
+
+std::string TextureCache::StatsReport(int level) const { return Ts(system_)->getstats(level); }
+
+}  // namespace nave::render
