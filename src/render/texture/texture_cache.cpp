@@ -57,7 +57,9 @@ StatusOr<std::unique_ptr<TextureCache>> TextureCache::Create(size_t max_memory_b
 }
 
 TextureCache::~TextureCache() {
-    if (system_ != nullptr) OIIO::TextureSystem::destroy(Ts(system_));
+    // The system was created unshared, so it owns a private ImageCache: ask destroy() to tear that down
+    // too, or every TextureCache leaks its ImageCache (LeakSanitizer found it).
+    if (system_ != nullptr) OIIO::TextureSystem::destroy(Ts(system_), /*teardown_imagecache=*/true);
 }
 
 StatusOr<TextureRef> TextureCache::Open(const std::filesystem::path& path) {
