@@ -23,6 +23,7 @@
 #include "preprocess/partition/brick_builder.h"
 #include "preprocess/partition/partitioner.h"
 #include "preprocess/partition/temp_dir.h"
+#include "preprocess/texture_convert.h"
 #include "store/store_writer.h"
 
 namespace nave::preprocess {
@@ -43,6 +44,25 @@ std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} units={}",
         o.brick_triangles, budget, step, threads, o.encode.draco_speed, units);
 }
+
+/// Removes the texture folder of a run that fails, unless it existed before the run (it may hold textures an
+/// earlier store still uses).
+class TextureFolderGuard {
+  public:
+    explicit TextureFolderGuard(std::filesystem::path folder) : folder_(std::move(folder)) {
+        std::error_code ec;
+        existed_ = std::filesystem::exists(folder_, ec);
+    }
+    ~TextureFolderGuard() {
+        std::error_code ec;
+        if (!committed_ && !existed_) std::filesystem::remove_all(folder_, ec);
+    }
+    void Commit() { committed_ = true; }
+
+  private:
+    std::filesystem::path folder_;
+    bool existed_ = false, committed_ = false;
+};
 
 }  // namespace
 
@@ -126,6 +146,23 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     }
     auto materials = source->materials();
     source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
+
+    // Textures the materials reference become tiled, MIP-mapped files beside the store, and the material
+    // table points at them (texture_convert.h). Texture names are relative to their model's directory.
+    TextureFolderGuard texture_folder(TextureFolderFor(options.output));
+    {
+        std::vector<std::filesystem::path> source_dirs;
+        for (const auto& input : options.inputs)
+            source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));
+        NAVE_ASSIGN_OR_RETURN(TextureConvertStats textures, ConvertTextures(&materials, source_dirs, options.output));
+        for (const std::string& w : textures.warnings) {
+            log::Warning("{}", w);
+            stats.warnings.push_back(w);
+        }
+        stats.textures_converted = textures.converted;
+        stats.texture_bytes = textures.bytes_written;
+        stats.texture_seconds = textures.seconds;
+    }
 
     // The global grid.
     const Bounds3d& b = partitioner.bounds();
@@ -264,6 +301,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     NAVE_RETURN_IF_ERROR(CheckCancelled());
     store::BrickTree tree(root, nodes);
     NAVE_RETURN_IF_ERROR(writer->Finish(materials, tree, stats.source_triangles));
+    texture_folder.Commit();
     stats.output_bytes = writer->bytes_written();
     stats.peak_temp_bytes = partitioner.peak_temp_bytes();
     stats.seconds = Since(start);
@@ -300,6 +338,10 @@ std::string FormatSummary(const PreprocessStats& s) {
             "\nnote:        {} bricks exceed the target (triangles too large or overlapping to "
             "split)",
             s.oversized_bricks);
+    }
+    if (s.textures_converted > 0) {
+        out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}", s.textures_converted,
+                           FormatBytes(s.texture_bytes), FormatDuration(s.texture_seconds));
     }
     for (const auto& w : s.warnings) out += "\nwarning:     " + w;
     return out;

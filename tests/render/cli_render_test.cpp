@@ -13,7 +13,7 @@
 #include <fstream>
 #include <string>
 
-#include "render/image_io.h"
+#include "imaging/image_io.h"
 
 namespace nave::render {
 namespace {
@@ -58,7 +58,7 @@ aovs = ["albedo", "normal", "depth"]
     ASSERT_EQ(r.exit_code, 0) << r.output;
     ASSERT_TRUE(std::filesystem::exists(out));
     ASSERT_TRUE(std::filesystem::exists(dir_ / "furnace.png"));
-    auto image = ReadImage(out);
+    auto image = imaging::ReadImage(out);
     ASSERT_TRUE(image.ok()) << image.status().ToString();
     EXPECT_EQ(image->width, 16);
     EXPECT_EQ(image->height, 12);

@@ -16,10 +16,12 @@
 #include "render/scene.h"
 #include "render/scene_config.h"
 #include "render/texture/surface_textures.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/texture_cache.h"
 
 namespace nave::render {
 namespace {
+
+using namespace nave::imaging;
 
 constexpr const char* kConfig = R"(
 [camera]

@@ -11,9 +11,13 @@
 
 #include "core/spectrum.h"
 #include "core/status.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/texture_cache.h"
 
 namespace nave::render {
+
+using imaging::TextureCache;
+using imaging::TextureFootprint;
+using imaging::TextureRef;
 
 /// The header attribute holding the band centres, comma-separated, in nm.
 inline constexpr char kBandCentresAttribute[] = "nave:band_centres_nm";

@@ -13,10 +13,14 @@
 #include "core/spectrum.h"
 #include "core/status.h"
 #include "render/scene.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/texture_cache.h"
 #include "store/material_record.h"
 
 namespace nave::render {
+
+using imaging::TextureCache;
+using imaging::TextureFootprint;
+using imaging::TextureRef;
 
 /// Textures of one material. Immutable after construction; thread-safe. Attach it to a
 /// SurfaceMaterial (albedo_texture) to replace the diffuse albedo at hits with texture coordinates.
