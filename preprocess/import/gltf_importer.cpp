@@ -283,6 +283,12 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         add_texture("normalTexture", src.normalTexture.index);
         add_texture("emissiveTexture", src.emissiveTexture.index);
         add_texture("occlusionTexture", src.occlusionTexture.index);
+        // alphaMode MASK (glTF 2.0 §3.9.4): cut out where base-colour alpha x baseColorFactor alpha is below
+        // alphaCutoff. The renderer reads the alpha from "alphaMask", the base-colour image kept as data.
+        if (src.alphaMode == "MASK") {
+            m.alpha_cutoff = float(src.alphaCutoff);
+            add_texture("alphaMask", pbr.baseColorTexture.index);
+        }
         materials.push_back(std::move(m));
     }
     uint32_t default_material = uint32_t(materials.size());

@@ -27,6 +27,7 @@ struct RenderOptions {
     std::optional<uint64_t> seed, photons;
     std::string mode;
     std::string resolution;  // "WxH"
+    bool no_textures = false;
 };
 
 /// Parses "960x640" into width and height.
@@ -66,6 +67,7 @@ Status RunRender(const RenderOptions& o) {
     if (o.photons) config.render.photons_per_iteration = *o.photons;
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
+    if (o.no_textures) config.textures.enabled = false;
 
     NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create());
     std::unique_ptr<render::BrickSource> source;
@@ -75,6 +77,18 @@ Status RunRender(const RenderOptions& o) {
         NAVE_ASSIGN_OR_RETURN(source, render::OpenProceduralSource(o.procedural, device));
     }
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, *source));
+    // The model's textures, through a capped tile cache (docs/textures.md); only when some material has one,
+    // so that untextured models never load OpenImageIO's texture system.
+    std::unique_ptr<render::TextureCache> textures;
+    const bool any_texture = std::any_of(source->materials().begin(), source->materials().end(),
+                                         [](const store::MaterialRecord& m) { return !m.textures.empty(); });
+    if (config.textures.enabled && any_texture) {
+        NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(config.textures.cache_bytes));
+        std::filesystem::path base = std::filesystem::path(o.model).parent_path();
+        std::vector<std::string> warnings;
+        NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures, &scene, &warnings));
+        for (const std::string& w : warnings) log::Warning("{}", w);
+    }
     log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(), scene.materials.size(),
               config.camera.width, config.camera.height, ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
@@ -102,6 +116,10 @@ Status RunRender(const RenderOptions& o) {
         {"nave:statistics", statistics},
     };
     if (scene.sun >= 0) metadata.push_back({"nave:sun", scene.sun_description});
+    if (textures) {
+        metadata.push_back({"nave:textures", fmt::format("cache_cap={} bytes_read={}", textures->max_memory_bytes(),
+                                                         textures->bytes_read())});
+    }
     NAVE_RETURN_IF_ERROR(film.Write(out, metadata));
 
     std::filesystem::path png = out;
@@ -119,6 +137,11 @@ Status RunRender(const RenderOptions& o) {
                  FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),
                  FormatBytes(stats.bytes_read).c_str(), FormatBytes(stats.peak_rss_bytes).c_str(),
                  FormatBytes(stats.peak_queue_bytes).c_str());
+    if (textures) {
+        std::fprintf(stderr, "  textures: read %s through a %s tile cache (%s held at the end)\n",
+                     FormatBytes(textures->bytes_read()).c_str(), FormatBytes(textures->max_memory_bytes()).c_str(),
+                     FormatBytes(textures->memory_used_bytes()).c_str());
+    }
     return Status::Ok();
 }
 
@@ -141,6 +164,7 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
+    cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }
 

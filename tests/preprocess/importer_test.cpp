@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <random>
 
 #include "core/file.h"
@@ -191,6 +192,28 @@ TEST(GltfImporter, NodeTransformsAndMaterials) {
     EXPECT_FLOAT_EQ(m.emission[2], 0.3f);
     EXPECT_EQ(m.textures.at("baseColorTexture"), "brass.png");
     EXPECT_EQ(source->units(), "m");
+}
+
+// glTF 2.0 §3.9.4: alphaMode MASK cuts the surface out where base-colour alpha is below alphaCutoff; the
+// importer keeps the cutoff and names the base-colour image as the alpha source.
+TEST(GltfImporter, AlphaMaskKeepsCutoffAndAlphaSource) {
+    std::string text = ReadFileToString(Fixture("node_transform.gltf")).value();
+    const std::string name = "\"name\": \"brass\",";
+    ASSERT_NE(text.find(name), std::string::npos);
+    text.replace(text.find(name), name.size(), name + " \"alphaMode\": \"MASK\", \"alphaCutoff\": 0.3,");
+    auto dir = testing::MakeTempDir("gltf_mask");
+    std::ofstream(dir / "mask.gltf") << text;
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(dir / "mask.gltf", &source);
+    ASSERT_EQ(tris.size(), 1u);
+    const auto& m = source->materials().at(tris[0].material);
+    EXPECT_FLOAT_EQ(m.alpha_cutoff, 0.3f);
+    EXPECT_EQ(m.textures.at("alphaMask"), "brass.png");
+    // Without MASK there is no alpha source and the default cutoff.
+    auto plain = ReadModel(Fixture("node_transform.gltf"), &source);
+    const auto& p = source->materials().at(plain[0].material);
+    EXPECT_EQ(p.textures.count("alphaMask"), 0u);
+    EXPECT_FLOAT_EQ(p.alpha_cutoff, 0.5f);
 }
 
 TEST(GltfImporter, BinaryGlbGivesTheSameTriangle) {
