@@ -28,6 +28,7 @@ std::filesystem::path Resolve(const std::string& name,
 }
 
 struct Converted {
+    std::string first_user;  // "material lion map_Kd", for warnings
     bool ok = false;
     std::string relative;  // to the store's directory
 };
@@ -52,8 +53,10 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
     // Distinct (source file, colour?) pairs, converted once however many slots use them.
     std::map<std::pair<std::filesystem::path, bool>, Converted> work;
     for (const store::MaterialRecord& m : *materials)
-        for (const auto& [slot, name] : m.textures)
-            work[{Resolve(name, source_dirs), IsColourTextureSlot(slot)}];
+        for (const auto& [slot, name] : m.textures) {
+            Converted& c = work[{Resolve(name, source_dirs), IsColourTextureSlot(slot)}];
+            if (c.first_user.empty()) c.first_user = fmt::format("material {} {}", m.name, slot);
+        }
     if (work.empty()) return stats;
 
     std::filesystem::path folder = TextureFolderFor(store_path);
@@ -75,8 +78,8 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
         if (!made.ok()) {
             std::filesystem::remove(temp, ec);
             if (made.code() == StatusCode::kIoError) return made;  // the output side: nothing to fall back on
-            stats.warnings.push_back(fmt::format("texture {}; its materials use their flat colour",
-                                                 made.message()));
+            stats.warnings.push_back(fmt::format("texture {} (used by {}); its materials use their flat value",
+                                                 made.message(), result.first_user));
             continue;
         }
         NAVE_ASSIGN_OR_RETURN(std::string bytes, ReadFileToString(temp));

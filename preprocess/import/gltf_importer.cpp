@@ -273,10 +273,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         auto add_texture = [&](const char* slot, int index) {
             std::string name = TextureName(model, index);
             if (name.empty()) return;
+            // A missing or unreadable file is reported once, by the texture conversion (texture_convert.h).
             m.textures[slot] = name;
-            if (!std::filesystem::exists(path.parent_path() / name, ec) && ext != ".glb") {
-                warnings.Add("missing textures (material kept, colour used)", file + " " + name);
-            }
         };
         add_texture("baseColorTexture", pbr.baseColorTexture.index);
         add_texture("metallicRoughnessTexture", pbr.metallicRoughnessTexture.index);

@@ -55,7 +55,6 @@ TEST(ObjImporter, CrlfQuadsNgonsNegativeIndicesAndMaterials) {
     EXPECT_EQ(tris[5].p[0], Vec3f(0, 0, 1));
     EXPECT_EQ(tris[5].p[2], Vec3f(3, 1, 1));
     for (const auto& t : tris) EXPECT_GT(Normal(t).z, 0.99);  // counter-clockwise seen from +z
-    EXPECT_EQ(source->warnings().Count("missing textures (material kept, colour used)"), 1u);
     EXPECT_EQ(
         source->warnings().Count("materials used but defined in no MTL (default colour used)"), 1u);
 }
@@ -243,7 +242,6 @@ TEST(MergedInputs, MaterialNamesAreMadeUnique) {
     EXPECT_THAT(names, ::testing::UnorderedElementsAre("red", "blue", "undefined_in_mtl", "red.1",
                                                        "blue.1", "undefined_in_mtl.1", "default"));
     EXPECT_EQ((*source)->materials()[(*tris)[6].material].name, "red.1");
-    EXPECT_EQ((*source)->warnings().Count("missing textures (material kept, colour used)"), 2u);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <chrono>
 #include <system_error>
 
 #include "imaging/image_io.h"
@@ -99,6 +100,16 @@ class Plugin final : public OiioPlugin {
             }
             in = std::move(linear);
         }
+        // make_texture stamps the output with the current time unless the image has a DateTime: stamp the
+        // source's own modification time, so that converting the same file twice gives the same bytes (the
+        // converted file's name carries its checksum).
+        std::string stamp = "unknown";
+        const auto mtime = std::filesystem::last_write_time(source, ec);
+        if (!ec) {
+            const auto sys = std::chrono::file_clock::to_sys(mtime);
+            stamp = fmt::format("source modified {} s after 1970",
+                                std::chrono::duration_cast<std::chrono::seconds>(sys.time_since_epoch()).count());
+        }
         OIIO::ImageSpec config;
         // Colour: half floats (OpenEXR; OIIO's TIFF writer would store half as float); data: the source's
         // pixel type. Both tiled and MIP-mapped by make_texture.
@@ -106,6 +117,7 @@ class Plugin final : public OiioPlugin {
         config.tile_width = config.tile_height = 64;
         config.attribute("wrapmodes", "periodic,periodic");
         config.attribute("compression", "zip");
+        config.attribute("DateTime", stamp);
         if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in, output.string(), config))
             return IoError("{}: cannot write the texture converted from {}: {}", output.string(), source.string(),
                            GlobalError());
