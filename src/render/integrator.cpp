@@ -229,7 +229,7 @@ bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float 
         const ThinGlassMaterial* glass = m.thin_glass();
         if (glass == nullptr) return false;
         SampledSpectrum reflected, transmitted;
-        ThinDielectricBxdf(glass->eta.Sample(r.lambda), glass->internal_transmittance.Sample(r.lambda))
+        ThinDielectricBxdf(glass->eta.Sample(r.lambda), m.GlassInternalTransmittance(h.has_uv ? &h.uv : nullptr, r.lambda))
             .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
         r.beta *= transmitted;
         if (r.beta.IsZero()) return false;

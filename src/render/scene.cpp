@@ -120,6 +120,7 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
         SurfaceMaterial& m = scene->materials[i];
         SurfaceTextureOptions options;
         options.use_albedo = std::holds_alternative<DiffuseMaterial>(m.material);
+        options.use_transmittance = std::holds_alternative<ThinGlassMaterial>(m.material);
         options.emission_scale = mc.emission_scale;
         std::shared_ptr<const SurfaceTextures> t = OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
         if (t == nullptr) continue;

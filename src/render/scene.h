@@ -45,7 +45,17 @@ struct SurfaceMaterial {
         if (textures && textures->albedo && uv != nullptr && !black &&
             std::holds_alternative<DiffuseMaterial>(material))
             return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(textures->Albedo(*uv, *lambda))));
+        if (const ThinGlassMaterial* glass = thin_glass(); glass && textures && textures->transmittance && uv) {
+            SampledSpectrum tau = textures->Transmittance(*uv, *lambda);
+            return Bsdf(ns, Vec3f(0, 0, 0), glass->GetBxdf(*lambda, &tau));
+        }
         return MakeBsdf(ns, lambda);
+    }
+    /// The internal transmittance of a thin glass pane at a hit with texture coordinates `uv` (null when the
+    /// mesh has none): the spectral transmittance texture's where there is one. Call only on thin glass.
+    SampledSpectrum GlassInternalTransmittance(const std::array<float, 2>* uv, const SampledWavelengths& lambda) const {
+        if (textures && textures->transmittance && uv != nullptr) return textures->Transmittance(*uv, lambda);
+        return thin_glass()->internal_transmittance.Sample(lambda);
     }
     /// Radiance emitted at a hit with texture coordinates `uv` (null when the mesh has none): the emission
     /// texture's where there is one, else the config's spectrum. Call only when `emissive`.

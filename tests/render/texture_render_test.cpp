@@ -249,5 +249,31 @@ TEST_F(TextureRenderTest, EmissionTextureEmitsItsColours) {
     EXPECT_NEAR(xyz.y / 9, y_red, 0.05 * y_red);
 }
 
+// A thin glass pane whose internal transmittance is a spectral texture ("nave:transmittance", one channel per
+// band): over a uniform sky, the left half (every band 1) passes the sky's grey; the right half (bands below
+// 600 nm 0) passes only red.
+TEST_F(TextureRenderTest, SpectralTransmittanceTextureColoursTheLightThroughAPane) {
+    const std::vector<float> bands = {400, 450, 500, 550, 590, 610, 650, 700};
+    std::vector<float> px;
+    for (int x = 0; x < 2; ++x)
+        for (float b : bands) px.push_back(x == 0 || b > 600 ? 1.f : 0.f);
+    ASSERT_TRUE(WriteSpectralTexture(dir_ / "pane.exr", 2, 1, bands, px).ok());
+    store::MaterialRecord rec;
+    rec.name = "pane";
+    rec.textures["nave:transmittance"] = "pane.exr";
+    std::string config = kConfig;
+    config.replace(config.find("reflectance = 0.5"), std::string("reflectance = 0.5").size(),
+                   "type = \"thin_dielectric\"\neta = 1.5");
+    std::unique_ptr<Film> film = Render(Quad(), rec, config);
+    ASSERT_TRUE(film);
+    Vec3d clear = Block(*film, 6, 16), red = Block(*film, 25, 16);
+    // Clear glass at normal incidence passes (1 - R)^2 / (1 - R^2) = 92.3 % for eta 1.5 (R = 0.04).
+    Vec3d sky = RgbColorSpace::Srgb().ToRgb(Vec3d(1, 1, 1));
+    EXPECT_NEAR(clear.y / sky.y, 0.923, 0.03);
+    EXPECT_NEAR(clear.x / clear.z, sky.x / sky.z, 0.1);
+    EXPECT_GT(red.x, 4 * red.y) << red.x << " " << red.y;
+    EXPECT_GT(red.x, 4 * red.z) << red.x << " " << red.z;
+}
+
 }  // namespace
 }  // namespace nave::render

@@ -62,6 +62,9 @@ Status OiioTextureCache::Configure(size_t max_memory_bytes) {
 OiioTextureCache::~OiioTextureCache() {
     // The system was created unshared, so it owns a private ImageCache: ask destroy() to tear that down
     // too, or every TextureCache leaks its ImageCache (LeakSanitizer found it).
+    // Drop every tile first: per-thread tile references that outlive the cache otherwise corrupt the next
+    // cache's memory accounting (an OIIO assertion when tests create caches one after another).
+    system_->invalidate_all(/*force=*/true);
     OIIO::TextureSystem::destroy(system_, /*teardown_imagecache=*/true);
 }
 

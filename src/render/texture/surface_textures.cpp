@@ -54,6 +54,18 @@ SampledSpectrum SurfaceTextures::MeanEmission(const SampledWavelengths& lambda) 
     return RgbEmission(rgb).Sample(lambda) * emission_scale;
 }
 
+SampledSpectrum SurfaceTextures::Transmittance(const std::array<float, 2>& uv,
+                                               const SampledWavelengths& lambda) const {
+    const float s = uv[0], t = transmittance_top_left ? uv[1] : 1.f - uv[1];
+    StatusOr<SampledSpectrum> tau = transmittance->Sample(s, t, TextureFootprint{}, lambda);
+    if (!tau.ok()) {
+        static std::atomic<bool> logged{false};
+        if (!logged.exchange(true)) log::Warning("{} (clear glass is used instead)", tau.status().ToString());
+        return SampledSpectrum(1.f);
+    }
+    return *tau;
+}
+
 bool SurfaceTextures::Present(const std::array<float, 2>& uv) const {
     if (!alpha) return true;
     float a = 1.f;
@@ -97,12 +109,24 @@ std::shared_ptr<const SurfaceTextures> OpenSurfaceTextures(TextureCache& cache,
         if (record.textures.count("alphaMask") && channels < 4) t->alpha = {};
     }
     t->emission = open({"map_Ke", "emissiveTexture"}, &t->emission_top_left);
+    if (options.use_transmittance) {
+        if (auto it = record.textures.find("nave:transmittance"); it != record.textures.end()) {
+            StatusOr<SpectralTexture> tex = SpectralTexture::Open(cache, base_dir / it->second);
+            if (tex.ok()) {
+                t->transmittance = std::move(tex).value();
+                t->transmittance_top_left = true;  // written by nave: image rows from the top, t = v
+            } else {
+                warnings->push_back(fmt::format("material {}: nave:transmittance: {}; its flat value is used",
+                                                record.name, tex.status().ToString()));
+            }
+        }
+    }
     t->emission_scale = options.emission_scale;
     // MTL Ke and glTF emissiveFactor multiply the texture; exporters often leave Ke at 0 beside a map_Ke, which
     // would switch the texture off, so an all-zero factor counts as 1.
     const auto& f = record.emission;
     if (f[0] > 0.f || f[1] > 0.f || f[2] > 0.f) t->emission_factor = Vec3f(f[0], f[1], f[2]);
-    if (!t->albedo && !t->alpha && !t->emission) return nullptr;
+    if (!t->albedo && !t->alpha && !t->emission && !t->transmittance) return nullptr;
     return t;
 }
 

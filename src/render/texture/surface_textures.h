@@ -5,12 +5,15 @@
 //     sigmoid-polynomial method of Jakob & Hanika 2019 (core/rgb_to_spectrum.h), at most 1 everywhere;
 //   - alpha (map_d, glTF alphaMode MASK): cuts the surface out where alpha < the material's cutoff (Embree
 //     intersection filters in brick_source.cpp call Present());
-//   - emission (map_Ke, emissiveTexture): lifted as an illuminant spectrum (RgbEmission).
+//   - emission (map_Ke, emissiveTexture): lifted as an illuminant spectrum (RgbEmission);
+//   - spectral transmittance ("nave:transmittance", a SpectralTexture): the internal transmittance of a thin
+//     glass pane per texel and wavelength band (stained glass measured band by band, as in the origin paper).
 // Texture coordinates follow the model: OBJ/MTL has its origin bottom-left (t = 1 - v), glTF top-left (t = v).
 
 #include <array>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +21,7 @@
 #include "core/status.h"
 #include "imaging/texture_cache.h"
 #include "render/brick_source.h"
+#include "render/texture/spectral_texture.h"
 #include "store/material_record.h"
 
 namespace nave::render {
@@ -45,6 +49,9 @@ struct SurfaceTextures final : public AlphaMask {
     float emission_scale = 1.f;  ///< luminance of the lifted spectrum per unit texel luminance
     Vec3f emission_factor{1.f, 1.f, 1.f};  ///< multiplies the texel (MTL Ke, glTF emissiveFactor)
 
+    std::optional<SpectralTexture> transmittance;  ///< thin glass internal transmittance; empty: none
+    bool transmittance_top_left = false;
+
     /// The albedo at mesh texture coordinates `uv` at the path's wavelengths (requires `albedo`).
     SampledSpectrum Albedo(const std::array<float, 2>& uv, const TextureFootprint& footprint,
                            const SampledWavelengths& lambda) const;
@@ -57,13 +64,16 @@ struct SurfaceTextures final : public AlphaMask {
     SampledSpectrum Emission(const std::array<float, 2>& uv, const SampledWavelengths& lambda) const;
     /// The texture's mean emitted radiance (its coarsest MIP level), for choosing emitters by power.
     SampledSpectrum MeanEmission(const SampledWavelengths& lambda) const;
+    /// Internal transmittance of a pane at `uv` (requires `transmittance`); 1 if the lookup fails.
+    SampledSpectrum Transmittance(const std::array<float, 2>& uv, const SampledWavelengths& lambda) const;
     /// Whether the surface is there at `uv` (true without an alpha texture).
     bool Present(const std::array<float, 2>& uv) const override;
 };
 
 /// Options for resolving a material's textures.
 struct SurfaceTextureOptions {
-    bool use_albedo = true;      ///< the config material is diffuse (others keep their physics)
+    bool use_albedo = true;         ///< the config material is diffuse (others keep their physics)
+    bool use_transmittance = false; ///< the config material is thin glass
     float emission_scale = 1.f;
 };
 
