@@ -145,6 +145,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         stats.warnings.push_back(w);
     }
     auto materials = source->materials();
+    NAVE_RETURN_IF_ERROR(source->WriteGeneratedTextures(temp.path()));
     source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
 
     // Textures the materials reference become tiled, MIP-mapped files beside the store, and the material
@@ -154,6 +155,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         std::vector<std::filesystem::path> source_dirs;
         for (const auto& input : options.inputs)
             source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));
+        source_dirs.push_back(temp.path());  // a generator's textures (WriteGeneratedTextures)
         NAVE_ASSIGN_OR_RETURN(TextureConvertStats textures, ConvertTextures(&materials, source_dirs, options.output));
         for (const std::string& w : textures.warnings) {
             log::Warning("{}", w);

@@ -70,7 +70,9 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
     for (auto& [key, result] : work) {
         const auto& [source, colour] = key;
         progress.Add(1);
-        const char* extension = colour ? "exr" : "tx";
+        // Colour, and data that comes as OpenEXR (spectral maps, whose band centres live in an EXR header
+        // attribute), are written as OpenEXR; other data as TIFF in its own pixel type.
+        const char* extension = colour || source.extension() == ".exr" ? "exr" : "tx";
         std::filesystem::path temp =
             folder / fmt::format(".tmp-{}-{}.{}", getpid(), counter.fetch_add(1), extension);
         Status made = imaging::MakeTiledTexture(

@@ -41,6 +41,11 @@ ImageWriteRequest FloatRequest(const FloatImage& image, const ImageMetadata& met
 
 }  // namespace
 
+std::string BandChannelName(int b) {
+    NAVE_CHECK(b >= 0 && b < 100) << "band " << b;
+    return fmt::format("band{:02d}", b);
+}
+
 std::filesystem::path TemporaryImagePath(const std::filesystem::path& path) {
     static std::atomic<int> counter{0};
     std::filesystem::path p = path;

@@ -22,6 +22,13 @@ struct FloatImage {
 
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
+/// The header attribute of a spectral texture (one channel per wavelength band) holding the band centres,
+/// comma-separated, in nm, strictly increasing ("400,420,440").
+inline constexpr char kBandCentresAttribute[] = "nave:band_centres_nm";
+/// The channel name of band `b` of a spectral texture: "band00", "band01"... OpenEXR stores channels sorted
+/// by name, so the names are zero-padded to keep the file's channel order the band order (at most 100 bands).
+std::string BandChannelName(int b);
+
 /// Writes a linear float OpenEXR file (half float for colour, float for depth "Z") with string metadata.
 Status WriteExr(const std::filesystem::path& path, const FloatImage& image, const ImageMetadata& metadata);
 /// Writes a tiled (tile_size x tile_size), half-float OpenEXR file, as textures are read best.

@@ -113,7 +113,7 @@ Status WriteSpectralTexture(const std::filesystem::path& path, int width, int he
     imaging::FloatImage image;
     image.width = width;
     image.height = height;
-    for (int b = 0; b < n; ++b) image.channels.push_back("band" + std::to_string(b));
+    for (int b = 0; b < n; ++b) image.channels.push_back(imaging::BandChannelName(b));
     image.pixels.assign(pixels.begin(), pixels.end());
     return imaging::WriteTiledExr(path, image, 64, {{kBandCentresAttribute, centres}});
 }
