@@ -3,6 +3,7 @@
 
 #include "preprocess/import/importer.h"
 
+#include <OpenImageIO/imageio.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -213,6 +214,53 @@ TEST(GltfImporter, AlphaMaskKeepsCutoffAndAlphaSource) {
     const auto& p = source->materials().at(plain[0].material);
     EXPECT_EQ(p.textures.count("alphaMask"), 0u);
     EXPECT_FLOAT_EQ(p.alpha_cutoff, 0.5f);
+}
+
+// RFC 4648 base64, for building data URIs in tests.
+std::string Base64(const std::string& bytes) {
+    static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        const size_t rem = std::min<size_t>(3, bytes.size() - i);
+        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
+        if (rem > 1) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+        if (rem > 2) v |= uint32_t(uint8_t(bytes[i + 2]));
+        out += kAlphabet[(v >> 18) & 63];
+        out += kAlphabet[(v >> 12) & 63];
+        out += rem > 1 ? kAlphabet[(v >> 6) & 63] : '=';
+        out += rem > 2 ? kAlphabet[v & 63] : '=';
+    }
+    return out;
+}
+
+// An image embedded in the file (a data URI here; GLB buffer views take the same path) gets a name, and the
+// source writes its bytes under that name for the texture conversion.
+TEST(GltfImporter, EmbeddedImageIsWrittenForTheTextureConversion) {
+    auto dir = testing::MakeTempDir("gltf_embedded");
+    // A real 2 x 1 PNG written by OpenImageIO.
+    {
+        auto out = OIIO::ImageOutput::create((dir / "src.png").string());
+        ASSERT_TRUE(out);
+        const uint8_t px[6] = {255, 0, 0, 0, 0, 255};
+        ASSERT_TRUE(out->open((dir / "src.png").string(), OIIO::ImageSpec(2, 1, 3, OIIO::TypeUInt8)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeUInt8, px));
+        ASSERT_TRUE(out->close());
+    }
+    const std::string png = ReadFileToString(dir / "src.png").value();
+    std::string text = ReadFileToString(Fixture("node_transform.gltf")).value();
+    const std::string uri = "\"uri\": \"brass.png\"";
+    ASSERT_NE(text.find(uri), std::string::npos);
+    text.replace(text.find(uri), uri.size(), "\"uri\": \"data:image/png;base64," + Base64(png) + "\"");
+    std::ofstream(dir / "inline.gltf") << text;
+    std::unique_ptr<TriangleSource> source;
+    auto tris = ReadModel(dir / "inline.gltf", &source);
+    ASSERT_EQ(tris.size(), 1u);
+    const auto& m = source->materials().at(tris[0].material);
+    EXPECT_EQ(m.textures.at("baseColorTexture"), "inline.image0.png");
+    auto out = dir / "generated";
+    std::filesystem::create_directories(out);
+    ASSERT_TRUE(source->WriteGeneratedTextures(out).ok());
+    EXPECT_EQ(ReadFileToString(out / "inline.image0.png").value(), png);
 }
 
 TEST(GltfImporter, BinaryGlbGivesTheSameTriangle) {
