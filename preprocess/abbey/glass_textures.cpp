@@ -55,7 +55,10 @@ std::string GlassTextureName(std::string_view material) {
 Status WriteGlassTextures(const std::filesystem::path& dir) {
     const SpectraTable& table = EmbeddedSpectraTable("stained_glass_approx.csv");
     std::string centres;
-    for (int b = 0; b < kBands; ++b) centres += (b ? "," : "") + fmt::format("{:g}", kFirstBandNm + b * kBandStepNm);
+    for (int b = 0; b < kBands; ++b) {
+        if (b > 0) centres += ',';
+        centres += fmt::format("{:g}", kFirstBandNm + b * kBandStepNm);
+    }
     uint64_t seed = 1;
     for (const char* name : {"glass_clear", "glass_blue", "glass_red", "glass_yellow", "glass_green"}) {
         NAVE_ASSIGN_OR_RETURN(Spectrum total, table.ToSpectrum(name));
