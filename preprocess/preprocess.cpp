@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #ifdef __GLIBC__
@@ -233,15 +235,35 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     std::mutex mutex;
     size_t next = 0;
     Status failure;
+    // Bricks are appended in leaf order whatever order the threads finish them in, so that brick ids, and
+    // the store's bytes, do not depend on the thread count. A finished brick waits here (compressed) until
+    // the leaves before it are appended.
+    std::map<size_t, std::optional<store::EncodedBrick>> finished;
+    size_t next_append = 0;
+    auto append_ready = [&]() -> Status {  // with `mutex` held
+        for (auto it = finished.begin(); it != finished.end() && it->first == next_append;
+             it = finished.erase(it), ++next_append) {
+            if (!it->second) continue;  // every triangle collapsed: no brick
+            const store::EncodedBrick& encoded = *it->second;
+            NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
+            nodes[leaves[it->first].node].brick = id;
+            stats.stored_triangles += encoded.triangle_count;
+            stats.collapsed_triangles += encoded.dropped_triangle_count;
+            ++stats.bricks;
+        }
+        return Status::Ok();
+    };
     auto worker = [&] {
         std::vector<Triangle> triangles;
         BrickBuilder builder;
         while (true) {
             const LeafBin* leaf = nullptr;
+            size_t index = 0;
             {
                 std::lock_guard<std::mutex> lock(mutex);
                 if (next >= leaves.size() || !failure.ok()) return;
-                leaf = &leaves[next++];
+                index = next++;
+                leaf = &leaves[index];
             }
             Status s = [&]() -> Status {
                 NAVE_RETURN_IF_ERROR(CheckCancelled());
@@ -256,23 +278,14 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 std::error_code ec;
                 std::filesystem::remove(leaf->file, ec);
                 const BuiltBrick& built = builder.Build(triangles, grid);
-                if (built.mesh.indices.empty()) {
-                    std::lock_guard<std::mutex> lock(mutex);
-                    stats.collapsed_triangles += built.collapsed_triangles;
-                    ++stats.empty_cells;
-                    return Status::Ok();
+                std::optional<store::EncodedBrick> encoded;
+                if (!built.mesh.indices.empty()) {
+                    NAVE_ASSIGN_OR_RETURN(encoded, store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
                 }
-                NAVE_ASSIGN_OR_RETURN(
-                    store::EncodedBrick encoded,
-                    store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
                 std::lock_guard<std::mutex> lock(mutex);
-                NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
-                nodes[leaf->node].brick = id;
-                stats.stored_triangles += encoded.triangle_count;
-                stats.collapsed_triangles +=
-                    built.collapsed_triangles + encoded.dropped_triangle_count;
-                ++stats.bricks;
-                return Status::Ok();
+                stats.collapsed_triangles += built.collapsed_triangles;
+                finished.emplace(index, std::move(encoded));
+                return append_ready();
             }();
             bar.Add(leaf->triangles);
             if (!s.ok()) {
