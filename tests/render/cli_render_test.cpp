@@ -53,21 +53,7 @@ TEST_F(CliRenderTest, PreprocessedTexturesAppearInTheRender) {
     for (const auto& e : std::filesystem::directory_iterator(dir_ / "q.nave.textures")) converted += e.is_regular_file();
     EXPECT_EQ(converted, 2) << "one colour texture and one data texture";
 
-    auto config = Write("quad.toml", R"(
-[camera]
-position = [0.0, 0.0, 2.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0, 1, 0]
-fov_deg = 40
-resolution = [32, 32]
-[sky]
-radiance = 1.0
-[materials.painted]
-reflectance = 0.5
-[render]
-spp = 16
-max_depth = 1
-)");
+    const auto config = std::filesystem::path(NAVE_TEST_FIXTURES) / "scenes/quad_under_sky.toml";
     auto out = dir_ / "quad.exr";
     CommandResult r = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;

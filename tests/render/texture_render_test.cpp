@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/color.h"
+#include "core/file.h"
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
@@ -24,22 +25,12 @@ namespace {
 
 using namespace nave::imaging;
 
-constexpr const char* kConfig = R"(
-[camera]
-position = [0.0, 0.0, 2.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0, 1, 0]
-fov_deg = 40
-resolution = [32, 32]
-[sky]
-radiance = 1.0
-[materials.default]
-reflectance = 0.5
-[render]
-spp = 16
-max_depth = 1
-seed = 5
-)";
+/// The scene of every test here (tests/fixtures/scenes/quad_under_sky.toml), as text to adapt.
+std::string BaseConfig() {
+    auto text = ReadFileToString(std::filesystem::path(NAVE_TEST_FIXTURES) / "scenes/quad_under_sky.toml");
+    EXPECT_TRUE(text.ok()) << text.status().ToString();
+    return text.ok() ? *text : std::string();
+}
 
 /// Writes a small float image with OpenImageIO (rows from the top).
 void WriteImage(const std::filesystem::path& path, int w, int h, int channels, const std::vector<float>& px) {
@@ -113,7 +104,7 @@ class TextureRenderTest : public ::testing::Test {
         store::MaterialRecord rec;
         rec.name = "checker";
         rec.textures["map_Kd"] = "checker.exr";
-        return Render(Quad(), rec, kConfig + extra_config, textures);
+        return Render(Quad(), rec, BaseConfig() + extra_config, textures);
     }
 
     // Linear sRGB of the 3 x 3 pixels around (x, y) (row 0 at the top).
@@ -174,7 +165,7 @@ TEST_F(TextureRenderTest, AlphaMaskLetsTheSkyThroughWhereAlphaIsZero) {
     store::MaterialRecord rec;
     rec.name = "leaf";
     rec.textures["map_d"] = "mask.exr";
-    std::string config = kConfig;
+    std::string config = BaseConfig();
     config.replace(config.find("[materials.default]\nreflectance = 0.5"),
                    std::string("[materials.default]\nreflectance = 0.5").size(),
                    "[materials.default]\ntype = \"black\"");
@@ -234,7 +225,7 @@ TEST_F(TextureRenderTest, EmissionTextureEmitsItsColours) {
     store::MaterialRecord rec;
     rec.name = "panel";
     rec.textures["map_Ke"] = "checker.exr";
-    std::string config = kConfig;
+    std::string config = BaseConfig();
     config.replace(config.find("[sky]\nradiance = 1.0\n"), std::string("[sky]\nradiance = 1.0\n").size(), "");
     config.replace(config.find("reflectance = 0.5"), std::string("reflectance = 0.5").size(),
                    "reflectance = 0.0\nemission_scale = 2.0");
@@ -261,7 +252,7 @@ TEST_F(TextureRenderTest, SpectralTransmittanceTextureColoursTheLightThroughAPan
     store::MaterialRecord rec;
     rec.name = "pane";
     rec.textures["nave:transmittance"] = "pane.exr";
-    std::string config = kConfig;
+    std::string config = BaseConfig();
     config.replace(config.find("reflectance = 0.5"), std::string("reflectance = 0.5").size(),
                    "type = \"thin_dielectric\"\neta = 1.5");
     std::unique_ptr<Film> film = Render(Quad(), rec, config);
