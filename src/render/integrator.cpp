@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/log.h"
 #include "core/memory.h"
 #include "core/progress.h"
 #include "core/sampling.h"
@@ -108,8 +109,8 @@ class Engine {
                      const RayRecord& r, const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out,
                      LocalCounters& c);
     void Escape(const RayRecord& r);
-    /// Next-event estimation of the uniform sky: a uniform direction on the sphere (its pdf does not depend on
-    /// the vertex, so an escaping path can weigh itself against it), power heuristic with the BSDF.
+    /// Next-event estimation of the sky: a uniform direction on the sphere, or with render.sky_sampling =
+    /// "portals" mostly a direction toward a point on a window (SkyPdf), power heuristic with the BSDF.
     void SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r, const VertexRng& rng,
                    bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
     /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin glass
@@ -121,6 +122,16 @@ class Engine {
         return m.thin_glass() != nullptr && bs.IsTransmission();
     }
     void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
+    /// Builds the portal scene and area CDF from the triangles of portal materials.
+    Status SetPortals(const std::vector<std::array<Vec3f, 3>>& triangles);
+    /// With render.sky_sampling = "portals": gathers the portal triangles (one pass over the bricks, unless
+    /// the photon emitters gathered them already) so that sky next-event estimation aims at the windows.
+    Status BuildSkyPortals();
+    /// The solid-angle pdf with which SampleSky picks direction `w` at point `p`: the mixture of uniform
+    /// directions and portal sampling, whose pdf sums d² / (|cos θ| A_portals) over every portal triangle the
+    /// ray from p crosses (each crossing could have been the sampled point; Veach 1997 §9.2 area-to-solid-angle
+    /// conversion).
+    float SkyPdf(const Vec3f& p, const Vec3f& w) const;
     SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
     RngKey Key(const RayRecord& r, uint32_t stream) const {
         return RngKey{scene_.settings.seed, r.pixel, r.sample, r.vertex, iteration_, stream};
@@ -157,6 +168,10 @@ class Engine {
     std::vector<std::array<Vec3f, 3>> portal_triangles_;
     std::vector<double> portal_area_cdf_;
     double portal_area_ = 0;
+    // Sky next-event estimation toward the portals: this share of the samples, the rest uniform (which keeps
+    // light that enters elsewhere, and vertices outside, sampled).
+    bool sky_portals_ = false;
+    static constexpr float kPortalSkyShare = 0.75f;
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     Vec3f scene_center_;
@@ -197,9 +212,12 @@ void Engine::Escape(const RayRecord& r) {
     if (r.kind != kPathRay) return;  // photons leaving the model carry nothing back
     SampledSpectrum L;
     if (scene_.sky) {
-        // The sky is also next-event estimated (uniform directions): weight the BSDF-sampled escape.
+        // The sky is also next-event estimated: weight the BSDF-sampled escape against it, at the vertex the
+        // direction was sampled from.
         float w = 1;
-        if (r.depth > 0 && !(r.flags & kSpecularBounce)) w = PowerHeuristic(r.prev_pdf, UniformSpherePdf());
+        if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
+            w = PowerHeuristic(r.prev_pdf, SkyPdf(r.origin - r.dir * r.since_vertex, r.dir));
+        }
         L += scene_.SkyRadiance(r.dir, r.lambda) * w;
     }
     if (scene_.sun >= 0) {
@@ -314,10 +332,25 @@ void Engine::SampleLight(const Light& light, int index, const SurfaceHit& h, con
 void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r,
                        const VertexRng& rng, bool mis, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c) {
     const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
-    Vec3f wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+    Vec3f wi;
+    if (sky_portals_ && rng.Uniform(dim + 2) < kPortalSkyShare) {
+        // A uniform point on the portals (a triangle by area, then Turk 1990's square-root parameterisation).
+        const double u = rng.Uniform(dim + 3);
+        size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(), u) -
+                          (portal_area_cdf_.begin() + 1));
+        const auto& t = portal_triangles_[std::min(i, portal_triangles_.size() - 1)];
+        const float su = std::sqrt(rng.Uniform(dim)), v = rng.Uniform(dim + 1);
+        const Vec3f q = t[0] * (1 - su) + t[1] * (su * (1 - v)) + t[2] * (su * v);
+        const float d = Length(q - h.p);
+        if (!(d > 0)) return;
+        wi = (q - h.p) / d;
+    } else {
+        wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+    }
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return;
-    const float light_pdf = UniformSpherePdf();
+    const float light_pdf = SkyPdf(h.p, wi);
+    if (!(light_pdf > 0)) return;
     float w = mis ? PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda)) : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
@@ -341,7 +374,10 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
         // chains; light reaching diffuse vertices from emitters comes with the photons.
         film_->AddSample(r.pixel, r.beta * mat.Emitted(h.has_uv ? &h.uv : nullptr, r.lambda), r.lambda);
     }
-    if (r.depth >= uint32_t(scene_.settings.max_depth)) return false;
+    // A path at its last scattering still passes through thin glass (not a scattering event): cut there,
+    // the light that next-event estimation left to BSDF sampling through a window would be lost.
+    const bool last = r.depth >= uint32_t(scene_.settings.max_depth);
+    if (last && mat.thin_glass() == nullptr) return false;
     Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
@@ -368,10 +404,12 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     r.vertex += 1;
     if (IsPassThrough(mat, *bs)) {
         if (r.beta.IsZero()) return false;
+        r.since_vertex += Length(h.p - r.origin);
         r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
         r.t_max = kInfinity;
         return true;
     }
+    if (last) return false;
     r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
     r.prev_pdf = bs->pdf;
     if (r.depth >= 2) {
@@ -385,6 +423,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     }
     if (r.beta.IsZero()) return false;
     r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.since_vertex = 0;
     r.dir = bs->wi;
     r.t_max = kInfinity;
     r.depth += 1;
@@ -403,7 +442,9 @@ bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, c
     if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
         visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
     }
-    if (uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth)) return false;
+    // As for paths, a photon at its last bounce still passes through thin glass.
+    const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);
+    if (last && mat.thin_glass() == nullptr) return false;
     VertexRng rng(Key(r, kStreamPhoton));
     std::optional<BsdfSample> bs =
         bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice), Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),
@@ -420,6 +461,7 @@ bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, c
         r.t_max = kInfinity;
         return true;
     }
+    if (last) return false;
     // Russian roulette on the photon's change of power (pbrt-v4 SPPM photon pass).
     float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
     if (rng.Uniform(kDimRoulette) < q) return false;
@@ -539,6 +581,7 @@ void Engine::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample, 
 }
 
 Status Engine::RunPath() {
+    NAVE_RETURN_IF_ERROR(BuildSkyPortals());
     const Camera& camera = *scene_.camera;
     const uint64_t pixels = uint64_t(camera.width()) * camera.height();
     const int spp = scene_.settings.spp;
@@ -591,6 +634,75 @@ float EmissionPower(const SurfaceMaterial& m) {
     return std::max(float(sum / (8 * kNumWavelengths)), 1e-6f);
 }
 }  // namespace
+
+Status Engine::SetPortals(const std::vector<std::array<Vec3f, 3>>& triangles) {
+    store::BrickMesh mesh;
+    portal_area_ = 0;
+    portal_area_cdf_.assign(1, 0.0);
+    for (const auto& t : triangles) {
+        uint32_t base = uint32_t(mesh.positions.size());
+        mesh.positions.insert(mesh.positions.end(), {t[0], t[1], t[2]});
+        mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+        mesh.material_ids.push_back(0);
+        portal_area_ += 0.5 * double(Length(Cross(t[1] - t[0], t[2] - t[0])));
+        portal_area_cdf_.push_back(portal_area_);
+    }
+    for (double& c : portal_area_cdf_) c /= portal_area_;
+    portal_triangles_ = triangles;
+    NAVE_ASSIGN_OR_RETURN(portal_scene_, ResidentBrick::Build(scene_.source->device(), 0, scene_.source->bounds(),
+                                                              std::move(mesh)));
+    return Status::Ok();
+}
+
+Status Engine::BuildSkyPortals() {
+    if (!scene_.sky || scene_.settings.sky_sampling != RenderSettings::SkySampling::kPortals) return Status::Ok();
+    if (scene_.settings.mode == RenderSettings::Mode::kPhoton) {
+        // Photons from the sky are aimed at the portals only with photon_target = "portals"; the visible
+        // points' sky sampling shares those portals rather than changing where photons go.
+        if (!portal_scene_) {
+            log::Warning("render.sky_sampling = \"portals\" in photon mode needs render.photon_target = "
+                         "\"portals\"; the sky is sampled uniformly");
+        }
+        sky_portals_ = portal_scene_ != nullptr;
+        return Status::Ok();
+    }
+    std::vector<std::array<Vec3f, 3>> triangles;
+    if (std::none_of(scene_.materials.begin(), scene_.materials.end(), [](const auto& m) { return m.portal; })) {
+        return InvalidArgumentError("render.sky_sampling = \"portals\" but no material has portal = true");
+    }
+    for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
+        NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
+        const store::BrickMesh& m = h->mesh();
+        for (size_t t = 0; t < m.TriangleCount(); ++t) {
+            const uint32_t mat = m.material_ids[t];
+            if (mat >= scene_.materials.size() || !scene_.materials[mat].portal) continue;
+            const Vec3f v0 = m.positions[m.indices[3 * t]], v1 = m.positions[m.indices[3 * t + 1]],
+                        v2 = m.positions[m.indices[3 * t + 2]];
+            // A triangle stored in several bricks (it crosses cells) counts once: in its centroid's brick.
+            if (tree_.Locate((v0 + v1 + v2) * (1.f / 3.f)) == b) triangles.push_back({v0, v1, v2});
+        }
+    }
+    if (triangles.empty()) {
+        return InvalidArgumentError("render.sky_sampling = \"portals\" but the model has no triangle of a "
+                                    "portal material");
+    }
+    NAVE_RETURN_IF_ERROR(SetPortals(triangles));
+    sky_portals_ = true;
+    return Status::Ok();
+}
+
+float Engine::SkyPdf(const Vec3f& p, const Vec3f& w) const {
+    if (!sky_portals_) return UniformSpherePdf();
+    double portal_pdf = 0;
+    BrickHit hit;
+    int crossings = 0;
+    for (float t0 = 0; crossings < 64 && portal_scene_->Intersect(p, w, t0, kInfinity, &hit); ++crossings) {
+        const float cos_theta = std::abs(Dot(Normalize(hit.ng), w));
+        if (cos_theta > 1e-6f) portal_pdf += double(hit.t) * hit.t / (double(cos_theta) * portal_area_);
+        t0 = hit.t * (1 + 1e-6f) + 1e-6f;
+    }
+    return float((1 - kPortalSkyShare) * UniformSpherePdf() + kPortalSkyShare * portal_pdf);
+}
 
 Status Engine::BuildEmitters() {
     const Bounds3f& bounds = scene_.source->bounds();
@@ -670,22 +782,7 @@ Status Engine::BuildEmitters() {
         emitters_.push_back(e);
         weights.push_back(w);
     }
-    if (scene_.sky && want_portals && !portal_triangles.empty()) {
-        store::BrickMesh mesh;
-        portal_area_cdf_.push_back(0);
-        for (const auto& t : portal_triangles) {
-            uint32_t base = uint32_t(mesh.positions.size());
-            mesh.positions.insert(mesh.positions.end(), {t[0], t[1], t[2]});
-            mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
-            mesh.material_ids.push_back(0);
-            portal_area_ += 0.5 * double(Length(Cross(t[1] - t[0], t[2] - t[0])));
-            portal_area_cdf_.push_back(portal_area_);
-        }
-        for (double& c : portal_area_cdf_) c /= portal_area_;
-        portal_triangles_ = portal_triangles;
-        NAVE_ASSIGN_OR_RETURN(portal_scene_,
-                              ResidentBrick::Build(scene_.source->device(), 0, bounds, std::move(mesh)));
-    }
+    if (scene_.sky && want_portals && !portal_triangles.empty()) NAVE_RETURN_IF_ERROR(SetPortals(portal_triangles));
     if (scene_.sky) {
         Emitter e;
         e.kind = Emitter::Kind::kSky;
@@ -849,6 +946,7 @@ Status Engine::RunPhoton() {
     const uint64_t photons = scene_.settings.photons_per_iteration;
     const uint64_t wave = scene_.settings.wave_paths;
     NAVE_RETURN_IF_ERROR(BuildEmitters());
+    NAVE_RETURN_IF_ERROR(BuildSkyPortals());
     float radius = scene_.settings.initial_radius_m > 0 ? scene_.settings.initial_radius_m
                                                          : 0.01f * 2 * scene_radius_;
     visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius);

@@ -33,7 +33,9 @@ struct RayRecord {
     uint8_t kind = kPathRay;
     uint8_t flags = 0;
     uint16_t vertex = 0;   ///< surfaces met so far, passes through thin glass included (keys the random numbers)
-    float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun)
+    float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
+    float since_vertex = 0;  ///< distance from the last scattering vertex to `origin` (passes through thin
+                             ///< glass move the origin along the ray; the sky's MIS needs the vertex)
     SampledSpectrum beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };

@@ -483,6 +483,16 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
         return InvalidArgumentError("{}: render.photon_target: '{}' (expected \"bounds\" or \"portals\")",
                                     r.WhereTable(), target);
     }
+    std::string sky = "uniform";
+    NAVE_RETURN_IF_ERROR(r.String("sky_sampling", &sky));
+    if (sky == "uniform") {
+        s->sky_sampling = RenderSettings::SkySampling::kUniform;
+    } else if (sky == "portals") {
+        s->sky_sampling = RenderSettings::SkySampling::kPortals;
+    } else {
+        return InvalidArgumentError("{}: render.sky_sampling: '{}' (expected \"uniform\" or \"portals\")",
+                                    r.WhereTable(), sky);
+    }
     return r.Finish();
 }
 

@@ -116,6 +116,10 @@ struct RenderSettings {
     /// light's direction, or the triangles of materials marked `portal` (windows) only.
     enum class PhotonTarget { kBounds, kPortals };
     PhotonTarget photon_target = PhotonTarget::kBounds;
+    /// How next-event estimation picks sky directions: uniformly over the sphere, or mostly toward the
+    /// triangles of `portal` materials (windows), which an interior sees the sky through.
+    enum class SkySampling { kUniform, kPortals };
+    SkySampling sky_sampling = SkySampling::kUniform;
 };
 
 struct OutputConfig {
