@@ -130,6 +130,23 @@ class TableReader {
         *out = *n->value<std::string>();
         return Status::Ok();
     }
+    /// A string naming one of `choices`; anything else is an error listing them.
+    template <typename E>
+    Status Choice(std::string_view key, std::initializer_list<std::pair<const char*, E>> choices, E* out) {
+        const toml::node* n = Take(key);
+        if (n == nullptr) return Status::Ok();
+        if (!n->is_string()) return TypeError(key, *n, "a string");
+        const std::string value = *n->value<std::string>();
+        std::vector<std::string> names;
+        for (const auto& [name, e] : choices) {
+            if (value == name) {
+                *out = e;
+                return Status::Ok();
+            }
+            names.push_back(fmt::format("\"{}\"", name));
+        }
+        return RangeError(key, *n, fmt::format("'{}' (expected {})", value, fmt::join(names, " or ")));
+    }
     Status Vec3(std::string_view key, Vec3f* out) {
         const toml::node* n = Take(key);
         if (n == nullptr) return Status::Ok();
@@ -473,26 +490,12 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Int("seed", &s->seed, 0, INT64_MAX));
     NAVE_RETURN_IF_ERROR(r.Int("threads", &s->threads, 0, 4096));
     NAVE_RETURN_IF_ERROR(r.Int("wave_paths", &s->wave_paths, 1024, int64_t(1) << 30));
-    std::string target = "bounds";
-    NAVE_RETURN_IF_ERROR(r.String("photon_target", &target));
-    if (target == "bounds") {
-        s->photon_target = RenderSettings::PhotonTarget::kBounds;
-    } else if (target == "portals") {
-        s->photon_target = RenderSettings::PhotonTarget::kPortals;
-    } else {
-        return InvalidArgumentError("{}: render.photon_target: '{}' (expected \"bounds\" or \"portals\")",
-                                    r.WhereTable(), target);
-    }
-    std::string sky = "uniform";
-    NAVE_RETURN_IF_ERROR(r.String("sky_sampling", &sky));
-    if (sky == "uniform") {
-        s->sky_sampling = RenderSettings::SkySampling::kUniform;
-    } else if (sky == "portals") {
-        s->sky_sampling = RenderSettings::SkySampling::kPortals;
-    } else {
-        return InvalidArgumentError("{}: render.sky_sampling: '{}' (expected \"uniform\" or \"portals\")",
-                                    r.WhereTable(), sky);
-    }
+    NAVE_RETURN_IF_ERROR(r.Choice("photon_target", {{"bounds", RenderSettings::PhotonTarget::kBounds},
+                                                    {"portals", RenderSettings::PhotonTarget::kPortals}},
+                                  &s->photon_target));
+    NAVE_RETURN_IF_ERROR(r.Choice("sky_sampling", {{"uniform", RenderSettings::SkySampling::kUniform},
+                                                   {"portals", RenderSettings::SkySampling::kPortals}},
+                                  &s->sky_sampling));
     return r.Finish();
 }
 

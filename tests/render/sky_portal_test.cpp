@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "render/brick_source.h"
@@ -64,25 +65,31 @@ spp = 32
 max_depth = 1
 )";
 
+/// The room split into n^3 bricks, with its two materials.
+std::unique_ptr<MemoryBrickSource> RoomSource(int n) {
+    auto device = EmbreeDevice::Create();
+    EXPECT_TRUE(device.ok());
+    GridBricks grid = SplitIntoGridBricks(Room(), n, n, n);
+    store::MaterialRecord wall, window;
+    wall.name = "wall";
+    window.name = "window";
+    return std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes,
+                                               std::vector<store::MaterialRecord>{wall, window});
+}
+
 struct Result {
     double mean = 0;   ///< mean luminance over the image
     double noise = 0;  ///< RMS of the per-pixel difference between two seeds, over sqrt(2)
 };
 
 Result RenderRoom(const std::string& sky_sampling) {
-    auto device = EmbreeDevice::Create();
-    EXPECT_TRUE(device.ok());
-    GridBricks grid = SplitIntoGridBricks(Room(), 2, 2, 2);
-    store::MaterialRecord wall, window;
-    wall.name = "wall";
-    window.name = "window";
-    MemoryBrickSource source(*device, grid.tree, grid.meshes, {wall, window});
+    std::unique_ptr<MemoryBrickSource> source = RoomSource(2);
     auto config = ParseSceneConfig(std::string(kConfig) + "sky_sampling = \"" + sky_sampling + "\"\n", "room");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     std::vector<double> y[2];
     for (int seed = 0; seed < 2; ++seed) {
         config->render.seed = uint64_t(seed + 1);
-        auto scene = BuildRenderScene(*config, source);
+        auto scene = BuildRenderScene(*config, *source);
         EXPECT_TRUE(scene.ok()) << scene.status().ToString();
         Film film(config->camera.width, config->camera.height, config->output);
         RenderStats stats;
@@ -116,14 +123,8 @@ TEST(SkyPortals, PortalSamplingWithoutPortalsIsAnError) {
     text.replace(text.find("portal = true"), std::string("portal = true").size(), "");
     auto config = ParseSceneConfig(text + "sky_sampling = \"portals\"\n", "room");
     ASSERT_TRUE(config.ok()) << config.status().ToString();
-    auto device = EmbreeDevice::Create();
-    ASSERT_TRUE(device.ok());
-    GridBricks grid = SplitIntoGridBricks(Room(), 1, 1, 1);
-    store::MaterialRecord wall, window;
-    wall.name = "wall";
-    window.name = "window";
-    MemoryBrickSource source(*device, grid.tree, grid.meshes, {wall, window});
-    auto scene = BuildRenderScene(*config, source);
+    std::unique_ptr<MemoryBrickSource> source = RoomSource(1);
+    auto scene = BuildRenderScene(*config, *source);
     ASSERT_TRUE(scene.ok());
     Film film(config->camera.width, config->camera.height, config->output);
     RenderStats stats;
