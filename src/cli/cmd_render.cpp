@@ -11,6 +11,7 @@
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
+#include "render/pager.h"
 #include "render/procedural_scenes.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
@@ -27,6 +28,8 @@ struct RenderOptions {
     std::optional<uint64_t> seed, photons;
     std::string mode;
     std::string resolution;  // "WxH"
+    std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
+    std::string pager;       // --pager TUNABLES
 };
 
 /// Parses "960x640" into width and height.
@@ -79,9 +82,39 @@ Status RunRender(const RenderOptions& o) {
               config.camera.width, config.camera.height, ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
 
+    // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process); the
+    // bricks get what is left (docs/pager.md).
+    std::optional<render::PagerOptions> paging;
+    if (!o.memory.empty() || !o.pager.empty()) {
+        if (o.memory.empty()) return InvalidArgumentError("--pager {}: tunables need --memory SIZE", o.pager);
+        NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
+        render::PagerOptions options;
+        NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
+        const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width,
+                                                            config.camera.height, source->brick_count());
+        const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        if (memory < reserve + need.min_bytes) {
+            return InvalidArgumentError(
+                "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
+                "resident{}, and the reserve for the film, ray queues and process is {}: at least {} ({} bytes) "
+                "is needed",
+                o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
+                options.prefetch && need.second_bytes > 0
+                    ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
+                                  FormatBytes(need.second_bytes))
+                    : std::string(),
+                FormatBytes(reserve), FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes);
+        }
+        options.brick_budget_bytes = memory - reserve;
+        log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once), {} reserved", FormatBytes(memory),
+                  FormatBytes(options.brick_budget_bytes), FormatBytes(need.total_bytes), source->brick_count(),
+                  FormatBytes(reserve));
+        paging = options;
+    }
+
     render::Film film(config.camera.width, config.camera.height, config.output);
     render::RenderStats stats;
-    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats));
+    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, paging ? &*paging : nullptr));
 
     const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);
@@ -91,9 +124,13 @@ Status RunRender(const RenderOptions& o) {
         config.render.seed, config.render.max_depth, config.render.threads);
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
-        "bytes_read={} peak_rss={}",
+        "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} brick_reloads={} "
+        "prefetch_loads={} prefetch_hits={} stall={:.3f}s",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
-        stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes);
+        stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
+        stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes) : std::string("in-core"),
+        stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads, stats.prefetch_hits,
+        stats.stall_seconds);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -119,6 +156,18 @@ Status RunRender(const RenderOptions& o) {
                  FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),
                  FormatBytes(stats.bytes_read).c_str(), FormatBytes(stats.peak_rss_bytes).c_str(),
                  FormatBytes(stats.peak_queue_bytes).c_str());
+    std::fprintf(stderr, "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
+                 "resident when needed %s of %s, workers stalled on loads %s\n",
+                 paging ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")").c_str()
+                        : "in-core",
+                 FormatBytes(stats.peak_brick_bytes).c_str(),
+                 paging ? fmt::format(" ({:.0f}% of budget)",
+                                      100.0 * double(stats.peak_brick_bytes) / double(stats.brick_budget_bytes))
+                              .c_str()
+                        : "",
+                 FormatCount(double(stats.brick_evictions)).c_str(), FormatCount(double(stats.brick_reloads)).c_str(),
+                 FormatCount(double(stats.prefetch_loads)).c_str(), FormatCount(double(stats.prefetch_hits)).c_str(),
+                 FormatCount(double(stats.brick_acquires)).c_str(), FormatDuration(stats.stall_seconds).c_str());
     return Status::Ok();
 }
 
@@ -141,6 +190,12 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
+    cmd->add_option("--memory", opts->memory,
+                    "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
+                    "Default: every brick stays resident once loaded");
+    cmd->add_option("--pager", opts->pager,
+                    "Pager tunables with --memory: prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION "
+                    "(comma separated; docs/pager.md)");
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }
 
