@@ -25,7 +25,7 @@ struct RenderOptions {
     std::string config;
     std::string output;
     std::optional<int> spp, iterations, threads;
-    std::optional<uint64_t> seed, photons;
+    std::optional<uint64_t> seed, photons, wave_paths;
     std::string mode;
     std::string resolution;  // "WxH"
     std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
@@ -67,6 +67,7 @@ Status RunRender(const RenderOptions& o) {
     if (o.threads) config.render.threads = *o.threads;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
+    if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
 
@@ -96,19 +97,21 @@ Status RunRender(const RenderOptions& o) {
         if (memory < reserve + need.min_bytes) {
             return InvalidArgumentError(
                 "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
-                "resident{}, and the reserve for the film, ray queues and process is {}: at least {} ({} bytes) "
-                "is needed",
+                "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes): at least {} ({} "
+                "bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
                 o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
                 options.prefetch && need.second_bytes > 0
                     ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
                                   FormatBytes(need.second_bytes))
                     : std::string(),
-                FormatBytes(reserve), FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes);
+                FormatBytes(reserve), reserve, FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes,
+                source->brick_count(), FormatBytes(need.total_bytes), need.total_bytes);
         }
         options.brick_budget_bytes = memory - reserve;
-        log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once), {} reserved", FormatBytes(memory),
-                  FormatBytes(options.brick_budget_bytes), FormatBytes(need.total_bytes), source->brick_count(),
-                  FormatBytes(reserve));
+        log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
+                  "reserved", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
+                  FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
+                  reserve);
         paging = options;
     }
 
@@ -190,6 +193,10 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
+    cmd->add_option("--wave-paths", opts->wave_paths,
+                    "Camera paths (or photons) in flight at once (default 1048576): more rays per brick visit, so "
+                    "fewer loads under --memory, for more ray-queue memory")
+        ->check(CLI::Range(uint64_t(1024), uint64_t(1) << 31));
     cmd->add_option("--memory", opts->memory,
                     "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
                     "Default: every brick stays resident once loaded");

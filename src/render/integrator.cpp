@@ -522,7 +522,7 @@ Status Engine::Drain() {
         batches_.fetch_add(1, std::memory_order_relaxed);
         if (pager_) {
             waiting[b] -= batch.size();
-            pager_->Prefetch(waiting, b);  // loads the next brick while this batch is traced
+            pager_->Prefetch(waiting, b, batch.size());  // loads the next brick while this batch is traced
         }
         const ResidentBrick& brick = *handle;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), kChunk), [&](const tbb::blocked_range<size_t>& range) {

@@ -14,7 +14,8 @@ namespace nave::render {
 // ---------------------------------------------------------------------------------------------- options
 
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
-    constexpr const char* kKeys = "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION";
+    constexpr const char* kKeys =
+        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -33,6 +34,14 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                 options->prefetch = false;
             } else {
                 return InvalidArgumentError("pager tunable prefetch={}: expected on or off", value);
+            }
+        } else if (key == "evict") {
+            if (value == "lru") {
+                options->evict_least_traffic = false;
+            } else if (value == "traffic") {
+                options->evict_least_traffic = true;
+            } else {
+                return InvalidArgumentError("pager tunable evict={}: expected lru or traffic", value);
             }
         } else if (key == "nearly_empty") {
             uint64_t rays = 0;
@@ -111,6 +120,7 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       state_(source.brick_count(), State::kAbsent),
       bytes_(source.brick_count(), 0),
       last_used_(source.brick_count(), 0),
+      traffic_(source.brick_count(), 0),
       load_count_(source.brick_count(), 0),
       request_(store::kNoBrick),
       loader_target_(store::kNoBrick) {
@@ -218,6 +228,7 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
     if (committed_bytes_ + need <= budget) return true;
     struct Candidate {
         size_t waiting;
+        uint64_t traffic;
         uint64_t last_used;
         uint32_t id;
     };
@@ -226,12 +237,17 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
         if (state_[b] != State::kResident || b == exclude) continue;
         size_t w = waiting_ ? waiting_(b) : 0;
         if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
-        candidates.push_back({w, last_used_[b], b});
+        // Nearly empty queues count as empty when traffic decides: their few rays matter less than how busy
+        // the brick is.
+        if (options_.evict_least_traffic && w < options_.nearly_empty_rays) w = 0;
+        candidates.push_back({w, options_.evict_least_traffic ? traffic_[b] : 0, last_used_[b], b});
     }
     // Emptiest queue first: the fewer rays wait for a brick, the fewer need it back soon (the paper unloads a
     // sub-model once almost all its rays are handled); least recently used breaks ties.
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-        return a.waiting != b.waiting ? a.waiting < b.waiting : a.last_used < b.last_used;
+        if (a.waiting != b.waiting) return a.waiting < b.waiting;
+        if (a.traffic != b.traffic) return a.traffic < b.traffic;
+        return a.last_used < b.last_used;
     });
     for (const Candidate& c : candidates) {
         if (committed_bytes_ + need <= budget) break;
@@ -302,9 +318,10 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     }
 }
 
-void Pager::Prefetch(const std::vector<size_t>& waiting, uint32_t current) {
-    if (!options_.prefetch) return;
+void Pager::Prefetch(const std::vector<size_t>& waiting, uint32_t current, size_t batch_rays) {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (current < traffic_.size()) traffic_[current] += batch_rays;
+    if (!options_.prefetch) return;
     uint32_t best = store::kNoBrick;
     for (uint32_t b = 0; b < waiting.size(); ++b) {
         if (b == current || waiting[b] == 0 || state_[b] != State::kAbsent) continue;

@@ -36,9 +36,12 @@ struct PagerOptions {
     /// (Loads the scheduler cannot avoid evict whatever is unpinned, emptiest first.)
     size_t nearly_empty_rays = 4096;
     /// Process the fullest resident brick instead of loading the fullest brick when the resident one has at
-    /// least this fraction of the fullest brick's rays waiting (0: always prefer resident bricks; above 1:
-    /// always the fullest brick, as in-core).
-    double prefer_resident = 0.25;
+    /// least this fraction of the fullest brick's rays waiting (0: drain resident bricks before any load;
+    /// above 1: always the fullest brick, as in-core).
+    double prefer_resident = 0;
+    /// Among bricks evictable alike, evict first the least recently used (false) or the one that has taken
+    /// the fewest rays so far (true: busy bricks, like the floor in view, stay).
+    bool evict_least_traffic = false;
 };
 
 /// Parses "prefetch=off,nearly_empty=4096,prefer_resident=0.25" (any subset, comma separated) into
@@ -101,7 +104,8 @@ class Pager {
     StatusOr<BrickHandle> Acquire(uint32_t id);
     /// A batch of brick `current` starts: asks the loader to load the fullest non-resident brick other than
     /// `current` meanwhile, evicting only nearly empty bricks (waiting for a batch end if none is).
-    void Prefetch(const std::vector<size_t>& waiting, uint32_t current);
+    /// `batch_rays`: rays taken from `current`'s queue for this batch (its traffic, for eviction choices).
+    void Prefetch(const std::vector<size_t>& waiting, uint32_t current, size_t batch_rays);
     /// The scheduler released its pin on the batch's brick: a loader waiting for room may retry.
     void BatchDone();
     PagerStats stats() const;
@@ -128,6 +132,7 @@ class Pager {
     std::vector<State> state_;
     std::vector<uint64_t> bytes_;        // resident: real bytes; loading: the reserved estimate
     std::vector<uint64_t> last_used_;    // tick of the last pick or load
+    std::vector<uint64_t> traffic_;      // rays taken from the brick's queue so far
     std::vector<uint32_t> load_count_;
     uint64_t tick_ = 0;
     uint64_t committed_bytes_ = 0;
