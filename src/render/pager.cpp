@@ -1,5 +1,7 @@
 #include "render/pager.h"
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -346,6 +348,10 @@ PagerStats Pager::stats() const {
 }
 
 void Pager::LoaderLoop() {
+    // Loads run in a one-thread arena of their own: the render's workers are busy tracing, and Embree builds
+    // the brick's BVH with the threads of the arena it is called from (outside any arena it would use TBB's
+    // default pool: more threads than cores, each with its own build buffers).
+    tbb::task_arena arena(1);
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
         loader_cv_.wait(lock, [&] { return stop_ || request_ != store::kNoBrick; });
@@ -372,7 +378,8 @@ void Pager::LoaderLoop() {
         }
         if (reserved) {
             lock.unlock();
-            StatusOr<BrickHandle> handle = source_.Acquire(target);
+            StatusOr<BrickHandle> handle = BrickHandle();
+            arena.execute([&] { handle = source_.Acquire(target); });
             const bool ok = handle.ok();
             const uint64_t bytes = ok ? (*handle)->memory_bytes() : 0;
             // Unpinned at once: the brick stays resident until the scheduler picks it or a load evicts it.
