@@ -110,8 +110,14 @@ class Engine {
         r.t_exit = s.t_exit;
         return s.brick;
     }
-    /// Runs the scheduler until every queue is empty.
-    Status Drain();
+    /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty).
+    Status Drain(size_t stop_below = 0);
+    /// Rays left waiting when the next wave is generated: under paging the next wave joins the tail of the
+    /// previous one, whose few scattered rays would otherwise cost a load each (docs/pager.md); in-core,
+    /// waves do not overlap.
+    size_t WaveOverlap() const {
+        return pager_ ? size_t(pager_->options().wave_overlap * double(scene_.settings.wave_paths)) : 0;
+    }
     void Flush(Outbox& out, const LocalCounters& c);
     void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
     /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if the path ends.
@@ -506,13 +512,13 @@ void Engine::Flush(Outbox& out, const LocalCounters& c) {
     rays_.fetch_add(c.rays, std::memory_order_relaxed);
 }
 
-Status Engine::Drain() {
+Status Engine::Drain(size_t stop_below) {
     std::vector<RayRecord> batch;
     std::vector<size_t> waiting(queues_.brick_count());
     for (;;) {
         size_t total = 0;
         for (uint32_t i = 0; i < queues_.brick_count(); ++i) total += waiting[i] = queues_.Waiting(i);
-        if (total == 0) break;
+        if (total <= stop_below) break;
         const uint32_t b = pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, *scene_.source);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0) << "the brick picker chose brick " << b
                                                          << " which has no rays waiting";
@@ -578,13 +584,14 @@ Status Engine::RunPath() {
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
             for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(WaveOverlap()));
             progress.Add((last - first) * uint64_t(s_end - s));
         }
         passes = s_end;
         double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
     }
+    NAVE_RETURN_IF_ERROR(Drain());  // the last wave's tail
     progress.Finish();
     stats_->samples_per_pixel = passes;
     stats_->camera_paths = pixels * uint64_t(passes);
@@ -863,14 +870,15 @@ Status Engine::RunPhoton() {
             SampledWavelengths::SampleVisible(VertexRng(RngKey{scene_.settings.seed, 0, 0, 0, iteration_,
                                                                kStreamLambda}).Uniform(0));
         visible_->BeginIteration(lambda);
+        // Visible points must all be in place before photons arrive: waves overlap within each pass only.
         for (uint64_t first = 0; first < pixels; first += wave) {
             GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(first + wave < pixels ? WaveOverlap() : 0));
         }
         visible_->BuildBrickGrids(tree_);
         for (uint64_t first = 0; first < photons; first += wave) {
             EmitPhotons(first, std::min(photons, first + wave), lambda);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(first + wave < photons ? WaveOverlap() : 0));
         }
         visible_->EndIteration(scene_.settings.alpha);
         done = it + 1;

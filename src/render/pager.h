@@ -42,6 +42,9 @@ struct PagerOptions {
     /// Among bricks evictable alike, evict first the least recently used (false) or the one that has taken
     /// the fewest rays so far (true: busy bricks, like the floor in view, stay).
     bool evict_least_traffic = false;
+    /// The next wave of camera paths (or photons) is generated once no more than this fraction of a wave's
+    /// paths are still waiting, so that its rays join the previous wave's tail (0: waves do not overlap).
+    double wave_overlap = 0.25;
 };
 
 /// Parses "prefetch=off,nearly_empty=4096,prefer_resident=0.25" (any subset, comma separated) into
@@ -109,6 +112,7 @@ class Pager {
     /// The scheduler released its pin on the batch's brick: a loader waiting for room may retry.
     void BatchDone();
     PagerStats stats() const;
+    const PagerOptions& options() const { return options_; }
 
   private:
     enum class State : uint8_t { kAbsent, kLoading, kResident };

@@ -100,12 +100,14 @@ struct Rendered {
     Status status;
 };
 
-Rendered RenderBallGrid(const std::string& mode, const PagerOptions* paging, int threads = 2) {
+Rendered RenderBallGrid(const std::string& mode, const PagerOptions* paging, int threads = 2,
+                        uint32_t wave_paths = 0) {
     Rendered r;
     r.source = BallGridSource();
     auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), mode), "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     config->render.threads = threads;
+    if (wave_paths > 0) config->render.wave_paths = wave_paths;
     auto scene = BuildRenderScene(*config, *r.source);
     EXPECT_TRUE(scene.ok()) << scene.status().ToString();
     r.film = std::make_unique<Film>(config->camera.width, config->camera.height, config->output);
@@ -127,15 +129,18 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
     const BrickBudgetMinimum m = MinimumBrickBudget(*in_core.source, true);
     EXPECT_GE(in_core.source->brick_count(), 30u);
-    for (bool prefetch : {true, false}) {
+    // Prefetching on and off; then small waves (the in-core render has one), which under paging overlap.
+    for (int variant = 0; variant < 3; ++variant) {
+        const bool prefetch = variant != 1;
+        const uint32_t wave_paths = variant == 2 ? 500 : 0;
         PagerOptions options = SmallBudget(*in_core.source, prefetch);
         EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4) << "the test scene should allow a small budget";
-        Rendered paged = RenderBallGrid(mode, &options);
+        Rendered paged = RenderBallGrid(mode, &options, 2, wave_paths);
         ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
         EXPECT_GT(MeanY(*paged.film), 0.0);
         // Same bounds as the brick-count and brick-order tests (render_test.cpp): path mode differs only by
         // double summation order; photon deposits add floats atomically.
-        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound) << mode << " prefetch " << prefetch;
+        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound) << mode << " variant " << variant;
         // The budget holds, by the pager's count and by the source's own.
         EXPECT_LE(paged.stats.peak_brick_bytes, options.brick_budget_bytes);
         EXPECT_LE(paged.source->stats().peak_resident_bytes, options.brick_budget_bytes);
@@ -302,12 +307,16 @@ TEST_F(PagerTest, PickPrefersAResidentBrickWithEnoughRays) {
 
 TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     PagerOptions o;
-    ASSERT_TRUE(ParsePagerTunables("prefetch=off,nearly_empty=100,prefer_resident=0.5", &o).ok());
+    ASSERT_TRUE(ParsePagerTunables("prefetch=off,nearly_empty=100,prefer_resident=0.5,evict=traffic,overlap=0",
+                                   &o).ok());
     EXPECT_FALSE(o.prefetch);
+    EXPECT_TRUE(o.evict_least_traffic);
+    EXPECT_EQ(o.wave_overlap, 0.0);
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11", "prefetch"}) {
+    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11", "prefetch",
+                            "evict=random", "overlap=2"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
