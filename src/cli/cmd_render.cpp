@@ -91,8 +91,8 @@ Status RunRender(const RenderOptions& o) {
         NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
         render::PagerOptions options;
         NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
-        const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width,
-                                                            config.camera.height, source->brick_count());
+        const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
+                                                            source->brick_count(), options.wave_overlap);
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
         if (memory < reserve + need.min_bytes) {
             return InvalidArgumentError(

@@ -100,7 +100,8 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
     return m;
 }
 
-uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count) {
+uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count,
+                            double wave_overlap) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
     // The process without bricks: code, Embree's device, TBB's threads, the store's tables, allocator slack.
     const uint64_t kProcess = (32ull << 20) + uint64_t(brick_count) * 256;
@@ -114,8 +115,8 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
         in_flight = std::max<uint64_t>(in_flight, std::min<uint64_t>(settings.wave_paths,
                                                                      settings.photons_per_iteration));
     }
-    // Under paging the next wave is generated while a quarter of a wave is still waiting (wave_overlap).
-    in_flight += in_flight / 4;
+    // Under paging the next wave is generated while wave_overlap of a wave is still waiting.
+    in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) * std::clamp(wave_overlap, 0.0, 1.0));
     const uint64_t queues = 3 * in_flight * sizeof(RayRecord);
     // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and references
     // to the points in the brick grids.

@@ -44,7 +44,7 @@ struct PagerOptions {
     bool evict_least_traffic = false;
     /// The next wave of camera paths (or photons) is generated once no more than this fraction of a wave's
     /// paths are still waiting, so that its rays join the previous wave's tail (0: waves do not overlap).
-    double wave_overlap = 0.25;
+    double wave_overlap = 0.5;
 };
 
 /// Parses "prefetch=off,nearly_empty=4096,prefer_resident=0.25" (any subset, comma separated) into
@@ -65,7 +65,9 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch);
 
 /// Memory `nave render --memory` sets aside for everything but bricks: the film, the ray queues of a wave
 /// and the process itself (code, Embree and TBB state, the store's tables); see docs/pager.md.
-uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count);
+/// `wave_overlap`: PagerOptions::wave_overlap (more rays in flight).
+uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count,
+                            double wave_overlap);
 
 /// What the pager did during one render.
 struct PagerStats {
