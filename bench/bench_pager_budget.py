@@ -97,13 +97,24 @@ def main():
     common = [args.nave, "render", store, "--config", args.config, "--mode", "path", "--resolution",
               args.resolution, "--spp", str(args.spp), "--threads", str(args.threads), "--wave-paths", str(wave)]
 
-    # The reserve and the in-core brick bytes, from the refusal of a 1-byte budget.
-    p = run(common + ["--memory", "1", "-o", os.path.join(args.out, "never.exr")], log)
-    m_reserve = re.search(r"ray queues and process is [^(]*\((\d+) bytes\)", p.stdout)
-    m_total = re.search(r"resident at once take [^,]*, (\d+) bytes", p.stdout)
-    if p.returncode == 0 or not m_reserve or not m_total:
-        sys.exit(f"could not read the reserve and brick bytes from nave's refusal, see {log.name}")
-    reserve, total = int(m_reserve.group(1)), int(m_total.group(1))
+    # The reserve and the in-core brick bytes, from the refusal of a 1-byte budget (per tunables: the wave
+    # overlap changes the reserve, and the brick budget must stay the same fraction).
+    reserves = {}
+
+    def reserve_and_total(tunables):
+        if tunables not in reserves:
+            cmd = common + ["--memory", "1", "-o", os.path.join(args.out, "never.exr")]
+            if tunables:
+                cmd += ["--pager", tunables]
+            p = run(cmd, log)
+            m_reserve = re.search(r"ray queues and process is [^(]*\((\d+) bytes\)", p.stdout)
+            m_total = re.search(r"resident at once take [^,]*, (\d+) bytes", p.stdout)
+            if p.returncode == 0 or not m_reserve or not m_total:
+                sys.exit(f"could not read the reserve and brick bytes from nave's refusal, see {log.name}")
+            reserves[tunables] = (int(m_reserve.group(1)), int(m_total.group(1)))
+        return reserves[tunables]
+
+    reserve, total = reserve_and_total("")
     print(f"in-core bricks {total / 2**20:.1f} MiB, reserve {reserve / 2**20:.1f} MiB, wave {wave} paths",
           file=sys.stderr)
 
@@ -111,7 +122,8 @@ def main():
         exr = os.path.join(args.out, f"{label}.exr")
         cmd = ["/usr/bin/time", "-f", "rss_kb=%M cpu_s=%U+%S"] + common + ["-o", exr]
         if fraction is not None:
-            cmd += ["--memory", str(reserve + int(fraction * total))]
+            variant_reserve, _ = reserve_and_total(tunables)
+            cmd += ["--memory", str(variant_reserve + int(fraction * total))]
         if tunables:
             cmd += ["--pager", tunables]
         start = time.time()
@@ -134,7 +146,10 @@ def main():
             "evictions": int(stats["brick_evictions"]),
             "bytes_read": int(stats["bytes_read"]),
             "peak_brick_bytes": int(stats["peak_brick_bytes"]),
-            "peak_rss_bytes": int(rss.group(1)) * 1024 if rss else int(stats["peak_rss"]),
+            # The render's peak (nave measures it when tracing ends) and the whole process's, which includes
+            # writing the images through the OpenImageIO plugin afterwards.
+            "peak_rss_bytes": int(stats["peak_rss"]),
+            "process_peak_rss_bytes": int(rss.group(1)) * 1024 if rss else "",
             "stall_s": stats["stall"],
             "prefetch_loads": int(stats["prefetch_loads"]),
             "prefetch_hits": int(stats["prefetch_hits"]),
@@ -162,7 +177,8 @@ def main():
 
     csv_path = os.path.join(args.out, "pager_budget.csv")
     fields = ["label", "budget_fraction", "brick_budget_bytes", "tunables", "time_s", "time_ratio", "runs_s", "cpu_s",
-              "loads", "reloads", "evictions", "bytes_read", "peak_brick_bytes", "peak_rss_bytes", "stall_s",
+              "loads", "reloads", "evictions", "bytes_read", "peak_brick_bytes", "peak_rss_bytes",
+              "process_peak_rss_bytes", "stall_s",
               "prefetch_loads", "prefetch_hits", "brick_visits", "process_s"]
     with open(csv_path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=fields)

@@ -523,6 +523,9 @@ Status Engine::Drain(size_t stop_below) {
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0) << "the brick picker chose brick " << b
                                                          << " which has no rays waiting";
         stats_->peak_queue_bytes = std::max<uint64_t>(stats_->peak_queue_bytes, queues_.MemoryBytes());
+        // If b must be loaded now, the loader loads the next brick meanwhile: two loads at once while the
+        // workers would idle anyway.
+        if (pager_ && !scene_.source->IsResident(b)) pager_->Prefetch(waiting, b, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, AcquireBrick(b));
         queues_.Take(b, kMaxBatch, &batch);
         batches_.fetch_add(1, std::memory_order_relaxed);
