@@ -3,6 +3,9 @@
 
 #include <cstdio>
 #include <optional>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "cli/commands.h"
 #include "core/log.h"
@@ -118,6 +121,11 @@ Status RunRender(const RenderOptions& o) {
     render::Film film(config.camera.width, config.camera.height, config.output);
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, paging ? &*paging : nullptr));
+#if defined(__GLIBC__)
+    // The ray queues are gone: give their pages back before the image writer loads OpenImageIO, so that the
+    // process stays near --memory (glibc keeps freed heap pages otherwise).
+    if (paging) malloc_trim(0);
+#endif
 
     const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);

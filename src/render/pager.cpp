@@ -103,8 +103,9 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
 uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count,
                             double wave_overlap) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
-    // The process without bricks: code, Embree's device, TBB's threads, the store's tables, allocator slack.
-    const uint64_t kProcess = (32ull << 20) + uint64_t(brick_count) * 256;
+    // The process without bricks: code, Embree's device, TBB's threads, the store's tables, allocator slack,
+    // and the image writer's OpenImageIO plugin loaded after the render (~40 MiB resident, measured).
+    const uint64_t kProcess = (56ull << 20) + uint64_t(brick_count) * 256;
     // Film: 3 doubles of XYZ, 7 floats of AOVs and a counter per pixel (film.h).
     const uint64_t film = pixels * (3 * 8 + 7 * 4 + 4);
     // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken from a
