@@ -1,6 +1,7 @@
-// The pager's decision cost (docs/pager.md): choosing the next brick among N, pinning a resident brick, and
-// a load that must first choose and evict a victim, for models of 256 to 65536 bricks. Bricks are single
-// triangles so that the load itself (copy + Embree build) costs little next to the decisions.
+// The pager's decision cost (docs/pager.md): choosing the next brick among N, pinning a resident
+// brick, and a load that must first choose and evict a victim, for models of 256 to 65536 bricks.
+// Bricks are single triangles so that the load itself (copy + Embree build) costs little next to
+// the decisions.
 //   build/release/bench/bench_pager --benchmark_counters_tabular=true
 
 #include <benchmark/benchmark.h>
@@ -88,8 +89,8 @@ void BM_PagerAcquireResident(benchmark::State& state) {
 BENCHMARK(BM_PagerAcquireResident)->Arg(4096);
 
 void BM_PagerLoadWithEviction(benchmark::State& state) {
-    // Half the bricks fit: every acquire of the sweep loads one brick and evicts one, chosen among the
-    // resident half by queue length then age.
+    // Half the bricks fit: every acquire of the sweep loads one brick and evicts one, chosen among
+    // the resident half by queue length then age.
     const uint32_t n = uint32_t(state.range(0));
     auto source = TinyBricks(n);
     std::vector<size_t> waiting = RandomWaiting(n);

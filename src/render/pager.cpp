@@ -13,15 +13,18 @@
 
 namespace nave::render {
 
-// ---------------------------------------------------------------------------------------------- options
+// ----------------------------------------------------------------------------------------------
+// options
 
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
-        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, overlap=FRACTION";
+        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, "
+        "overlap=FRACTION";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
-        std::string_view item = text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos);
+        std::string_view item =
+            text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos);
         pos = comma == std::string_view::npos ? text.size() + 1 : comma + 1;
         if (item.empty()) continue;
         size_t eq = item.find('=');
@@ -43,13 +46,15 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             } else if (value == "traffic") {
                 options->evict_least_traffic = true;
             } else {
-                return InvalidArgumentError("pager tunable evict={}: expected lru or traffic", value);
+                return InvalidArgumentError("pager tunable evict={}: expected lru or traffic",
+                                            value);
             }
         } else if (key == "nearly_empty") {
             uint64_t rays = 0;
             auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), rays);
             if (ec != std::errc() || end != value.data() + value.size()) {
-                return InvalidArgumentError("pager tunable nearly_empty={}: expected a ray count", value);
+                return InvalidArgumentError("pager tunable nearly_empty={}: expected a ray count",
+                                            value);
             }
             options->nearly_empty_rays = size_t(rays);
         } else if (key == "overlap") {
@@ -57,7 +62,8 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             char* end = nullptr;
             double f = std::strtod(v.c_str(), &end);
             if (v.empty() || end != v.c_str() + v.size() || !(f >= 0 && f <= 1)) {
-                return InvalidArgumentError("pager tunable overlap={}: expected a fraction in [0, 1]", value);
+                return InvalidArgumentError(
+                    "pager tunable overlap={}: expected a fraction in [0, 1]", value);
             }
             options->wave_overlap = f;
         } else if (key == "prefer_resident") {
@@ -65,7 +71,8 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             char* end = nullptr;
             double f = std::strtod(v.c_str(), &end);
             if (v.empty() || end != v.c_str() + v.size() || !(f >= 0)) {
-                return InvalidArgumentError("pager tunable prefer_resident={}: expected a fraction >= 0", value);
+                return InvalidArgumentError(
+                    "pager tunable prefer_resident={}: expected a fraction >= 0", value);
             }
             options->prefer_resident = f;
         } else {
@@ -100,32 +107,37 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
     return m;
 }
 
-uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height, uint32_t brick_count,
-                            double wave_overlap) {
+uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
+                            uint32_t brick_count, double wave_overlap) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
-    // The process without bricks: code, Embree's device, TBB's threads, the store's tables, allocator slack,
-    // and the image writer's OpenImageIO plugin loaded after the render (~40 MiB resident, measured).
+    // The process without bricks: code, Embree's device, TBB's threads, the store's tables,
+    // allocator slack, and the image writer's OpenImageIO plugin loaded after the render (~40 MiB
+    // resident, measured).
     const uint64_t kProcess = (56ull << 20) + uint64_t(brick_count) * 256;
     // Film: 3 doubles of XYZ, 7 floats of AOVs and a counter per pixel (film.h).
     const uint64_t film = pixels * (3 * 8 + 7 * 4 + 4);
-    // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken from a
-    // queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on the abbey.
-    const uint64_t per_pass = settings.mode == RenderSettings::Mode::kPath ? uint64_t(std::max(1, settings.spp)) : 1;
+    // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken
+    // from a queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on
+    // the abbey.
+    const uint64_t per_pass =
+        settings.mode == RenderSettings::Mode::kPath ? uint64_t(std::max(1, settings.spp)) : 1;
     uint64_t in_flight = std::min<uint64_t>(settings.wave_paths, pixels * per_pass);
     if (settings.mode == RenderSettings::Mode::kPhoton) {
-        in_flight = std::max<uint64_t>(in_flight, std::min<uint64_t>(settings.wave_paths,
-                                                                     settings.photons_per_iteration));
+        in_flight = std::max<uint64_t>(
+            in_flight, std::min<uint64_t>(settings.wave_paths, settings.photons_per_iteration));
     }
     // Under paging the next wave is generated while wave_overlap of a wave is still waiting.
-    in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) * std::clamp(wave_overlap, 0.0, 1.0));
+    in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) *
+                          std::clamp(wave_overlap, 0.0, 1.0));
     const uint64_t queues = 3 * in_flight * sizeof(RayRecord);
-    // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and references
-    // to the points in the brick grids.
+    // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and
+    // references to the points in the brick grids.
     const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton ? pixels * 256 : 0;
     return kProcess + film + queues + sppm;
 }
 
-// ---------------------------------------------------------------------------------------------- pager
+// ----------------------------------------------------------------------------------------------
+// pager
 
 Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting)
     : source_(source),
@@ -139,7 +151,8 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       request_(store::kNoBrick),
       loader_target_(store::kNoBrick) {
     estimate_.reserve(source.brick_count());
-    for (uint32_t b = 0; b < source.brick_count(); ++b) estimate_.push_back(source.EstimatedResidentBytes(b));
+    for (uint32_t b = 0; b < source.brick_count(); ++b)
+        estimate_.push_back(source.EstimatedResidentBytes(b));
     stats_.brick_budget_bytes = options.brick_budget_bytes;
 }
 
@@ -148,13 +161,14 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
     BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
     if (source.brick_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
         return InvalidArgumentError(
-            "brick memory budget {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} "
+            "brick memory budget {} ({} bytes) is too small for this model: its largest brick, "
+            "brick {}, takes {} "
             "({} bytes) when resident{}; the minimum brick budget is {} ({} bytes)",
             FormatBytes(options.brick_budget_bytes), options.brick_budget_bytes, need.largest_brick,
             FormatBytes(need.largest_bytes), need.largest_bytes,
             options.prefetch && need.second_bytes > 0
-                ? fmt::format(" and prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
-                              FormatBytes(need.second_bytes))
+                ? fmt::format(" and prefetching needs room for the next-largest, brick {} ({})",
+                              need.second_brick, FormatBytes(need.second_bytes))
                 : std::string(),
             FormatBytes(need.min_bytes), need.min_bytes);
     }
@@ -200,8 +214,9 @@ uint32_t Pager::Pick(const std::vector<size_t>& waiting) {
         }
     }
     if (state_[fullest] == State::kResident) return fullest;
-    // Tracing a resident brick's rays now costs no load and may let the loader bring the fullest brick in
-    // meanwhile; it pays when the resident brick's batch is large enough to be worth a visit.
+    // Tracing a resident brick's rays now costs no load and may let the loader bring the fullest
+    // brick in meanwhile; it pays when the resident brick's batch is large enough to be worth a
+    // visit.
     if (resident != store::kNoBrick &&
         double(waiting[resident]) >= options_.prefer_resident * double(waiting[fullest])) {
         return resident;
@@ -222,8 +237,10 @@ void Pager::Loaded(uint32_t id, uint64_t bytes, bool prefetched) {
         ++stats_.estimate_misses;
         if (!warned_estimate_) {
             warned_estimate_ = true;
-            log::Warning("pager: brick {} takes {} bytes resident, more than the {} estimated before loading", id,
-                         bytes, bytes_[id]);
+            log::Warning(
+                "pager: brick {} takes {} bytes resident, more than the {} estimated before "
+                "loading",
+                id, bytes, bytes_[id]);
         }
         // Keep the budget on real numbers: make up for the difference at once.
         MakeRoom(0, id, false);
@@ -251,13 +268,13 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
         if (state_[b] != State::kResident || b == exclude) continue;
         size_t w = waiting_ ? waiting_(b) : 0;
         if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
-        // Nearly empty queues count as empty when traffic decides: their few rays matter less than how busy
-        // the brick is.
+        // Nearly empty queues count as empty when traffic decides: their few rays matter less than
+        // how busy the brick is.
         if (options_.evict_least_traffic && w < options_.nearly_empty_rays) w = 0;
         candidates.push_back({w, options_.evict_least_traffic ? traffic_[b] : 0, last_used_[b], b});
     }
-    // Emptiest queue first: the fewer rays wait for a brick, the fewer need it back soon (the paper unloads a
-    // sub-model once almost all its rays are handled); least recently used breaks ties.
+    // Emptiest queue first: the fewer rays wait for a brick, the fewer need it back soon (the paper
+    // unloads a sub-model once almost all its rays are handled); least recently used breaks ties.
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
         if (a.waiting != b.waiting) return a.waiting < b.waiting;
         if (a.traffic != b.traffic) return a.traffic < b.traffic;
@@ -277,7 +294,9 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
 StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     if (id >= state_.size()) return source_.Acquire(id);  // the source's error names the brick
     const auto start = std::chrono::steady_clock::now();
-    auto stalled = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    auto stalled = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
     std::unique_lock<std::mutex> lock(mutex_);
     last_used_[id] = ++tick_;
     ++stats_.acquires;
@@ -285,7 +304,8 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     bool waited = false;
     for (;;) {
         if (state_[id] == State::kResident) {
-            // Pinned under the lock: evictions take it too, so the brick cannot go between check and pin.
+            // Pinned under the lock: evictions take it too, so the brick cannot go between check
+            // and pin.
             if (waited) stats_.stall_seconds += stalled();
             return source_.Acquire(id);
         }
@@ -296,7 +316,8 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
         }
         if (request_ == id) request_ = store::kNoBrick;
         if (loader_target_ == id) {
-            // The loader is still making room for it: take over (loads here may evict any unpinned brick).
+            // The loader is still making room for it: take over (loads here may evict any unpinned
+            // brick).
             loader_cancel_ = true;
             loader_cv_.notify_all();
         }
@@ -310,8 +331,10 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
                 continue;
             }
             return ResourceExhaustedError(
-                "brick memory budget {}: cannot make room for brick {} ({}): {} of bricks are pinned",
-                FormatBytes(options_.brick_budget_bytes), id, FormatBytes(need), FormatBytes(committed_bytes_));
+                "brick memory budget {}: cannot make room for brick {} ({}): {} of bricks are "
+                "pinned",
+                FormatBytes(options_.brick_budget_bytes), id, FormatBytes(need),
+                FormatBytes(committed_bytes_));
         }
         Reserve(id, need);
         lock.unlock();
@@ -360,9 +383,10 @@ PagerStats Pager::stats() const {
 }
 
 void Pager::LoaderLoop() {
-    // Loads run in a one-thread arena of their own: the render's workers are busy tracing, and Embree builds
-    // the brick's BVH with the threads of the arena it is called from (outside any arena it would use TBB's
-    // default pool: more threads than cores, each with its own build buffers).
+    // Loads run in a one-thread arena of their own: the render's workers are busy tracing, and
+    // Embree builds the brick's BVH with the threads of the arena it is called from (outside any
+    // arena it would use TBB's default pool: more threads than cores, each with its own build
+    // buffers).
     tbb::task_arena arena(1);
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
@@ -376,16 +400,19 @@ void Pager::LoaderLoop() {
         const uint64_t need = estimate_[target];
         bool reserved = false;
         for (;;) {
-            if (stop_ || loader_cancel_ || request_ != store::kNoBrick) break;  // given up or superseded
+            if (stop_ || loader_cancel_ || request_ != store::kNoBrick)
+                break;  // given up or superseded
             if (MakeRoom(need, target, true)) {
                 Reserve(target, need);
                 reserved = true;
                 break;
             }
-            // Nothing nearly empty to evict: wait for the batch to end (its brick is unpinned then).
+            // Nothing nearly empty to evict: wait for the batch to end (its brick is unpinned
+            // then).
             const uint64_t epoch = batch_epoch_;
             loader_cv_.wait(lock, [&] {
-                return stop_ || loader_cancel_ || request_ != store::kNoBrick || batch_epoch_ != epoch;
+                return stop_ || loader_cancel_ || request_ != store::kNoBrick ||
+                       batch_epoch_ != epoch;
             });
         }
         if (reserved) {
@@ -394,7 +421,8 @@ void Pager::LoaderLoop() {
             arena.execute([&] { handle = source_.Acquire(target); });
             const bool ok = handle.ok();
             const uint64_t bytes = ok ? (*handle)->memory_bytes() : 0;
-            // Unpinned at once: the brick stays resident until the scheduler picks it or a load evicts it.
+            // Unpinned at once: the brick stays resident until the scheduler picks it or a load
+            // evicts it.
             if (ok) (*handle).Reset();
             lock.lock();
             if (ok) {

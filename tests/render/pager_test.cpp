@@ -1,6 +1,9 @@
-// The out-of-core pager: a render under a small brick budget gives the image of an in-core render, never
-// holds more than the budget, evicts and reloads at small budgets and not at an in-core one, refuses an
-// impossible budget naming the largest brick, and returns a corrupt brick's error when it meets it.
+// The out-of-core pager: a render under a small brick budget gives the image of an in-core render,
+// never holds more than the budget, evicts and reloads at small budgets and not at an in-core one,
+// refuses an impossible budget naming the largest brick, and returns a corrupt brick's error when
+// it meets it.
+
+#include "render/pager.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,7 +14,6 @@
 #include "common/run_nave.h"
 #include "core/memory.h"
 #include "core/progress.h"
-#include "render/pager.h"
 #include "render/procedural_meshes.h"
 #include "render_test_util.h"
 #include "store/store_reader.h"
@@ -28,8 +30,8 @@ class PagerTest : public ::testing::Test {
 };
 
 // A floor with a 4 x 4 grid of balls, cut into 4 x 4 x 2 bricks: one ball per brick, so the largest
-// bricks are about 1/16 of the model and a budget of ~15 % of the in-core size is feasible. Ball (0, 0)
-// glows (photon mode then reads every brick to find its triangles).
+// bricks are about 1/16 of the model and a budget of ~15 % of the in-core size is feasible. Ball
+// (0, 0) glows (photon mode then reads every brick to find its triangles).
 store::BrickMesh BallGrid() {
     store::BrickMesh m;
     AppendQuad(&m, {0, 0, 0}, {4, 0, 0}, {0, 4, 0}, 6, 0);
@@ -129,18 +131,21 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
     const BrickBudgetMinimum m = MinimumBrickBudget(*in_core.source, true);
     EXPECT_GE(in_core.source->brick_count(), 30u);
-    // Prefetching on and off; then small waves (the in-core render has one), which under paging overlap.
+    // Prefetching on and off; then small waves (the in-core render has one), which under paging
+    // overlap.
     for (int variant = 0; variant < 3; ++variant) {
         const bool prefetch = variant != 1;
         const uint32_t wave_paths = variant == 2 ? 500 : 0;
         PagerOptions options = SmallBudget(*in_core.source, prefetch);
-        EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4) << "the test scene should allow a small budget";
+        EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4)
+            << "the test scene should allow a small budget";
         Rendered paged = RenderBallGrid(mode, &options, 2, wave_paths);
         ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
         EXPECT_GT(MeanY(*paged.film), 0.0);
-        // Same bounds as the brick-count and brick-order tests (render_test.cpp): path mode differs only by
-        // double summation order; photon deposits add floats atomically.
-        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound) << mode << " variant " << variant;
+        // Same bounds as the brick-count and brick-order tests (render_test.cpp): path mode differs
+        // only by double summation order; photon deposits add floats atomically.
+        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound)
+            << mode << " variant " << variant;
         // The budget holds, by the pager's count and by the source's own.
         EXPECT_LE(paged.stats.peak_brick_bytes, options.brick_budget_bytes);
         EXPECT_LE(paged.source->stats().peak_resident_bytes, options.brick_budget_bytes);
@@ -214,7 +219,8 @@ TEST_F(PagerTest, ImpossibleBudgetNamesTheLargestBrickAndTheMinimum) {
     EXPECT_NE(msg.find(fmt::format("brick {}", m.largest_brick)), std::string::npos) << msg;
     EXPECT_NE(msg.find(std::to_string(m.largest_bytes) + " bytes"), std::string::npos) << msg;
     EXPECT_NE(msg.find(std::to_string(m.min_bytes) + " bytes"), std::string::npos) << msg;
-    EXPECT_NE(msg.find(std::to_string(options.brick_budget_bytes) + " bytes"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::to_string(options.brick_budget_bytes) + " bytes"), std::string::npos)
+        << msg;
     // Without prefetching the largest brick alone is the minimum.
     options.prefetch = false;
     options.brick_budget_bytes = m.largest_bytes;
@@ -242,7 +248,8 @@ TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
     // Four bricks of the same size: balls (1, 1), (1, 2), (2, 1), (2, 2) have the same triangles.
     std::vector<uint32_t> same;
     std::map<uint64_t, std::vector<uint32_t>> by_size;
-    for (uint32_t b = 0; b < source->brick_count(); ++b) by_size[source->EstimatedResidentBytes(b)].push_back(b);
+    for (uint32_t b = 0; b < source->brick_count(); ++b)
+        by_size[source->EstimatedResidentBytes(b)].push_back(b);
     for (const auto& [bytes, ids] : by_size) {
         if (ids.size() >= 4) same = ids;
     }
@@ -255,7 +262,8 @@ TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
     auto pager = Pager::Create(*source, options, [&](uint32_t b) { return waiting[b]; });
     ASSERT_TRUE(pager.ok()) << pager.status().ToString();
     const uint32_t a = same[0], b = same[1], c = same[2], d = same[3];
-    for (uint32_t id : {a, b, c}) ASSERT_TRUE((*pager)->Acquire(id).ok());  // handles dropped at once
+    for (uint32_t id : {a, b, c})
+        ASSERT_TRUE((*pager)->Acquire(id).ok());  // handles dropped at once
     waiting[a] = 10;
     waiting[b] = 5;
     waiting[c] = 10;
@@ -307,16 +315,17 @@ TEST_F(PagerTest, PickPrefersAResidentBrickWithEnoughRays) {
 
 TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     PagerOptions o;
-    ASSERT_TRUE(ParsePagerTunables("prefetch=off,nearly_empty=100,prefer_resident=0.5,evict=traffic,overlap=0",
-                                   &o).ok());
+    ASSERT_TRUE(ParsePagerTunables(
+                    "prefetch=off,nearly_empty=100,prefer_resident=0.5,evict=traffic,overlap=0", &o)
+                    .ok());
     EXPECT_FALSE(o.prefetch);
     EXPECT_TRUE(o.evict_least_traffic);
     EXPECT_EQ(o.wave_overlap, 0.0);
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11", "prefetch",
-                            "evict=random", "overlap=2"}) {
+    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11",
+                            "prefetch", "evict=random", "overlap=2"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
@@ -324,18 +333,22 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     }
 }
 
-// ---------------------------------------------------------------------------------------------- store
+// ----------------------------------------------------------------------------------------------
+// store
 
 /// Writes `mesh` as a store cut into nx * ny * nz bricks.
-Status WriteStore(const std::filesystem::path& path, const store::BrickMesh& mesh, int nx, int ny, int nz) {
+Status WriteStore(const std::filesystem::path& path, const store::BrickMesh& mesh, int nx, int ny,
+                  int nz) {
     GridBricks grid = SplitIntoGridBricks(mesh, nx, ny, nz);
     store::GlobalGrid g;
     g.origin = Vec3d(-10, -10, -10);
     g.step = 1e-4;
-    NAVE_ASSIGN_OR_RETURN(auto writer, store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
+    NAVE_ASSIGN_OR_RETURN(auto writer,
+                          store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
     std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
     for (size_t b = 0; b < grid.meshes.size(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e, store::EncodeBrick(grid.meshes[b], cells[b], g, {}));
+        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e,
+                              store::EncodeBrick(grid.meshes[b], cells[b], g, {}));
         NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(e));
         NAVE_CHECK_EQ(id, uint32_t(b));
     }
@@ -375,7 +388,8 @@ TEST_F(PagerStoreTest, StoreEstimatesMatchTheRealSizes) {
 }
 
 TEST_F(PagerStoreTest, CorruptBrickMetWhilePagingNamesIt) {
-    // Corrupt the brick with the most triangles (a ball in view): a byte in the middle of its mesh section.
+    // Corrupt the brick with the most triangles (a ball in view): a byte in the middle of its mesh
+    // section.
     uint32_t victim = 0;
     uint64_t offset = 0;
     {
@@ -413,13 +427,16 @@ TEST_F(PagerStoreTest, CorruptBrickMetWhilePagingNamesIt) {
     EXPECT_NE(s.message().find("balls.nave"), std::string::npos) << s.message();
 }
 
-// ---------------------------------------------------------------------------------------------- CLI
+// ----------------------------------------------------------------------------------------------
+// CLI
 
 TEST(PagerCliTest, TooSmallMemoryIsRefusedNamingTheBrickAndTheMinimum) {
     const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
-    const auto out = std::filesystem::temp_directory_path() / ("nave_memory_" + std::to_string(getpid()) + ".exr");
-    const test::CommandResult r = test::RunNave("render --procedural clutter:bricks=4 --config " + config +
-                                                " --resolution 16x12 --spp 1 --memory 1M -o " + out.string());
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_memory_" + std::to_string(getpid()) + ".exr");
+    const test::CommandResult r =
+        test::RunNave("render --procedural clutter:bricks=4 --config " + config +
+                      " --resolution 16x12 --spp 1 --memory 1M -o " + out.string());
     EXPECT_NE(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("--memory 1M"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("largest brick, brick "), std::string::npos) << r.output;
@@ -429,15 +446,17 @@ TEST(PagerCliTest, TooSmallMemoryIsRefusedNamingTheBrickAndTheMinimum) {
 
 TEST(PagerCliTest, MemoryBudgetRendersAndReportsPaging) {
     const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
-    const auto out = std::filesystem::temp_directory_path() / ("nave_memory_ok_" + std::to_string(getpid()) + ".exr");
-    const test::CommandResult r = test::RunNave("render --procedural clutter:bricks=4 --config " + config +
-                                                " --resolution 16x12 --spp 1 --memory 64M --pager prefetch=off -o " +
-                                                out.string());
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_memory_ok_" + std::to_string(getpid()) + ".exr");
+    const test::CommandResult r = test::RunNave(
+        "render --procedural clutter:bricks=4 --config " + config +
+        " --resolution 16x12 --spp 1 --memory 64M --pager prefetch=off -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("(--memory 64M)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("evictions"), std::string::npos) << r.output;
-    const test::CommandResult bad = test::RunNave("render --procedural clutter:bricks=4 --config " + config +
-                                                  " --memory 64M --pager speed=11 -o " + out.string());
+    const test::CommandResult bad =
+        test::RunNave("render --procedural clutter:bricks=4 --config " + config +
+                      " --memory 64M --pager speed=11 -o " + out.string());
     EXPECT_NE(bad.exit_code, 0);
     EXPECT_NE(bad.output.find("speed"), std::string::npos) << bad.output;
     std::filesystem::remove(out);
