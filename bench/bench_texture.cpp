@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "core/rgb_to_spectrum.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/texture_cache.h"
 
 namespace nave::render {
 namespace {
+
+using namespace nave::imaging;
 
 constexpr int kSize = 2048;
 

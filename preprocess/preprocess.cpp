@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #ifdef __GLIBC__
@@ -23,6 +25,7 @@
 #include "preprocess/partition/brick_builder.h"
 #include "preprocess/partition/partitioner.h"
 #include "preprocess/partition/temp_dir.h"
+#include "preprocess/texture_convert.h"
 #include "store/store_writer.h"
 
 namespace nave::preprocess {
@@ -43,6 +46,25 @@ std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} units={}",
         o.brick_triangles, budget, step, threads, o.encode.draco_speed, units);
 }
+
+/// Removes the texture folder of a run that fails, unless it existed before the run (it may hold textures an
+/// earlier store still uses).
+class TextureFolderGuard {
+  public:
+    explicit TextureFolderGuard(std::filesystem::path folder) : folder_(std::move(folder)) {
+        std::error_code ec;
+        existed_ = std::filesystem::exists(folder_, ec);
+    }
+    ~TextureFolderGuard() {
+        std::error_code ec;
+        if (!committed_ && !existed_) std::filesystem::remove_all(folder_, ec);
+    }
+    void Commit() { committed_ = true; }
+
+  private:
+    std::filesystem::path folder_;
+    bool existed_ = false, committed_ = false;
+};
 
 }  // namespace
 
@@ -125,7 +147,26 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         stats.warnings.push_back(w);
     }
     auto materials = source->materials();
+    NAVE_RETURN_IF_ERROR(source->WriteGeneratedTextures(temp.path()));
     source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
+
+    // Textures the materials reference become tiled, MIP-mapped files beside the store, and the material
+    // table points at them (texture_convert.h). Texture names are relative to their model's directory.
+    TextureFolderGuard texture_folder(TextureFolderFor(options.output));
+    {
+        std::vector<std::filesystem::path> source_dirs;
+        for (const auto& input : options.inputs)
+            source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));
+        source_dirs.push_back(temp.path());  // a generator's textures (WriteGeneratedTextures)
+        NAVE_ASSIGN_OR_RETURN(TextureConvertStats textures, ConvertTextures(&materials, source_dirs, options.output));
+        for (const std::string& w : textures.warnings) {
+            log::Warning("{}", w);
+            stats.warnings.push_back(w);
+        }
+        stats.textures_converted = textures.converted;
+        stats.texture_bytes = textures.bytes_written;
+        stats.texture_seconds = textures.seconds;
+    }
 
     // The global grid.
     const Bounds3d& b = partitioner.bounds();
@@ -194,15 +235,35 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     std::mutex mutex;
     size_t next = 0;
     Status failure;
+    // Bricks are appended in leaf order whatever order the threads finish them in, so that brick ids, and
+    // the store's bytes, do not depend on the thread count. A finished brick waits here (compressed) until
+    // the leaves before it are appended.
+    std::map<size_t, std::optional<store::EncodedBrick>> finished;
+    size_t next_append = 0;
+    auto append_ready = [&]() -> Status {  // with `mutex` held
+        for (auto it = finished.begin(); it != finished.end() && it->first == next_append;
+             it = finished.erase(it), ++next_append) {
+            if (!it->second) continue;  // every triangle collapsed: no brick
+            const store::EncodedBrick& encoded = *it->second;
+            NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
+            nodes[leaves[it->first].node].brick = id;
+            stats.stored_triangles += encoded.triangle_count;
+            stats.collapsed_triangles += encoded.dropped_triangle_count;
+            ++stats.bricks;
+        }
+        return Status::Ok();
+    };
     auto worker = [&] {
         std::vector<Triangle> triangles;
         BrickBuilder builder;
         while (true) {
             const LeafBin* leaf = nullptr;
+            size_t index = 0;
             {
                 std::lock_guard<std::mutex> lock(mutex);
                 if (next >= leaves.size() || !failure.ok()) return;
-                leaf = &leaves[next++];
+                index = next++;
+                leaf = &leaves[index];
             }
             Status s = [&]() -> Status {
                 NAVE_RETURN_IF_ERROR(CheckCancelled());
@@ -217,23 +278,14 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 std::error_code ec;
                 std::filesystem::remove(leaf->file, ec);
                 const BuiltBrick& built = builder.Build(triangles, grid);
-                if (built.mesh.indices.empty()) {
-                    std::lock_guard<std::mutex> lock(mutex);
-                    stats.collapsed_triangles += built.collapsed_triangles;
-                    ++stats.empty_cells;
-                    return Status::Ok();
+                std::optional<store::EncodedBrick> encoded;
+                if (!built.mesh.indices.empty()) {
+                    NAVE_ASSIGN_OR_RETURN(encoded, store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
                 }
-                NAVE_ASSIGN_OR_RETURN(
-                    store::EncodedBrick encoded,
-                    store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
                 std::lock_guard<std::mutex> lock(mutex);
-                NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(encoded));
-                nodes[leaf->node].brick = id;
-                stats.stored_triangles += encoded.triangle_count;
-                stats.collapsed_triangles +=
-                    built.collapsed_triangles + encoded.dropped_triangle_count;
-                ++stats.bricks;
-                return Status::Ok();
+                stats.collapsed_triangles += built.collapsed_triangles;
+                finished.emplace(index, std::move(encoded));
+                return append_ready();
             }();
             bar.Add(leaf->triangles);
             if (!s.ok()) {
@@ -264,6 +316,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     NAVE_RETURN_IF_ERROR(CheckCancelled());
     store::BrickTree tree(root, nodes);
     NAVE_RETURN_IF_ERROR(writer->Finish(materials, tree, stats.source_triangles));
+    texture_folder.Commit();
     stats.output_bytes = writer->bytes_written();
     stats.peak_temp_bytes = partitioner.peak_temp_bytes();
     stats.seconds = Since(start);
@@ -300,6 +353,10 @@ std::string FormatSummary(const PreprocessStats& s) {
             "\nnote:        {} bricks exceed the target (triangles too large or overlapping to "
             "split)",
             s.oversized_bricks);
+    }
+    if (s.textures_converted > 0) {
+        out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}", s.textures_converted,
+                           FormatBytes(s.texture_bytes), FormatDuration(s.texture_seconds));
     }
     for (const auto& w : s.warnings) out += "\nwarning:     " + w;
     return out;

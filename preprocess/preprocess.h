@@ -38,6 +38,8 @@ struct PreprocessStats {
     uint64_t memory_budget = 0, peak_rss = 0, source_memory = 0;
     int threads = 1;
     double seconds = 0, read_seconds = 0, split_seconds = 0, encode_seconds = 0;
+    uint64_t textures_converted = 0, texture_bytes = 0;  ///< texture files written beside the store
+    double texture_seconds = 0;
     std::vector<std::string> warnings;
 };
 

@@ -1,8 +1,5 @@
 #include "preprocess/texture_convert.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -11,22 +8,14 @@
 #include <set>
 #include <utility>
 
-#include "core/color.h"
 #include "core/file.h"
 #include "core/hash.h"
 #include "core/progress.h"
+#include "imaging/make_texture.h"
 
 namespace nave::preprocess {
 
 namespace {
-
-// OpenImageIO errors end in newlines and repeat the file name; one line is kept.
-std::string OneLine(std::string s) {
-    for (char& c : s)
-        if (c == '\n') c = ' ';
-    while (!s.empty() && s.back() == ' ') s.pop_back();
-    return s.empty() ? "no detail from OpenImageIO" : s;
-}
 
 std::filesystem::path Resolve(const std::string& name,
                               const std::vector<std::filesystem::path>& source_dirs) {
@@ -38,25 +27,8 @@ std::filesystem::path Resolve(const std::string& name,
     return source_dirs.empty() ? p : source_dirs.front() / p;
 }
 
-// Decodes the sRGB transfer curve (IEC 61966-2-1) of the first three channels in place; alpha and
-// further channels are linear already.
-void DecodeSrgb(OIIO::ImageBuf& buf) {
-    const OIIO::ImageSpec& spec = buf.spec();
-    int colour_channels = std::min(spec.nchannels, 3);
-    std::vector<float> row(size_t(spec.width) * spec.nchannels);
-    for (int y = spec.y; y < spec.y + spec.height; ++y) {
-        OIIO::ROI roi(spec.x, spec.x + spec.width, y, y + 1, 0, 1, 0, spec.nchannels);
-        buf.get_pixels(roi, OIIO::TypeFloat, row.data());
-        for (int x = 0; x < spec.width; ++x)
-            for (int c = 0; c < colour_channels; ++c) {
-                float& v = row[size_t(x) * spec.nchannels + c];
-                v = float(SrgbDecode(std::clamp(double(v), 0.0, 1.0)));
-            }
-        buf.set_pixels(roi, OIIO::TypeFloat, row.data());
-    }
-}
-
 struct Converted {
+    std::string first_user;  // "material lion map_Kd", for warnings
     bool ok = false;
     std::string relative;  // to the store's directory
 };
@@ -81,8 +53,10 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
     // Distinct (source file, colour?) pairs, converted once however many slots use them.
     std::map<std::pair<std::filesystem::path, bool>, Converted> work;
     for (const store::MaterialRecord& m : *materials)
-        for (const auto& [slot, name] : m.textures)
-            work[{Resolve(name, source_dirs), IsColourTextureSlot(slot)}];
+        for (const auto& [slot, name] : m.textures) {
+            Converted& c = work[{Resolve(name, source_dirs), IsColourTextureSlot(slot)}];
+            if (c.first_user.empty()) c.first_user = fmt::format("material {} {}", m.name, slot);
+        }
     if (work.empty()) return stats;
 
     std::filesystem::path folder = TextureFolderFor(store_path);
@@ -96,34 +70,19 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
     for (auto& [key, result] : work) {
         const auto& [source, colour] = key;
         progress.Add(1);
-        OIIO::ImageBuf in(source.string());
-        if (!std::filesystem::exists(source, ec)) {
-            stats.warnings.push_back(fmt::format(
-                "texture {}: no such file; its materials use their flat colour", source.string()));
-            continue;
-        }
-        if (!in.read(0, 0, /*force=*/true, OIIO::TypeFloat)) {
-            stats.warnings.push_back(
-                fmt::format("texture {}: unreadable ({}); its materials use their flat colour",
-                            source.string(), OneLine(in.geterror())));
-            continue;
-        }
-        if (colour) DecodeSrgb(in);
-        // Colour: half-float OpenEXR (OIIO's TIFF writer stores half as float); data: TIFF in the
-        // source's pixel type. Both tiled and MIP-mapped by make_texture.
-        const char* extension = colour ? "exr" : "tx";
-        OIIO::ImageSpec config;
-        config.format = colour ? OIIO::TypeHalf : in.nativespec().format;
-        config.tile_width = config.tile_height = 64;
-        config.attribute("wrapmodes", "periodic,periodic");
-        config.attribute("compression", "zip");
+        // Colour, and data that comes as OpenEXR (spectral maps, whose band centres live in an EXR header
+        // attribute), are written as OpenEXR; other data as TIFF in its own pixel type.
+        const char* extension = colour || source.extension() == ".exr" ? "exr" : "tx";
         std::filesystem::path temp =
             folder / fmt::format(".tmp-{}-{}.{}", getpid(), counter.fetch_add(1), extension);
-        if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in, temp.string(),
-                                              config)) {
+        Status made = imaging::MakeTiledTexture(
+            source, temp, colour ? imaging::TextureContent::kColour : imaging::TextureContent::kData);
+        if (!made.ok()) {
             std::filesystem::remove(temp, ec);
-            return IoError("{}: cannot write the texture converted from {}: {}", temp.string(),
-                           source.string(), OneLine(OIIO::geterror()));
+            if (made.code() == StatusCode::kIoError) return made;  // the output side: nothing to fall back on
+            stats.warnings.push_back(fmt::format("texture {} (used by {}); its materials use their flat value",
+                                                 made.message(), result.first_user));
+            continue;
         }
         NAVE_ASSIGN_OR_RETURN(std::string bytes, ReadFileToString(temp));
         std::string file_name =

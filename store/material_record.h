@@ -18,6 +18,9 @@ struct MaterialRecord {
     float shininess = 0.f;                             ///< MTL Ns
     float metallic = 0.f;                              ///< glTF metallicFactor
     float roughness = 1.f;                             ///< glTF roughnessFactor
+    /// Where an alpha texture (MTL map_d, glTF alphaMode MASK) is below this, the surface is cut out
+    /// (glTF alphaCutoff; 0.5 for MTL and by default). Format 1.1; 1.0 stores read as 0.5.
+    float alpha_cutoff = 0.5f;
     /// Texture slots by their source name ("map_Kd", "map_d", "bump", "baseColorTexture"...) to a path
     /// relative to the store file, or to the source model's directory when not yet converted.
     std::map<std::string, std::string> textures;

@@ -416,6 +416,7 @@ std::string EncodeMaterials(const std::vector<MaterialRecord>& materials) {
             rec.PutString(slot);
             rec.PutString(path);
         }
+        rec.Put(m.alpha_cutoff);  // 1.1
         // Each record carries its length so that a newer minor version may append fields to it.
         w.Put(uint32_t(rec.size()));
         w.bytes().append(rec.bytes());
@@ -466,6 +467,8 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
             NAVE_RETURN_IF_ERROR(r.GetString(&path));
             m.textures[slot] = path;
         }
+        // Fields appended by later minor versions: absent in older records, which keep the defaults.
+        if (r.remaining() >= sizeof(float)) NAVE_RETURN_IF_ERROR(r.Get(&m.alpha_cutoff));
     }
     if (table.remaining() != 0) {
         return DataLossError("{} materials @0x{:x}: {} bytes left after {} records", name,

@@ -12,7 +12,7 @@ namespace nave::store {
 
 /// Current format version. Readers refuse another major version; a newer minor version only adds fields.
 inline constexpr uint16_t kFormatMajor = 1;
-inline constexpr uint16_t kFormatMinor = 0;
+inline constexpr uint16_t kFormatMinor = 1;  // 1.1: material alpha_cutoff
 
 /// Header fields that the writer's caller provides: how the store was made and from what.
 struct StoreProvenance {

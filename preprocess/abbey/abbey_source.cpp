@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "preprocess/abbey/abbey_plan.h"
+#include "preprocess/abbey/glass_textures.h"
 #include "preprocess/abbey/materials.h"
 #include "preprocess/import/text_parse.h"
 
@@ -58,6 +59,9 @@ class AbbeySource final : public TriangleSource {
     const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
     std::string name() const override { return fmt::format("abbey:detail={}", detail_); }
     std::string units() const override { return "m"; }
+    Status WriteGeneratedTextures(const std::filesystem::path& dir) const override {
+        return abbey::WriteGlassTextures(dir);
+    }
     uint64_t progress_done() const override { return parts_done_.load(); }
     uint64_t progress_total() const override { return parts_total_; }
     uint64_t memory_bytes() const override {

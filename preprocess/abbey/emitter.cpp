@@ -1,5 +1,6 @@
 #include "preprocess/abbey/emitter.h"
 
+#include <array>
 #include <cmath>
 
 namespace nave::preprocess::abbey {
@@ -18,34 +19,44 @@ void Emitter::Flush() {
     batch_.clear();
 }
 
+bool Emitter::Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material,
+                     Triangle* t, bool* flip) {
+    Vec3d n = Cross(b - a, c - a);
+    t->material = material;
+    t->p[0] = Vec3f(a);
+    *flip = Dot(n, outward) < 0;
+    t->p[1] = Vec3f(*flip ? c : b);
+    t->p[2] = Vec3f(*flip ? b : c);
+    if (t->p[0] == t->p[1] || t->p[1] == t->p[2] || t->p[0] == t->p[2]) return false;
+    Vec3f nf = Cross(t->p[1] - t->p[0], t->p[2] - t->p[0]);
+    return Dot(nf, nf) != 0.f;
+}
+
 void Emitter::Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward,
                   uint32_t material) {
-    Vec3d n = Cross(b - a, c - a);
     Triangle t;
-    t.material = material;
-    t.p[0] = Vec3f(a);
-    bool flip = Dot(n, outward) < 0;
-    t.p[1] = Vec3f(flip ? c : b);
-    t.p[2] = Vec3f(flip ? b : c);
-    if (t.p[0] == t.p[1] || t.p[1] == t.p[2] || t.p[0] == t.p[2]) return;
-    Vec3f nf = Cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-    if (Dot(nf, nf) == 0.f) return;
+    bool flip = false;
+    if (Orient(a, b, c, outward, material, &t, &flip)) Push(t);
+}
+
+void Emitter::TriUv(const Vec3d& a, const Vec3d& b, const Vec3d& c, const std::array<float, 2>& ta,
+                    const std::array<float, 2>& tb, const std::array<float, 2>& tc, const Vec3d& outward,
+                    uint32_t material) {
+    Triangle t;
+    bool flip = false;
+    if (!Orient(a, b, c, outward, material, &t, &flip)) return;
+    t.uv = {ta, flip ? tc : tb, flip ? tb : tc};  // the texture coordinates follow their corners
+    t.has_uvs = true;
     Push(t);
 }
 
 void Emitter::TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& na, const Vec3d& nb,
                    const Vec3d& nc, const Vec3d& outward, uint32_t material) {
-    Vec3d n = Cross(b - a, c - a);
-    bool flip = Dot(n, outward) < 0;
     Triangle t;
-    t.material = material;
+    bool flip = false;
+    if (!Orient(a, b, c, outward, material, &t, &flip)) return;
     t.has_normals = true;
-    t.p[0] = Vec3f(a);
-    t.p[1] = Vec3f(flip ? c : b);
-    t.p[2] = Vec3f(flip ? b : c);
-    if (t.p[0] == t.p[1] || t.p[1] == t.p[2] || t.p[0] == t.p[2]) return;
     Vec3f nf = Cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-    if (Dot(nf, nf) == 0.f) return;
     // Shading normals face the same side as the geometric normal.
     Vec3d face = Normalize(Vec3d(nf));
     auto orient = [&](const Vec3d& v) {

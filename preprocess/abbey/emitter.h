@@ -4,6 +4,7 @@
 // space a visitor stands in), and the emitter orders the corners so that the winding agrees, which
 // keeps normals consistent without each primitive having to get its vertex order right.
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -29,6 +30,10 @@ class Emitter {
     /// `outward`).
     void TriN(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& na, const Vec3d& nb,
               const Vec3d& nc, const Vec3d& outward, uint32_t material);
+    /// The same with texture coordinates (reordered with the corners if needed).
+    void TriUv(const Vec3d& a, const Vec3d& b, const Vec3d& c, const std::array<float, 2>& ta,
+               const std::array<float, 2>& tb, const std::array<float, 2>& tc, const Vec3d& outward,
+               uint32_t material);
     /// A planar-ish quad a b c d (in order around it), split along a-c.
     void Quad(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& outward,
               uint32_t material) {
@@ -42,11 +47,20 @@ class Emitter {
         TriN(a, c, d, na, nc, nd, outward, material);
     }
 
+    void QuadUv(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d,
+                const std::array<std::array<float, 2>, 4>& uv, const Vec3d& outward, uint32_t material) {
+        TriUv(a, b, c, uv[0], uv[1], uv[2], outward, material);
+        TriUv(a, c, d, uv[0], uv[2], uv[3], outward, material);
+    }
+
     /// Hands the pending triangles on.
     void Flush();
     uint64_t emitted() const { return emitted_; }
 
   private:
+    /// Fills `t` with a b c, wound to face `outward` (`flip`: b and c swapped); false if degenerate.
+    static bool Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material,
+                       Triangle* t, bool* flip);
     void Push(Triangle& t);
     std::function<void(std::vector<Triangle>&)> flush_;
     size_t batch_triangles_;

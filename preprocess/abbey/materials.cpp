@@ -1,5 +1,9 @@
 #include "preprocess/abbey/materials.h"
 
+#include <string_view>
+
+#include "preprocess/abbey/glass_textures.h"
+
 namespace nave::preprocess::abbey {
 
 std::vector<store::MaterialRecord> AbbeyMaterials() {
@@ -30,6 +34,8 @@ std::vector<store::MaterialRecord> AbbeyMaterials() {
         m.diffuse = {d.r, d.g, d.b};
         m.opacity = d.opacity;
         m.ior = d.ior;
+        // Glass carries its spectral transmittance map, written beside the model by WriteGlassTextures.
+        if (std::string_view(d.name).rfind("glass_", 0) == 0) m.textures[kTransmittanceSlot] = GlassTextureName(d.name);
         out.push_back(m);
     }
     return out;

@@ -156,8 +156,13 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
             uint32_t m = palette[int(Hash01(seed, r, c) * 10) % 10];
             // One sheet per pane, facing outward: the renderer's thin-pane material accounts for
             // both faces of the glass in a single surface, so a closed slab would count them twice.
-            em.Quad(g.P(x0, z0, mid), g.P(x1, z0, mid), g.P(x1, t1, mid), g.P(x0, t0, mid),
-                    -w.inward, m);
+            // Texture coordinates span the whole window, origin top-left (glass_textures.h), so the
+            // spectral transmittance map of each glass colour lies across the window.
+            auto uv = [&](double x, double z) {
+                return std::array<float, 2>{float((x - a) / (b - a)), float((apex - z) / (apex - o.sill))};
+            };
+            em.QuadUv(g.P(x0, z0, mid), g.P(x1, z0, mid), g.P(x1, t1, mid), g.P(x0, t0, mid),
+                      {uv(x0, z0), uv(x1, z0), uv(x1, t1), uv(x0, t0)}, -w.inward, m);
         }
     }
     // Lead cames on every line between pieces: 12 mm wide, 20 mm deep boxes.

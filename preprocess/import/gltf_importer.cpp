@@ -3,8 +3,11 @@
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
+#include <map>
+#include <memory>
 
 #include "preprocess/import/indexed_mesh_source.h"
 
@@ -108,9 +111,25 @@ Vec3f TransformNormal(const NormalMatrix& n, const Vec3f& v) {
     return len > 0 ? Vec3f(r / len) : Vec3f(0, 0, 1);
 }
 
-bool SkipImageData(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                   const unsigned char*, int, void*) {
-    return true;  // nave keeps texture names only; the renderer loads images itself
+/// Encoded images the file carries inside it (GLB buffer views, data URIs), by image index.
+using EmbeddedImages = std::map<int, std::string>;
+
+/// tinygltf's image loader: nave does not decode images here (the texture conversion does). External files
+/// are kept by name; embedded images have no name (their uri is empty), so their encoded bytes are kept.
+bool KeepEmbeddedImageBytes(tinygltf::Image* image, const int image_index, std::string*, std::string*, int,
+                            int, const unsigned char* bytes, int size, void* user) {
+    if (image->uri.empty() && bytes != nullptr && size > 0) {
+        (*static_cast<EmbeddedImages*>(user))[image_index] = std::string(reinterpret_cast<const char*>(bytes), size_t(size));
+    }
+    return true;
+}
+
+/// The file extension of encoded image bytes by their signature, or empty if not PNG or JPEG.
+std::string ImageExtension(const std::string& bytes) {
+    if (bytes.size() >= 8 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return "png";
+    if (bytes.size() >= 3 && uint8_t(bytes[0]) == 0xFF && uint8_t(bytes[1]) == 0xD8 && uint8_t(bytes[2]) == 0xFF)
+        return "jpg";
+    return {};
 }
 
 class GltfReader {
@@ -229,12 +248,18 @@ class GltfReader {
     std::string file_;
 };
 
-std::string TextureName(const tinygltf::Model& model, int texture) {
+/// The file a texture's image is read from: its uri, or for an embedded image the name it is written under
+/// ("helmet.image3.png", see KeepEmbeddedImageBytes), or empty when it has neither.
+std::string TextureName(const tinygltf::Model& model, int texture, const EmbeddedImages& embedded,
+                        const std::string& stem) {
     if (texture < 0 || size_t(texture) >= model.textures.size()) return {};
     int source = model.textures[texture].source;
     if (source < 0 || size_t(source) >= model.images.size()) return {};
     const tinygltf::Image& image = model.images[source];
-    return !image.uri.empty() ? image.uri : image.name;
+    if (!image.uri.empty()) return image.uri;
+    auto it = embedded.find(source);
+    if (it == embedded.end() || ImageExtension(it->second).empty()) return {};
+    return fmt::format("{}.image{}.{}", stem, source, ImageExtension(it->second));
 }
 
 }  // namespace
@@ -244,7 +269,8 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(SkipImageData, nullptr);
+    EmbeddedImages embedded;
+    loader.SetImageLoader(KeepEmbeddedImageBytes, &embedded);
     std::string err, warn;
     std::string ext = path.extension().string();
     for (char& c : ext) c = char(std::tolower(c));
@@ -271,18 +297,28 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
             for (int c = 0; c < 3; ++c) m.emission[c] = float(src.emissiveFactor[c]);
         }
         auto add_texture = [&](const char* slot, int index) {
-            std::string name = TextureName(model, index);
-            if (name.empty()) return;
-            m.textures[slot] = name;
-            if (!std::filesystem::exists(path.parent_path() / name, ec) && ext != ".glb") {
-                warnings.Add("missing textures (material kept, colour used)", file + " " + name);
+            std::string name = TextureName(model, index, embedded, path.stem().string());
+            if (name.empty()) {
+                if (index >= 0) {
+                    warnings.Add("textures neither in a file nor embedded as PNG/JPEG (colour used)",
+                                 fmt::format("{} material {} {}", file, m.name, slot));
+                }
+                return;
             }
+            // A missing or unreadable file is reported once, by the texture conversion (texture_convert.h).
+            m.textures[slot] = name;
         };
         add_texture("baseColorTexture", pbr.baseColorTexture.index);
         add_texture("metallicRoughnessTexture", pbr.metallicRoughnessTexture.index);
         add_texture("normalTexture", src.normalTexture.index);
         add_texture("emissiveTexture", src.emissiveTexture.index);
         add_texture("occlusionTexture", src.occlusionTexture.index);
+        // alphaMode MASK (glTF 2.0 §3.9.4): cut out where base-colour alpha x baseColorFactor alpha is below
+        // alphaCutoff. The renderer reads the alpha from "alphaMask", the base-colour image kept as data.
+        if (src.alphaMode == "MASK") {
+            m.alpha_cutoff = float(src.alphaCutoff);
+            add_texture("alphaMask", pbr.baseColorTexture.index);
+        }
         materials.push_back(std::move(m));
     }
     uint32_t default_material = uint32_t(materials.size());
@@ -403,8 +439,21 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         m.name = "default";
         materials.push_back(m);
     }
-    return std::unique_ptr<TriangleSource>(new IndexedMeshSource(
-        file, "m", std::move(meshes), std::move(materials), std::move(warnings)));
+    // The embedded images some material uses, under the names TextureName gave them.
+    std::vector<std::pair<std::string, std::string>> images;
+    for (const auto& [index, bytes] : embedded) {
+        std::string ext = ImageExtension(bytes);
+        if (ext.empty()) continue;
+        std::string name = fmt::format("{}.image{}.{}", path.stem().string(), index, ext);
+        bool used = std::any_of(materials.begin(), materials.end(), [&](const store::MaterialRecord& m) {
+            return std::any_of(m.textures.begin(), m.textures.end(), [&](const auto& t) { return t.second == name; });
+        });
+        if (used) images.emplace_back(std::move(name), bytes);
+    }
+    auto source = std::make_unique<IndexedMeshSource>(file, "m", std::move(meshes), std::move(materials),
+                                                      std::move(warnings));
+    source->SetEmbeddedImages(std::move(images));
+    return std::unique_ptr<TriangleSource>(std::move(source));
 }
 
 }  // namespace nave::preprocess

@@ -1,10 +1,21 @@
 #include "preprocess/import/indexed_mesh_source.h"
 
+#include "core/file.h"
+
 #include <fmt/format.h>
 
 #include "preprocess/import/triangle_check.h"
 
 namespace nave::preprocess {
+
+Status IndexedMeshSource::WriteGeneratedTextures(const std::filesystem::path& dir) const {
+    for (const auto& [name, bytes] : embedded_images_) {
+        NAVE_ASSIGN_OR_RETURN(AtomicFile file, AtomicFile::Create(dir / name));
+        NAVE_RETURN_IF_ERROR(file.Write(bytes.data(), bytes.size()));
+        NAVE_RETURN_IF_ERROR(file.Commit());
+    }
+    return Status::Ok();
+}
 
 IndexedMeshSource::IndexedMeshSource(std::string name, std::string units,
                                      std::vector<IndexedMesh> meshes,

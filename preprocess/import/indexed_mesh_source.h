@@ -34,8 +34,16 @@ class IndexedMeshSource final : public TriangleSource {
     uint64_t progress_total() const override { return total_; }
     uint64_t memory_bytes() const override;
     const ImportWarnings& warnings() const override { return warnings_; }
+    /// Writes the embedded images handed to SetEmbeddedImages under their names.
+    Status WriteGeneratedTextures(const std::filesystem::path& dir) const override;
+    /// Images the model file carries inside it (glTF buffer views, data URIs): file name -> encoded bytes.
+    /// The materials name them; WriteGeneratedTextures puts them where the texture conversion finds them.
+    void SetEmbeddedImages(std::vector<std::pair<std::string, std::string>> images) {
+        embedded_images_ = std::move(images);
+    }
 
   private:
+    std::vector<std::pair<std::string, std::string>> embedded_images_;
     std::string name_, units_;
     std::vector<IndexedMesh> meshes_;
     std::vector<store::MaterialRecord> materials_;

@@ -70,12 +70,8 @@ StatusOr<std::vector<store::MaterialRecord>> ParseMtl(const std::filesystem::pat
             while (!(token = NextToken(rest)).empty()) name = token;
             if (name.empty()) continue;
             std::string texture(name);
+            // A missing or unreadable file is reported once, by the texture conversion (texture_convert.h).
             m.textures[std::string(keyword)] = texture;
-            std::error_code ec;
-            if (!std::filesystem::exists(path.parent_path() / texture, ec)) {
-                warnings.Add("missing textures (material kept, colour used)",
-                             reader.Where() + " " + texture);
-            }
         }
     }
     return materials;

@@ -33,6 +33,7 @@ struct RenderOptions {
     std::string resolution;  // "WxH"
     std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
     std::string pager;       // --pager TUNABLES
+    bool no_textures = false;
 };
 
 /// Parses "960x640" into width and height.
@@ -73,6 +74,7 @@ Status RunRender(const RenderOptions& o) {
     if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
+    if (o.no_textures) config.textures.enabled = false;
 
     NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create());
     std::unique_ptr<render::BrickSource> source;
@@ -82,6 +84,18 @@ Status RunRender(const RenderOptions& o) {
         NAVE_ASSIGN_OR_RETURN(source, render::OpenProceduralSource(o.procedural, device));
     }
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, *source));
+    // The model's textures, through a capped tile cache (docs/textures.md); only when some material has one,
+    // so that untextured models never load OpenImageIO's texture system.
+    std::unique_ptr<render::TextureCache> textures;
+    const bool any_texture = std::any_of(source->materials().begin(), source->materials().end(),
+                                         [](const store::MaterialRecord& m) { return !m.textures.empty(); });
+    if (config.textures.enabled && any_texture) {
+        NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(config.textures.cache_bytes));
+        std::filesystem::path base = std::filesystem::path(o.model).parent_path();
+        std::vector<std::string> warnings;
+        NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures, &scene, &warnings));
+        for (const std::string& w : warnings) log::Warning("{}", w);
+    }
     log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(), scene.materials.size(),
               config.camera.width, config.camera.height, ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
@@ -94,20 +108,26 @@ Status RunRender(const RenderOptions& o) {
         NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
         render::PagerOptions options;
         NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
+        // The texture cache's cap comes out of --memory too (docs/pager.md).
+        const uint64_t texture_bytes = textures ? textures->max_memory_bytes() : 0;
         const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
-                                                            source->brick_count(), options.wave_overlap);
+                                                            source->brick_count(), options.wave_overlap) +
+                                 texture_bytes;
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
         if (memory < reserve + need.min_bytes) {
             return InvalidArgumentError(
                 "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
-                "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes): at least {} ({} "
-                "bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
+                "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes){}: at least {} "
+                "({} bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
                 o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
                 options.prefetch && need.second_bytes > 0
                     ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
                                   FormatBytes(need.second_bytes))
                     : std::string(),
-                FormatBytes(reserve), reserve, FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes,
+                FormatBytes(reserve), reserve,
+                texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
+                                  : std::string(),
+                FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes,
                 source->brick_count(), FormatBytes(need.total_bytes), need.total_bytes);
         }
         options.brick_budget_bytes = memory - reserve;
@@ -150,6 +170,10 @@ Status RunRender(const RenderOptions& o) {
         {"nave:statistics", statistics},
     };
     if (scene.sun >= 0) metadata.push_back({"nave:sun", scene.sun_description});
+    if (textures) {
+        metadata.push_back({"nave:textures", fmt::format("cache_cap={} bytes_read={}", textures->max_memory_bytes(),
+                                                         textures->bytes_read())});
+    }
     NAVE_RETURN_IF_ERROR(film.Write(out, metadata));
 
     std::filesystem::path png = out;
@@ -179,6 +203,11 @@ Status RunRender(const RenderOptions& o) {
                  FormatCount(double(stats.brick_evictions)).c_str(), FormatCount(double(stats.brick_reloads)).c_str(),
                  FormatCount(double(stats.prefetch_loads)).c_str(), FormatCount(double(stats.prefetch_hits)).c_str(),
                  FormatCount(double(stats.brick_acquires)).c_str(), FormatDuration(stats.stall_seconds).c_str());
+    if (textures) {
+        std::fprintf(stderr, "  textures: read %s through a %s tile cache (%s held at the end)\n",
+                     FormatBytes(textures->bytes_read()).c_str(), FormatBytes(textures->max_memory_bytes()).c_str(),
+                     FormatBytes(textures->memory_used_bytes()).c_str());
+    }
     return Status::Ok();
 }
 
@@ -211,6 +240,7 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--pager", opts->pager,
                     "Pager tunables with --memory: prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION "
                     "(comma separated; docs/pager.md)");
+    cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }
 

@@ -63,8 +63,49 @@ ResidentBrick::~ResidentBrick() {
     if (scene_ != nullptr) rtcReleaseScene(static_cast<RTCScene>(scene_));
 }
 
+namespace {
+
+/// Embree's intersection and occlusion filter for bricks with cut-outs: a hit where the material's alpha mask
+/// says the surface is absent is rejected, and the ray goes on to the next surface (Embree 3
+/// RTCFilterFunctionN: clear valid[i] to reject hit i).
+void AlphaFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* brick = static_cast<const ResidentBrick*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+        if (!brick->SurfacePresent(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i)))
+            args->valid[i] = 0;
+    }
+}
+
+/// Whether any triangle of `m` has a material with an alpha mask.
+bool NeedsAlphaFilter(const store::BrickMesh& m, const AlphaMasks* masks) {
+    if (masks == nullptr || masks->empty() || !m.HasUvs()) return false;
+    std::vector<bool> seen(masks->size(), false);
+    for (uint32_t id : m.material_ids) {
+        if (id < masks->size() && !seen[id]) {
+            if ((*masks)[id] != nullptr) return true;
+            seen[id] = true;
+        }
+    }
+    return false;
+}
+
+}  // namespace
+
+bool ResidentBrick::SurfacePresent(uint32_t triangle, float u, float v) const {
+    const uint32_t material = mesh_.material_ids[triangle];
+    if (masks_ == nullptr || material >= masks_->size() || (*masks_)[material] == nullptr) return true;
+    const uint32_t* tri = &mesh_.indices[3 * size_t(triangle)];
+    const float w = 1.f - u - v;
+    std::array<float, 2> uv;
+    for (int k = 0; k < 2; ++k) uv[k] = mesh_.uvs[tri[0]][k] * w + mesh_.uvs[tri[1]][k] * u + mesh_.uvs[tri[2]][k] * v;
+    return (*masks_)[material]->Present(uv);
+}
+
 StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
-                                                              Bounds3f cell, store::BrickMesh mesh) {
+                                                              Bounds3f cell, store::BrickMesh mesh,
+                                                              const AlphaMasks* masks) {
     // Embree reads vertex buffers with 16-byte loads: the last vertex needs 4 readable bytes after it.
     mesh.positions.reserve(mesh.positions.size() + 1);
     std::unique_ptr<ResidentBrick> brick(new ResidentBrick(id, cell, std::move(mesh)));
@@ -81,6 +122,12 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
                                    sizeof(Vec3f), m.positions.size());
         rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0,
                                    3 * sizeof(uint32_t), m.TriangleCount());
+        if (NeedsAlphaFilter(m, masks)) {
+            brick->masks_ = masks;
+            rtcSetGeometryUserData(geom, brick.get());
+            rtcSetGeometryIntersectFilterFunction(geom, AlphaFilter);
+            rtcSetGeometryOccludedFilterFunction(geom, AlphaFilter);
+        }
         rtcCommitGeometry(geom);
         rtcAttachGeometry(scene, geom);
         rtcReleaseGeometry(geom);
@@ -201,7 +248,7 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     uint64_t bytes = 0;
     StatusOr<store::BrickMesh> mesh = LoadMesh(id, &bytes);
     StatusOr<std::unique_ptr<ResidentBrick>> built =
-        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value())
+        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(), &alpha_masks_)
                   : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
@@ -220,6 +267,12 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     }
     slot.ready.store(slot.brick.get(), std::memory_order_release);
     return BrickHandle(this, slot.brick.get());
+}
+
+void BrickSource::SetAlphaMasks(AlphaMasks masks) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "alpha masks set while bricks are resident";
+    alpha_masks_ = std::move(masks);
 }
 
 void BrickSource::Release(uint32_t id) {

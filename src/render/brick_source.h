@@ -5,6 +5,7 @@
 // policy under a memory budget). A resident brick carries its decoded mesh and its Embree scene, built when
 // the brick is loaded. Embree types stay in brick_source.cpp.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -26,6 +27,16 @@ namespace nave::render {
 
 class EmbreeDevice;
 
+/// A cut-out (alpha-masked leaves, chains, lead cames): whether the surface of one material is there at mesh
+/// texture coordinates `uv`. Called by Embree's intersection filters from any thread, so thread-safe.
+class AlphaMask {
+  public:
+    virtual ~AlphaMask() = default;
+    virtual bool Present(const std::array<float, 2>& uv) const = 0;
+};
+/// Alpha masks by material id; a null entry (or an id past the end) is an opaque material.
+using AlphaMasks = std::vector<std::shared_ptr<const AlphaMask>>;
+
 /// The nearest hit of a ray inside one brick.
 struct BrickHit {
     float t = 0;          ///< ray parameter of the hit
@@ -43,9 +54,11 @@ class ResidentBrick {
     ResidentBrick& operator=(const ResidentBrick&) = delete;
 
     /// Builds the Embree scene over `mesh` (shared buffers: the mesh is not copied). Embree errors (out of
-    /// memory, invalid geometry) come back as a Status naming the brick.
+    /// memory, invalid geometry) come back as a Status naming the brick. With `masks`, hits on masked
+    /// materials where the mask says the surface is absent are skipped by every query (the masks must outlive
+    /// the brick).
     static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id, Bounds3f cell,
-                                                          store::BrickMesh mesh);
+                                                          store::BrickMesh mesh, const AlphaMasks* masks = nullptr);
 
     uint32_t id() const { return id_; }
     const Bounds3f& cell() const { return cell_; }
@@ -62,9 +75,13 @@ class ResidentBrick {
     /// Whether any triangle is hit with t in [t0, t1]. Thread-safe.
     bool Occluded(const Vec3f& origin, const Vec3f& dir, float t0, float t1) const;
 
+    /// Whether the surface of `triangle` is there at barycentrics (u, v) (its material's alpha mask).
+    bool SurfacePresent(uint32_t triangle, float u, float v) const;
+
   private:
     ResidentBrick(uint32_t id, Bounds3f cell, store::BrickMesh mesh);
     uint32_t id_;
+    const AlphaMasks* masks_ = nullptr;
     Bounds3f cell_;
     store::BrickMesh mesh_;
     void* scene_ = nullptr;  // RTCScene
@@ -135,6 +152,9 @@ class BrickSource {
     BrickSourceStats stats() const;
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon portals).
     EmbreeDevice& device() const { return *device_; }
+    /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is loaded
+    /// (checked): a resident brick keeps the masks it was built with.
+    void SetAlphaMasks(AlphaMasks masks);
 
   protected:
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
@@ -158,6 +178,7 @@ class BrickSource {
     std::vector<Bounds3f> cells_;
     std::vector<store::MaterialRecord> materials_;
     Bounds3f bounds_;
+    AlphaMasks alpha_masks_;
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;

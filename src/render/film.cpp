@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "render/image_io.h"
+#include "imaging/image_io.h"
 
 namespace nave::render {
 namespace {
@@ -72,7 +72,7 @@ std::vector<float> Film::LinearRgb() const {
 Status Film::Write(const std::filesystem::path& exr_path,
                    const std::vector<std::pair<std::string, std::string>>& metadata) const {
     std::vector<float> rgb = LinearRgb();
-    FloatImage image;
+    imaging::FloatImage image;
     image.width = width_;
     image.height = height_;
     image.channels = {"R", "G", "B"};
@@ -99,7 +99,7 @@ Status Film::Write(const std::filesystem::path& exr_path,
         }
         if (output_.aov_depth) out[k++] = aov_count_[p].load() ? aov(6) : INFINITY;
     }
-    NAVE_RETURN_IF_ERROR(WriteExr(exr_path, image, metadata));
+    NAVE_RETURN_IF_ERROR(imaging::WriteExr(exr_path, image, metadata));
 
     // PNG: exposure set so the log-average luminance maps to middle grey 0.18 (Reinhard et al. 2002,
     // "Photographic tone reproduction", eq. 1-2), shifted by exposure_ev, then clamped and sRGB-encoded.
@@ -122,7 +122,7 @@ Status Film::Write(const std::filesystem::path& exr_path,
     }
     std::filesystem::path png_path = exr_path;
     png_path.replace_extension(".png");
-    return WriteRgb8(png_path, width_, height_, png, metadata);
+    return imaging::WriteRgb8(png_path, width_, height_, png, metadata);
 }
 
 }  // namespace nave::render

@@ -169,7 +169,9 @@ class Engine {
         const Light* light = nullptr;
         Vec3f v0, v1, v2, n;  // kTriangle
         float area = 0;
-        const Spectrum* emission = nullptr;
+        const SurfaceMaterial* material = nullptr;  // kTriangle: what it emits
+        std::array<std::array<float, 2>, 3> uv{};     // kTriangle: texture coordinates of v0, v1, v2
+        bool has_uv = false;
         int portal = -1;      // kLight (sun, directional): index in portals_ when aiming at windows
     };
     std::vector<PortalProjection> portals_;
@@ -251,7 +253,7 @@ bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float 
         const ThinGlassMaterial* glass = m.thin_glass();
         if (glass == nullptr) return false;
         SampledSpectrum reflected, transmitted;
-        ThinDielectricBxdf(glass->eta.Sample(r.lambda), glass->internal_transmittance.Sample(r.lambda))
+        ThinDielectricBxdf(glass->eta.Sample(r.lambda), m.GlassInternalTransmittance(h.has_uv ? &h.uv : nullptr, r.lambda))
             .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
         r.beta *= transmitted;
         if (r.beta.IsZero()) return false;
@@ -361,7 +363,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
         // Emission found by the path itself (two-sided; emissive surfaces are not light-sampled, so weight
         // 1). In photon mode paths stop at their first diffuse vertex, so this only sees specular and glossy
         // chains; light reaching diffuse vertices from emitters comes with the photons.
-        film_->AddSample(r.pixel, r.beta * mat.emission.Sample(r.lambda), r.lambda);
+        film_->AddSample(r.pixel, r.beta * mat.Emitted(h.has_uv ? &h.uv : nullptr, r.lambda), r.lambda);
     }
     if (r.depth >= uint32_t(scene_.settings.max_depth)) return false;
     Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
@@ -380,7 +382,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     }
     if (visible_point) {
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from photons.
-        visible_->Add(r.pixel, h.p, h.ns, wo, mat, r.beta);
+        visible_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, r.beta);
         return false;
     }
     std::optional<BsdfSample> bs = bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice),
@@ -609,6 +611,21 @@ float MeanVisible(const Spectrum& s) {
     for (int l = 400; l <= 700; l += 10) sum += s.Evaluate(float(l));
     return float(sum / 31);
 }
+
+/// The rough power of an emissive material for choosing emitters: MeanVisible of its spectrum, or for an
+/// emission texture the mean of its mean radiance over a few wavelength sets (any positive weight keeps the
+/// estimate unbiased; a good one only lowers noise).
+float EmissionPower(const SurfaceMaterial& m) {
+    if (!(m.textures && m.textures->emission)) return MeanVisible(m.emission);
+    double sum = 0;
+    for (int i = 0; i < 8; ++i) {
+        SampledWavelengths lambda = SampledWavelengths::SampleVisible((i + 0.5f) / 8);
+        SampledSpectrum s = m.textures->MeanEmission(lambda);
+        for (int k = 0; k < kNumWavelengths; ++k) sum += s[k];
+    }
+    // A black texture would give 0 and never be chosen; keep a floor so its triangles can still emit.
+    return std::max(float(sum / (8 * kNumWavelengths)), 1e-6f);
+}
 }  // namespace
 
 Status Engine::BuildEmitters() {
@@ -656,10 +673,14 @@ Status Engine::BuildEmitters() {
                 e.area = 0.5f * Length(c);
                 if (e.area <= 0) continue;
                 e.n = Normalize(c);
-                e.emission = &sm.emission;
+                e.material = &sm;
+                if (m.HasUvs()) {
+                    for (int k = 0; k < 3; ++k) e.uv[k] = m.uvs[m.indices[3 * t + k]];
+                    e.has_uv = true;
+                }
                 triangles.push_back(e);
                 // Two-sided Lambertian emitter: power = L pi A per side.
-                triangle_weights.push_back(MeanVisible(*e.emission) * 2 * kPiF * e.area);
+                triangle_weights.push_back(EmissionPower(sm) * 2 * kPiF * e.area);
             }
         }
     }
@@ -843,7 +864,10 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                 r.dir = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
                 r.origin = OffsetOrigin(p, n, r.dir);
                 // L cos / (1/A * cos/pi * 1/2).
-                r.beta = e.emission->Sample(lambda) * (2 * kPiF * e.area);
+                std::array<float, 2> uv;
+                for (int k = 0; k < 2; ++k)
+                    uv[k] = e.uv[0][k] * (1 - su) + e.uv[1][k] * (su * (1 - u1.y)) + e.uv[2][k] * (su * u1.y);
+                r.beta = e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPiF * e.area);
                 r.flags = kFromAreaLight;
             }
             r.beta /= p_choice;

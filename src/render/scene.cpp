@@ -92,6 +92,55 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
     return s;
 }
 
+namespace {
+
+/// The config mapping of a model material: its own, else "default", else null.
+const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config, const std::string& name) {
+    auto it = config.materials.find(name);
+    if (it == config.materials.end()) it = config.materials.find("default");
+    return it == config.materials.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir, TextureCache& cache,
+                      RenderScene* scene, std::vector<std::string>* warnings) {
+    if (!config.textures.enabled) return Status::Ok();
+    const auto& records = scene->source->materials();
+    NAVE_CHECK_EQ(records.size(), scene->materials.size());
+    AlphaMasks masks(records.size());
+    bool any_mask = false;
+    for (size_t i = 0; i < records.size(); ++i) {
+        const store::MaterialRecord& rec = records[i];
+        if (rec.textures.empty()) continue;
+        const auto* mapping = FindMapping(config, rec.name);
+        NAVE_CHECK(mapping != nullptr);  // BuildRenderScene refused unmapped materials
+        const MaterialConfig& mc = mapping->second;
+        if (!mc.textures) continue;
+        SurfaceMaterial& m = scene->materials[i];
+        SurfaceTextureOptions options;
+        options.use_albedo = std::holds_alternative<DiffuseMaterial>(m.material);
+        options.use_transmittance = std::holds_alternative<ThinGlassMaterial>(m.material);
+        options.emission_scale = mc.emission_scale;
+        std::shared_ptr<const SurfaceTextures> t = OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
+        if (t == nullptr) continue;
+        if (t->emission && mc.emission) {
+            // The config's emission overrides the model's, texture included.
+            auto copy = std::make_shared<SurfaceTextures>(*t);
+            copy->emission = {};
+            t = copy;
+        }
+        if (t->emission) m.emissive = true;
+        if (t->alpha) {
+            masks[i] = t;
+            any_mask = true;
+        }
+        m.textures = std::move(t);
+    }
+    if (any_mask) scene->source->SetAlphaMasks(std::move(masks));
+    return Status::Ok();
+}
+
 StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source) {
     RenderScene scene;
     scene.source = &source;
@@ -102,12 +151,10 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
 
     // Materials: every model material needs a mapping (or the default).
     const auto& records = source.materials();
-    auto default_it = config.materials.find("default");
     for (size_t i = 0; i < records.size(); ++i) {
         const store::MaterialRecord& rec = records[i];
-        auto it = config.materials.find(rec.name);
-        if (it == config.materials.end()) it = default_it;
-        if (it == config.materials.end()) {
+        const auto* it = FindMapping(config, rec.name);
+        if (it == nullptr) {
             return InvalidArgumentError("{}: the model's material '{}' has no mapping: add [materials.{}] or "
                                         "[materials.default]",
                                         file, rec.name, rec.name);

@@ -18,18 +18,9 @@
 #include "render/materials/materials.h"
 #include "render/scene_config.h"
 #include "render/sun/sky.h"
+#include "render/texture/surface_textures.h"
 
 namespace nave::render {
-
-// [texture] An albedo texture of a diffuse material. Implemented over OpenImageIO in render/texture/
-// (SurfaceTextures, library nave_texture), which nave_render does not link: the caller attaches it.
-/// The diffuse reflectance of a textured material at mesh texture coordinates `uv` (as the store keeps
-/// them), at a path's wavelengths; at most 1. Thread-safe.
-class AlbedoTexture {
-  public:
-    virtual ~AlbedoTexture() = default;
-    virtual SampledSpectrum Albedo(const std::array<float, 2>& uv, const SampledWavelengths& lambda) const = 0;
-};
 
 /// A spectral material as the integrators use it: the physics engineer's Material (render/materials/
 /// materials.h) plus what the scene adds: emission, the portal flag, and black (absorbs everything).
@@ -40,8 +31,8 @@ struct SurfaceMaterial {
     bool emissive = false;
     Spectrum emission;           ///< radiance, W m^-2 sr^-1 nm^-1, both sides
     bool portal = false;         ///< photons are aimed at it (render.photon_target = "portals")
-    /// [texture] Replaces the albedo of a diffuse material at hits with texture coordinates; null: none.
-    std::shared_ptr<const AlbedoTexture> albedo_texture;
+    /// The model's textures for this material (albedo of a diffuse material, alpha, emission); null: none.
+    std::shared_ptr<const SurfaceTextures> textures;
 
     /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the secondary
     /// wavelengths of `lambda`.
@@ -49,11 +40,30 @@ struct SurfaceMaterial {
         if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
         return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
     }
-    /// [texture] The BSDF at a hit with texture coordinates `uv` (null when the mesh has none).
+    /// The BSDF at a hit with texture coordinates `uv` (null when the mesh has none).
     Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda, const std::array<float, 2>* uv) const {
-        if (albedo_texture && uv != nullptr && !black && std::holds_alternative<DiffuseMaterial>(material))
-            return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(albedo_texture->Albedo(*uv, *lambda))));
+        if (textures && textures->albedo && uv != nullptr && !black &&
+            std::holds_alternative<DiffuseMaterial>(material))
+            return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(textures->Albedo(*uv, *lambda))));
+        if (const ThinGlassMaterial* glass = thin_glass(); glass && textures && textures->transmittance && uv) {
+            SampledSpectrum tau = textures->Transmittance(*uv, *lambda);
+            return Bsdf(ns, Vec3f(0, 0, 0), glass->GetBxdf(*lambda, &tau));
+        }
         return MakeBsdf(ns, lambda);
+    }
+    /// The internal transmittance of a thin glass pane at a hit with texture coordinates `uv` (null when the
+    /// mesh has none): the spectral transmittance texture's where there is one. Call only on thin glass.
+    SampledSpectrum GlassInternalTransmittance(const std::array<float, 2>* uv, const SampledWavelengths& lambda) const {
+        if (textures && textures->transmittance && uv != nullptr) return textures->Transmittance(*uv, lambda);
+        return thin_glass()->internal_transmittance.Sample(lambda);
+    }
+    /// Radiance emitted at a hit with texture coordinates `uv` (null when the mesh has none): the emission
+    /// texture's where there is one, else the config's spectrum. Call only when `emissive`.
+    SampledSpectrum Emitted(const std::array<float, 2>* uv, const SampledWavelengths& lambda) const {
+        if (textures && textures->emission) {
+            return uv != nullptr ? textures->Emission(*uv, lambda) : textures->MeanEmission(lambda);
+        }
+        return emission.Sample(lambda);
     }
     /// The window pane, if this is thin glass (rays cross it without bending).
     const ThinGlassMaterial* thin_glass() const {
@@ -98,6 +108,14 @@ struct RenderScene {
 
 /// Resolves `config` against the model in `source`.
 StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source);
+
+/// Attaches the model's textures (config.textures.enabled, and each material's `textures` key) to the
+/// materials of `scene`: albedo, emission (making the material emissive) and alpha cut-outs, which are handed
+/// to the brick source, so call before any brick is loaded. Texture paths in the material table are relative
+/// to `base_dir` (the store's directory). A texture that cannot be opened is a warning in `warnings` and
+/// the material keeps its flat value. `cache` must outlive the render.
+Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir, TextureCache& cache,
+                      RenderScene* scene, std::vector<std::string>* warnings);
 
 /// The tabulated form of a config spectrum.
 Spectrum ToSpectrum(const SpectrumSpec& spec);

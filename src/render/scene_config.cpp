@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/file.h"
+#include "core/memory.h"
 #include "core/spectrum.h"
 #include "render/sun/spa.h"
 
@@ -380,6 +381,12 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     return r.Finish();
 }
 
+/// The texture keys every material type takes.
+Status ParseMaterialTextures(TableReader& r, MaterialConfig* m) {
+    NAVE_RETURN_IF_ERROR(r.Bool("textures", &m->textures));
+    return r.Float("emission_scale", &m->emission_scale, 0, 1e9);
+}
+
 Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     m->where = r.WhereTable();
     if (r.Has("builtin")) {
@@ -390,6 +397,7 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
         NAVE_RETURN_IF_ERROR(r.String("builtin", &m->builtin));
         NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
         NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
+        NAVE_RETURN_IF_ERROR(ParseMaterialTextures(r, m));
         return r.Finish();
     }
     std::string type = "diffuse";
@@ -429,6 +437,19 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     }
     NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
     NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
+    NAVE_RETURN_IF_ERROR(ParseMaterialTextures(r, m));
+    return r.Finish();
+}
+
+Status ParseTextures(TableReader& r, TextureConfig* t) {
+    NAVE_RETURN_IF_ERROR(r.Bool("enabled", &t->enabled));
+    if (const toml::node* n = r.Take("cache")) {
+        if (!n->is_string()) return r.TypeError("cache", *n, "a size such as \"256M\"");
+        StatusOr<uint64_t> bytes = ParseByteSize(*n->value<std::string>());
+        if (!bytes.ok()) return r.RangeError("cache", *n, bytes.status().message());
+        t->cache_bytes = *bytes;
+    }
+    NAVE_RETURN_IF_ERROR(r.Double("memory_share", &t->memory_share, 0.0, 0.9));
     return r.Finish();
 }
 
@@ -574,6 +595,11 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
     if (output != nullptr) {
         TableReader t(*output, "output", name);
         NAVE_RETURN_IF_ERROR(ParseOutput(t, &config.output));
+    }
+    NAVE_ASSIGN_OR_RETURN(const toml::table* textures, r.Table("textures"));
+    if (textures != nullptr) {
+        TableReader t(*textures, "textures", name);
+        NAVE_RETURN_IF_ERROR(ParseTextures(t, &config.textures));
     }
     NAVE_RETURN_IF_ERROR(r.Finish());
     return config;

@@ -91,6 +91,11 @@ struct MaterialConfig {
     float roughness = 0.f;
     std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface
     bool portal = false;             ///< with render.photon_target = "portals", sun photons aim at it
+    /// Use the model's textures for this material (albedo of a diffuse material, alpha cut-outs, emission).
+    bool textures = true;
+    /// Multiplies the radiance lifted from the model's emission texture (map_Ke, emissiveTexture): an RGB
+    /// texel of luminance 1 emits a spectrum of luminance `emission_scale` (W m^-2 sr^-1 nm^-1 units).
+    float emission_scale = 1.f;
     std::string where;
 };
 
@@ -119,6 +124,13 @@ struct OutputConfig {
     bool aov_albedo = false, aov_normal = false, aov_depth = false;
 };
 
+/// The model's image textures (docs/textures.md).
+struct TextureConfig {
+    bool enabled = true;                        ///< false: every material keeps its flat config colour
+    uint64_t cache_bytes = uint64_t(256) << 20; ///< tile cache cap when `nave render` has no --memory
+    double memory_share = 0.2;                  ///< with --memory: the cache's share of the budget
+};
+
 struct SceneConfig {
     std::filesystem::path path;
     CameraConfig camera;
@@ -128,6 +140,7 @@ struct SceneConfig {
     std::map<std::string, MaterialConfig> materials;  ///< by model material name; "default" for the rest
     RenderSettings render;
     OutputConfig output;
+    TextureConfig textures;
 };
 
 /// Parses and checks a scene config file. Errors name the file, line and column, and the key.

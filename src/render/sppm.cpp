@@ -43,8 +43,11 @@ void VisiblePoints::BeginIteration(const SampledWavelengths& lambda) {
 }
 
 void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
-                        const SurfaceMaterial& material, const SampledSpectrum& beta) {
+                        const SurfaceMaterial& material, const std::array<float, 2>* uv,
+                        const SampledSpectrum& beta) {
     Point& vp = points_[pixel];
+    vp.has_uv = uv != nullptr;
+    if (uv != nullptr) vp.uv = *uv;
     vp.p = p;
     vp.ns = ns;
     vp.wo = wo;
@@ -101,7 +104,7 @@ void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, con
         Vec3f d = vp.p - p;
         if (Dot(d, d) > px.radius * px.radius) continue;
         SampledWavelengths l = lambda;
-        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l).Eval(vp.wo, wi, l);
+        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr).Eval(vp.wo, wi, l);
         if (f.IsZero()) continue;
         SampledSpectrum phi = beta * f;
         for (int k = 0; k < kNumWavelengths; ++k) {

@@ -10,6 +10,7 @@
 // overlaps, so a photon landing in a brick finds all the points it can reach in that brick's own grid.
 
 #include <atomic>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -29,9 +30,10 @@ class VisiblePoints {
 
     /// Starts an iteration at wavelengths `lambda`: forgets the previous visible points.
     void BeginIteration(const SampledWavelengths& lambda);
-    /// Records pixel's visible point. Thread-safe for distinct pixels (one camera path per pixel).
+    /// Records pixel's visible point, with its texture coordinates `uv` (null when the mesh has none).
+    /// Thread-safe for distinct pixels (one camera path per pixel).
     void Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo, const SurfaceMaterial& material,
-             const SampledSpectrum& beta);
+             const std::array<float, 2>* uv, const SampledSpectrum& beta);
     /// Registers every visible point in the bricks its gather sphere overlaps (after the camera pass).
     void BuildBrickGrids(const store::BrickTree& tree);
     /// A photon of power `beta` arriving from direction `wi` (pointing away from the surface) at `p` in
@@ -50,6 +52,8 @@ class VisiblePoints {
     struct Point {
         Vec3f p, ns, wo;
         const SurfaceMaterial* material = nullptr;
+        std::array<float, 2> uv{};  // texture coordinates, when has_uv
+        bool has_uv = false;
         SampledSpectrum beta;
         bool valid = false;
     };

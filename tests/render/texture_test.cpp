@@ -12,10 +12,12 @@
 #include <vector>
 
 #include "render/texture/spectral_texture.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/texture_cache.h"
 
 namespace nave::render {
 namespace {
+
+using namespace nave::imaging;
 
 class TextureTest : public ::testing::Test {
   protected:

@@ -53,7 +53,7 @@ TEST_F(NaveCli, InspectJsonDescribesTheStore) {
     for (const std::string& part :
          {fmt::format("\"triangles\": {},", triangles_),
           fmt::format("\"source_triangles\": {},", triangles_), std::string("\"bricks\": 4,"),
-          std::string("\"format_version\": \"1.0\""), std::string("\"step\": 0.001"),
+          fmt::format("\"format_version\": \"{}.{}\"", kFormatMajor, kFormatMinor), std::string("\"step\": 0.001"),
           std::string("\"max_axis_error\": 0.0005"), std::string("\"name\": \"m2\""),
           std::string("\"map_Kd\": \"textures/m1.png\""),
           std::string("\"source_files\": [\"synthetic-surface\"]"),

@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <random>
 #include <set>
 #include <thread>
 
 #include "store/brick_codec.h"
+#include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/store_writer.h"
 #include "store/testing/store_testing.h"
@@ -371,6 +373,47 @@ TEST(StoreWriter, FinishRefusesInconsistentTablesAndCanRetry) {
     ASSERT_TRUE(
         (*writer)->Finish(testing::MakeMaterials(3), split.tree, mesh.TriangleCount()).ok());
     EXPECT_TRUE(Store::Open(dir / "w.nave").ok());
+}
+
+}  // namespace
+}  // namespace nave::store
+
+namespace nave::store {
+namespace {
+
+// Format 1.1 appended alpha_cutoff to each material record; a 1.0 record ends before it and must read as
+// the default, while a 1.1 record keeps its value.
+TEST(StoreMaterialTable, ReadsRecordsOfFormat10WithoutAlphaCutoff) {
+    using format::DecodeMaterials;
+    using format::EncodeMaterials;
+    using format::RawHeader;
+    std::vector<MaterialRecord> materials = testing::MakeMaterials(2);
+    materials[0].alpha_cutoff = 0.25f;
+    materials[1].alpha_cutoff = 0.75f;
+    const std::string v11 = EncodeMaterials(materials);
+    RawHeader h;
+    h.material_count = 2;
+    auto back = DecodeMaterials(v11, h, "t.nave");
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ((*back)[0].alpha_cutoff, 0.25f);
+    EXPECT_EQ((*back)[1].alpha_cutoff, 0.75f);
+
+    // Rebuild the table as 1.0 wrote it: each record 4 bytes shorter, its length field to match.
+    std::string v10;
+    for (size_t pos = 0; pos < v11.size();) {
+        uint32_t length = 0;
+        std::memcpy(&length, v11.data() + pos, 4);
+        const uint32_t shorter = length - 4;
+        v10.append(reinterpret_cast<const char*>(&shorter), 4);
+        v10.append(v11, pos + 4, shorter);
+        pos += 4 + length;
+    }
+    ASSERT_EQ(v10.size() + 8, v11.size());
+    auto old = DecodeMaterials(v10, h, "t.nave");
+    ASSERT_TRUE(old.ok()) << old.status().ToString();
+    EXPECT_EQ((*old)[0].alpha_cutoff, 0.5f);
+    EXPECT_EQ((*old)[1].name, materials[1].name);
+    EXPECT_EQ((*old)[1].textures, materials[1].textures);
 }
 
 }  // namespace

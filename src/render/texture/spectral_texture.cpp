@@ -1,15 +1,11 @@
 #include "render/texture/spectral_texture.h"
 
-#include <OpenImageIO/imageio.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <charconv>
 #include <string>
 
-#include "render/texture/oiio_status.h"
+#include "imaging/image_io.h"
 
 namespace nave::render {
 
@@ -114,35 +110,12 @@ Status WriteSpectralTexture(const std::filesystem::path& path, int width, int he
         if (b > 0) centres += ',';
         centres += std::to_string(band_centres_nm[b]);
     }
-    // OIIO picks the format from the extension, so the temporary name keeps ".exr" last.
-    static std::atomic<int> counter{0};
-    std::filesystem::path temp = path;
-    temp.replace_filename(path.stem().string() + ".tmp-" + std::to_string(getpid()) + "-" +
-                          std::to_string(counter++) + ".exr");
-    auto out = OIIO::ImageOutput::create(temp.string());
-    if (!out)
-        return texture_internal::OiioError(temp, "cannot create an OpenEXR writer",
-                                           OIIO::geterror());
-    OIIO::ImageSpec spec(width, height, n, OIIO::TypeHalf);
-    spec.tile_width = 64;
-    spec.tile_height = 64;
-    spec.channelnames.clear();
-    for (int b = 0; b < n; ++b) spec.channelnames.push_back("band" + std::to_string(b));
-    spec.attribute(kBandCentresAttribute, centres);
-    spec.attribute("compression", "zip");
-    bool ok = out->open(temp.string(), spec) && out->write_image(OIIO::TypeFloat, pixels.data()) &&
-              out->close();
-    if (!ok) {
-        std::string err = out->geterror();
-        std::error_code ec;
-        std::filesystem::remove(temp, ec);
-        return IoError("{}: cannot write spectral texture: {}", path.string(), err);
-    }
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec)
-        return IoError("{}: cannot rename from {}: {}", path.string(), temp.string(), ec.message());
-    return Status();
+    imaging::FloatImage image;
+    image.width = width;
+    image.height = height;
+    for (int b = 0; b < n; ++b) image.channels.push_back(imaging::BandChannelName(b));
+    image.pixels.assign(pixels.begin(), pixels.end());
+    return imaging::WriteTiledExr(path, image, 64, {{kBandCentresAttribute, centres}});
 }
 
 }  // namespace nave::render

@@ -11,12 +11,16 @@
 
 #include "core/spectrum.h"
 #include "core/status.h"
-#include "render/texture/texture_cache.h"
+#include "imaging/image_io.h"
+#include "imaging/texture_cache.h"
 
 namespace nave::render {
 
-/// The header attribute holding the band centres, comma-separated, in nm.
-inline constexpr char kBandCentresAttribute[] = "nave:band_centres_nm";
+using imaging::TextureCache;
+using imaging::TextureFootprint;
+using imaging::TextureRef;
+
+using imaging::kBandCentresAttribute;
 /// At most this many bands per spectral texture.
 inline constexpr int kMaxSpectralBands = 64;
 

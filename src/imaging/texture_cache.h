@@ -1,20 +1,20 @@
 #pragma once
-// Image textures out of core: a wrapper over OpenImageIO's TextureSystem whose tile cache is capped
-// by a byte budget (a share of the renderer's --memory, so the pager can count it). Textures are
-// read tile by tile on demand and evicted when the cap is reached; tiled, MIP-mapped files (what
-// `nave preprocess` writes) are read most efficiently, untiled ones are auto-tiled.
+// Image textures out of core: OpenImageIO's TextureSystem (in nave's plugin, imaging/oiio_plugin.h)
+// with its tile cache capped by a byte budget (a share of the renderer's --memory, so the pager can
+// count it). Textures are read tile by tile on demand and evicted when the cap is reached; tiled,
+// MIP-mapped files (what `nave preprocess` writes) are read most efficiently, untiled ones are
+// auto-tiled.
 
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "core/status.h"
 
-namespace nave::render {
+namespace nave::imaging {
 
 /// The filter footprint of one lookup: the derivatives of the texture coordinates (s, t) along two
 /// directions across the pixel's footprint on the surface. All zero means a point sample of the
@@ -56,46 +56,36 @@ struct TextureInfo {
 class TextureCache {
   public:
     /// A cache whose tiles use at most `max_memory_bytes` (OpenImageIO's own floor of 10 MiB
-    /// applies; max_memory_bytes() reports the effective cap).
+    /// applies; max_memory_bytes() reports the effective cap). Loads the OpenImageIO plugin.
     static StatusOr<std::unique_ptr<TextureCache>> Create(size_t max_memory_bytes);
-    ~TextureCache();
-    TextureCache(const TextureCache&) = delete;
-    TextureCache& operator=(const TextureCache&) = delete;
+    virtual ~TextureCache() = default;
 
     /// Opens `path` (reads its header only). A missing file is NotFound, an unreadable one
     /// IoError, both naming the file and with OpenImageIO's reason.
-    StatusOr<TextureRef> Open(const std::filesystem::path& path);
+    virtual StatusOr<TextureRef> Open(const std::filesystem::path& path) = 0;
 
     /// Filtered lookup of `num_channels` channels from `first_channel` at (s, t) (s to the right,
     /// t downwards, (0, 0) the top-left corner of the image, texel centres at (i + 0.5) / width),
     /// bilinear within and trilinear across MIP levels for the footprint. Missing channels are 0.
     /// Errors name the file.
-    Status Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
-                  int first_channel, int num_channels, float* result,
-                  TextureWrap wrap = TextureWrap::kRepeat) const;
+    virtual Status Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
+                          int first_channel, int num_channels, float* result,
+                          TextureWrap wrap = TextureWrap::kRepeat) const = 0;
 
-    const TextureInfo& info(TextureRef texture) const;
+    virtual const TextureInfo& info(TextureRef texture) const = 0;
     /// A string attribute of the file's header (e.g. "nave:band_centres_nm"); NotFound naming the
     /// file and the attribute when absent.
-    StatusOr<std::string> StringAttribute(TextureRef texture, const std::string& name) const;
+    virtual StatusOr<std::string> StringAttribute(TextureRef texture,
+                                                  const std::string& name) const = 0;
 
     /// The effective cap of the tile cache in bytes.
-    size_t max_memory_bytes() const { return max_memory_bytes_; }
+    virtual size_t max_memory_bytes() const = 0;
     /// Bytes of tiles held now (OpenImageIO "stat:cache_memory_used").
-    size_t memory_used_bytes() const;
+    virtual size_t memory_used_bytes() const = 0;
     /// Bytes read from texture files so far ("stat:bytes_read").
-    uint64_t bytes_read() const;
+    virtual uint64_t bytes_read() const = 0;
     /// OpenImageIO's statistics report (level 1-5), for --verbose output.
-    std::string StatsReport(int level = 1) const;
-
-  private:
-    struct Entry;
-    TextureCache() = default;
-
-    void* system_ = nullptr;  // OIIO::TextureSystem*, owned
-    size_t max_memory_bytes_ = 0;
-    mutable std::mutex mutex_;  // guards entries_ growth (entries themselves never move)
-    std::vector<std::unique_ptr<Entry>> entries_;
+    virtual std::string StatsReport(int level = 1) const = 0;
 };
 
-}  // namespace nave::render
+}  // namespace nave::imaging

@@ -1,7 +1,6 @@
 #pragma once
 // The one adapter from OpenImageIO's error reporting (geterror() strings after a failed call) to
-// nave's Status. Private to src/render/texture: it includes OIIO, which stays out of public
-// headers.
+// nave's Status. Private to the plugin (src/imaging/oiio): it includes OIIO.
 
 #include <OpenImageIO/texture.h>
 
@@ -11,7 +10,7 @@
 
 #include "core/status.h"
 
-namespace nave::render::texture_internal {
+namespace nave::imaging::oiio {
 
 /// A Status for a failed OIIO call on `file`: "<file>: <what>: <OIIO's message>". `oiio_message`
 /// is the text of geterror() (already cleared by the caller); a missing file becomes NotFound, an
@@ -22,4 +21,4 @@ Status OiioError(const std::filesystem::path& file, std::string_view what,
 /// Takes (and clears) the pending error of `ts` and, if empty, OIIO's global error.
 std::string TakeError(OIIO::TextureSystem& ts);
 
-}  // namespace nave::render::texture_internal
+}  // namespace nave::imaging::oiio

@@ -1,4 +1,4 @@
-#include "render/texture/oiio_status.h"
+#include "imaging/oiio/oiio_status.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -6,7 +6,7 @@
 #include <system_error>
 #include <vector>
 
-namespace nave::render::texture_internal {
+namespace nave::imaging::oiio {
 
 Status OiioError(const std::filesystem::path& file, std::string_view what,
                  std::string oiio_message) {
@@ -39,4 +39,4 @@ std::string TakeError(OIIO::TextureSystem& ts) {
     return e;
 }
 
-}  // namespace nave::render::texture_internal
+}  // namespace nave::imaging::oiio

@@ -1,47 +1,50 @@
-#include "render/texture/texture_cache.h"
+#include "imaging/oiio/oiio_texture_cache.h"
 
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
+#include <vector>
 
 #include "core/check.h"
-#include "render/texture/oiio_status.h"
+#include "imaging/oiio/oiio_status.h"
 
-namespace nave::render {
-
-using texture_internal::OiioError;
-using texture_internal::TakeError;
-
-struct TextureCache::Entry {
-    OIIO::TextureSystem::TextureHandle* handle = nullptr;
-    TextureInfo info;
-};
-
+namespace nave::imaging::oiio {
 namespace {
 
-OIIO::TextureSystem* Ts(void* p) { return static_cast<OIIO::TextureSystem*>(p); }
+class OiioTextureCache final : public TextureCache {
+  public:
+    explicit OiioTextureCache(OIIO::TextureSystem* system) : system_(system) {}
+    ~OiioTextureCache() override;
+    Status Configure(size_t max_memory_bytes);
 
-}  // namespace
+    StatusOr<TextureRef> Open(const std::filesystem::path& path) override;
+    Status Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
+                  int first_channel, int num_channels, float* result,
+                  TextureWrap wrap) const override;
+    const TextureInfo& info(TextureRef texture) const override;
+    StatusOr<std::string> StringAttribute(TextureRef texture,
+                                          const std::string& name) const override;
+    size_t max_memory_bytes() const override { return max_memory_bytes_; }
+    size_t memory_used_bytes() const override;
+    uint64_t bytes_read() const override;
+    std::string StatsReport(int level) const override { return system_->getstats(level); }
 
-TextureFootprint RayConeFootprint(float cone_width_m, float cos_theta, float uv_area,
-                                  float world_area_m2) {
-    if (!(world_area_m2 > 0.f) || !(uv_area > 0.f)) return {};
-    // Ray Tracing Gems ch. 20: LOD = Δ0 + log2(|W| / |n·d|) with Δ0 = ½ log2(t_a / p_a); in
-    // footprint form the width in texture units is sqrt(t_a / p_a) · |W| / |n·d|. |n·d| is kept
-    // away from 0 so grazing hits filter over at most the whole texture instead of overflowing.
-    float cos_abs = std::max(std::abs(cos_theta), 1e-3f);
-    float width = std::sqrt(uv_area / world_area_m2) * std::abs(cone_width_m) / cos_abs;
-    return TextureFootprint::Isotropic(std::min(width, 1.f));
-}
+  private:
+    struct Entry {
+        OIIO::TextureSystem::TextureHandle* handle = nullptr;
+        TextureInfo info;
+    };
+    OIIO::TextureSystem* system_;  // owned
+    size_t max_memory_bytes_ = 0;
+    mutable std::mutex mutex_;  // guards entries_ growth (entries themselves never move)
+    std::vector<std::unique_ptr<Entry>> entries_;
+};
 
-StatusOr<std::unique_ptr<TextureCache>> TextureCache::Create(size_t max_memory_bytes) {
-    std::unique_ptr<TextureCache> cache(new TextureCache());
-    // Not the shared TextureSystem: each cache has its own ImageCache and so its own budget.
-    OIIO::TextureSystem* ts = OIIO::TextureSystem::create(/*shared=*/false);
-    if (ts == nullptr) return InternalError("OpenImageIO: cannot create a texture system");
-    cache->system_ = ts;
+Status OiioTextureCache::Configure(size_t max_memory_bytes) {
+    OIIO::TextureSystem* ts = system_;
     ts->attribute("max_memory_MB", float(double(max_memory_bytes) / (1024.0 * 1024.0)));
     // Untiled files (JPEG, PNG, TGA as exported) are read in 64-pixel tiles rather than whole,
     // and get MIP levels built on demand, so they too stay within the cap.
@@ -52,18 +55,21 @@ StatusOr<std::unique_ptr<TextureCache>> TextureCache::Create(size_t max_memory_b
     float effective_mb = 0.f;
     if (!ts->getattribute("max_memory_MB", effective_mb))
         return InternalError("OpenImageIO: cannot read back max_memory_MB");
-    cache->max_memory_bytes_ = size_t(double(effective_mb) * 1024.0 * 1024.0);
-    return cache;
+    max_memory_bytes_ = size_t(double(effective_mb) * 1024.0 * 1024.0);
+    return Status::Ok();
 }
 
-TextureCache::~TextureCache() {
+OiioTextureCache::~OiioTextureCache() {
     // The system was created unshared, so it owns a private ImageCache: ask destroy() to tear that down
     // too, or every TextureCache leaks its ImageCache (LeakSanitizer found it).
-    if (system_ != nullptr) OIIO::TextureSystem::destroy(Ts(system_), /*teardown_imagecache=*/true);
+    // Drop every tile first: per-thread tile references that outlive the cache otherwise corrupt the next
+    // cache's memory accounting (an OIIO assertion when tests create caches one after another).
+    system_->invalidate_all(/*force=*/true);
+    OIIO::TextureSystem::destroy(system_, /*teardown_imagecache=*/true);
 }
 
-StatusOr<TextureRef> TextureCache::Open(const std::filesystem::path& path) {
-    OIIO::TextureSystem* ts = Ts(system_);
+StatusOr<TextureRef> OiioTextureCache::Open(const std::filesystem::path& path) {
+    OIIO::TextureSystem* ts = system_;
     OIIO::ustring name(path.string());
     OIIO::TextureSystem::TextureHandle* handle = ts->get_texture_handle(name);
     OIIO::ImageSpec spec;
@@ -85,12 +91,12 @@ StatusOr<TextureRef> TextureCache::Open(const std::filesystem::path& path) {
     return TextureRef{entries_.back().get()};
 }
 
-const TextureInfo& TextureCache::info(TextureRef texture) const {
+const TextureInfo& OiioTextureCache::info(TextureRef texture) const {
     NAVE_CHECK(texture.entry != nullptr);
     return static_cast<const Entry*>(texture.entry)->info;
 }
 
-Status TextureCache::Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
+Status OiioTextureCache::Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
                             int first_channel, int num_channels, float* result,
                             TextureWrap wrap) const {
     NAVE_CHECK(texture.entry != nullptr);
@@ -105,18 +111,18 @@ Status TextureCache::Lookup(TextureRef texture, float s, float t, const TextureF
     opt.swrap = w;
     opt.twrap = w;
     opt.fill = 0.f;
-    OIIO::TextureSystem* ts = Ts(system_);
+    OIIO::TextureSystem* ts = system_;
     if (!ts->texture(e.handle, nullptr, opt, s, t, footprint.dsdx, footprint.dtdx, footprint.dsdy,
                      footprint.dtdy, num_channels, result))
         return OiioError(e.info.path, "texture lookup failed", TakeError(*ts));
     return Status();
 }
 
-StatusOr<std::string> TextureCache::StringAttribute(TextureRef texture,
+StatusOr<std::string> OiioTextureCache::StringAttribute(TextureRef texture,
                                                     const std::string& name) const {
     NAVE_CHECK(texture.entry != nullptr);
     const Entry& e = *static_cast<const Entry*>(texture.entry);
-    OIIO::TextureSystem* ts = Ts(system_);
+    OIIO::TextureSystem* ts = system_;
     OIIO::ImageSpec spec;
     if (!ts->get_imagespec(e.handle, nullptr, 0, spec))
         return OiioError(e.info.path, "cannot read texture header", TakeError(*ts));
@@ -127,18 +133,27 @@ StatusOr<std::string> TextureCache::StringAttribute(TextureRef texture,
     return std::string(p->get_string());
 }
 
-size_t TextureCache::memory_used_bytes() const {
+size_t OiioTextureCache::memory_used_bytes() const {
     int64_t used = 0;
-    Ts(system_)->getattribute("stat:cache_memory_used", OIIO::TypeInt64, &used);
+    system_->getattribute("stat:cache_memory_used", OIIO::TypeInt64, &used);
     return size_t(std::max<int64_t>(used, 0));
 }
 
-uint64_t TextureCache::bytes_read() const {
+uint64_t OiioTextureCache::bytes_read() const {
     int64_t bytes = 0;
-    Ts(system_)->getattribute("stat:bytes_read", OIIO::TypeInt64, &bytes);
+    system_->getattribute("stat:bytes_read", OIIO::TypeInt64, &bytes);
     return uint64_t(std::max<int64_t>(bytes, 0));
 }
 
-std::string TextureCache::StatsReport(int level) const { return Ts(system_)->getstats(level); }
+}  // namespace
 
-}  // namespace nave::render
+StatusOr<std::unique_ptr<TextureCache>> CreateOiioTextureCache(size_t max_memory_bytes) {
+    // Not the shared TextureSystem: each cache has its own ImageCache and so its own budget.
+    OIIO::TextureSystem* ts = OIIO::TextureSystem::create(/*shared=*/false);
+    if (ts == nullptr) return InternalError("OpenImageIO: cannot create a texture system");
+    auto cache = std::make_unique<OiioTextureCache>(ts);
+    NAVE_RETURN_IF_ERROR(cache->Configure(max_memory_bytes));
+    return std::unique_ptr<TextureCache>(std::move(cache));
+}
+
+}  // namespace nave::imaging::oiio

@@ -1,0 +1,134 @@
+// nave's OpenImageIO plugin (libnave_oiio.so): the implementation of imaging/oiio_plugin.h. Loaded on first
+// use by LoadOiioPlugin; see that header for why OpenImageIO is not linked into `nave` itself.
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include <chrono>
+#include <system_error>
+
+#include "imaging/image_io.h"
+#include "imaging/oiio/oiio_status.h"
+#include "imaging/oiio/oiio_texture_cache.h"
+#include "imaging/oiio_plugin.h"
+
+namespace nave::imaging::oiio {
+namespace {
+
+OIIO::TypeDesc TypeOf(StoredPixel p) {
+    switch (p) {
+        case StoredPixel::kFloat: return OIIO::TypeDesc::FLOAT;
+        case StoredPixel::kHalf: return OIIO::TypeDesc::HALF;
+        case StoredPixel::kUint8: return OIIO::TypeDesc::UINT8;
+    }
+    return OIIO::TypeDesc::FLOAT;
+}
+
+/// OIIO's pending global error, or a note that it gave none.
+std::string GlobalError() { return OIIO::geterror(); }
+
+class Plugin final : public OiioPlugin {
+  public:
+    Status WriteImage(const std::filesystem::path& format_path, const std::filesystem::path& temp_path,
+                      const ImageWriteRequest& r) const override {
+        NAVE_CHECK_EQ(r.channels.size(), r.stored.size());
+        auto out = OIIO::ImageOutput::create(format_path.string());
+        if (!out) return OiioError(format_path, "no image writer for this extension", GlobalError());
+        const bool uint8 = !r.stored.empty() && r.stored[0] == StoredPixel::kUint8;
+        const OIIO::TypeDesc in_type = uint8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
+        OIIO::ImageSpec spec(r.width, r.height, int(r.channels.size()), in_type);
+        spec.channelnames = r.channels;
+        if (!uint8) {
+            spec.channelformats.clear();
+            for (StoredPixel p : r.stored) spec.channelformats.push_back(TypeOf(p));
+            spec.format = TypeOf(r.stored.empty() ? StoredPixel::kFloat : r.stored[0]);
+            spec.attribute("compression", "zip");
+        }
+        if (r.tile_size > 0) {
+            spec.tile_width = spec.tile_height = r.tile_size;
+            spec.tile_depth = 1;
+        }
+        for (const auto& [key, value] : r.metadata) spec.attribute(key, value);
+        if (!out->open(temp_path.string(), spec))
+            return IoError("{}: cannot open for writing: {}", format_path.string(), out->geterror());
+        if (!out->write_image(in_type, r.pixels)) {
+            std::string err = out->geterror();
+            out->close();
+            return IoError("{}: write failed: {}", format_path.string(), err);
+        }
+        if (!out->close()) return IoError("{}: close failed: {}", format_path.string(), out->geterror());
+        return Status::Ok();
+    }
+
+    StatusOr<FloatImage> ReadImage(const std::filesystem::path& path) const override {
+        auto in = OIIO::ImageInput::open(path.string());
+        if (!in) return OiioError(path, "cannot open image", GlobalError());
+        const OIIO::ImageSpec& spec = in->spec();
+        FloatImage image;
+        image.width = spec.width;
+        image.height = spec.height;
+        image.channels = spec.channelnames;
+        image.pixels.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+            return OiioError(path, "cannot read image", in->geterror());
+        in->close();
+        return image;
+    }
+
+    StatusOr<std::unique_ptr<TextureCache>> CreateTextureCache(size_t max_memory_bytes) const override {
+        return CreateOiioTextureCache(max_memory_bytes);
+    }
+
+    Status MakeTexture(const std::filesystem::path& source, const std::filesystem::path& output,
+                       TextureContent content) const override {
+        std::error_code ec;
+        if (!std::filesystem::exists(source, ec)) return NotFoundError("{}: no such file", source.string());
+        OIIO::ImageBuf in(source.string());
+        if (!in.read(0, 0, /*force=*/true, OIIO::TypeFloat)) {
+            Status st = OiioError(source, "unreadable", in.geterror());
+            return InvalidArgumentError("{}", st.message());
+        }
+        const bool colour = content == TextureContent::kColour;
+        if (colour) {
+            // Colour textures are sRGB-encoded (IEC 61966-2-1); the renderer filters and lifts linear values.
+            // Alpha and further channels are linear already, and colorconvert leaves alpha alone.
+            OIIO::ImageBuf linear;
+            if (!OIIO::ImageBufAlgo::colorconvert(linear, in, "sRGB", "linear")) {
+                Status st = OiioError(source, "cannot convert from sRGB to linear", linear.geterror());
+                return InvalidArgumentError("{}", st.message());
+            }
+            in = std::move(linear);
+        }
+        // make_texture stamps the output with the current time unless the image has a DateTime: stamp the
+        // source's own modification time, so that converting the same file twice gives the same bytes (the
+        // converted file's name carries its checksum).
+        std::string stamp = "unknown";
+        const auto mtime = std::filesystem::last_write_time(source, ec);
+        if (!ec) {
+            const auto sys = std::chrono::file_clock::to_sys(mtime);
+            stamp = fmt::format("source modified {} s after 1970",
+                                std::chrono::duration_cast<std::chrono::seconds>(sys.time_since_epoch()).count());
+        }
+        OIIO::ImageSpec config;
+        // Colour: half floats (OpenEXR; OIIO's TIFF writer would store half as float); data: the source's
+        // pixel type. Both tiled and MIP-mapped by make_texture.
+        config.format = colour ? OIIO::TypeHalf : in.nativespec().format;
+        config.tile_width = config.tile_height = 64;
+        config.attribute("wrapmodes", "periodic,periodic");
+        config.attribute("compression", "zip");
+        config.attribute("DateTime", stamp);
+        if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in, output.string(), config))
+            return IoError("{}: cannot write the texture converted from {}: {}", output.string(), source.string(),
+                           GlobalError());
+        return Status::Ok();
+    }
+};
+
+}  // namespace
+}  // namespace nave::imaging::oiio
+
+extern "C" __attribute__((visibility("default"))) nave::imaging::OiioPlugin* NaveCreateOiioPlugin(int version) {
+    if (version != nave::imaging::kOiioPluginVersion) return nullptr;
+    return new nave::imaging::oiio::Plugin();
+}
