@@ -149,13 +149,14 @@ class Engine {
 
     bool custom_picker_;
     BrickPicker picker_;
-    std::unique_ptr<Pager> pager_;  // null: in-core
     double stall_seconds_ = 0;      // in-core
     const RenderScene& scene_;
     Film* film_;
     RenderStats* stats_;
     const store::BrickTree& tree_;
     BrickQueues<RayRecord> queues_;
+    // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
+    std::unique_ptr<Pager> pager_;  // null: in-core
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
     bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
