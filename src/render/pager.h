@@ -25,7 +25,7 @@ namespace nave::render {
 
 struct RenderSettings;
 
-/// Tunables of the pager. Defaults are the measured best on the abbey (docs/pager.md).
+/// Tunables of the pager; docs/pager.md has the measurements behind the defaults.
 struct PagerOptions {
     /// Bytes the resident bricks may take (sum of ResidentBrick::memory_bytes, plus the estimate of
     /// a brick being loaded). The caller computes it from the user's --memory, minus what it
