@@ -3,6 +3,9 @@
 
 #include <cstdio>
 #include <optional>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "cli/commands.h"
 #include "core/log.h"
@@ -11,6 +14,7 @@
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
+#include "render/pager.h"
 #include "render/procedural_scenes.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
@@ -24,9 +28,11 @@ struct RenderOptions {
     std::string config;
     std::string output;
     std::optional<int> spp, iterations, threads;
-    std::optional<uint64_t> seed, photons;
+    std::optional<uint64_t> seed, photons, wave_paths;
     std::string mode;
     std::string resolution;  // "WxH"
+    std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
+    std::string pager;       // --pager TUNABLES
     bool no_textures = false;
 };
 
@@ -65,6 +71,7 @@ Status RunRender(const RenderOptions& o) {
     if (o.threads) config.render.threads = *o.threads;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
+    if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
@@ -93,9 +100,52 @@ Status RunRender(const RenderOptions& o) {
               config.camera.width, config.camera.height, ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
 
+    // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process); the
+    // bricks get what is left (docs/pager.md).
+    std::optional<render::PagerOptions> paging;
+    if (!o.memory.empty() || !o.pager.empty()) {
+        if (o.memory.empty()) return InvalidArgumentError("--pager {}: tunables need --memory SIZE", o.pager);
+        NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
+        render::PagerOptions options;
+        NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
+        // The texture cache's cap comes out of --memory too (docs/pager.md).
+        const uint64_t texture_bytes = textures ? textures->max_memory_bytes() : 0;
+        const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
+                                                            source->brick_count(), options.wave_overlap) +
+                                 texture_bytes;
+        const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        if (memory < reserve + need.min_bytes) {
+            return InvalidArgumentError(
+                "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
+                "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes){}: at least {} "
+                "({} bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
+                o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
+                options.prefetch && need.second_bytes > 0
+                    ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
+                                  FormatBytes(need.second_bytes))
+                    : std::string(),
+                FormatBytes(reserve), reserve,
+                texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
+                                  : std::string(),
+                FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes,
+                source->brick_count(), FormatBytes(need.total_bytes), need.total_bytes);
+        }
+        options.brick_budget_bytes = memory - reserve;
+        log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
+                  "reserved", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
+                  FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
+                  reserve);
+        paging = options;
+    }
+
     render::Film film(config.camera.width, config.camera.height, config.output);
     render::RenderStats stats;
-    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats));
+    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, paging ? &*paging : nullptr));
+#if defined(__GLIBC__)
+    // The ray queues are gone: give their pages back before the image writer loads OpenImageIO, so that the
+    // process stays near --memory (glibc keeps freed heap pages otherwise).
+    if (paging) malloc_trim(0);
+#endif
 
     const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);
@@ -105,9 +155,13 @@ Status RunRender(const RenderOptions& o) {
         config.render.seed, config.render.max_depth, config.render.threads);
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
-        "bytes_read={} peak_rss={}",
+        "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} brick_reloads={} "
+        "prefetch_loads={} prefetch_hits={} stall={:.3f}s",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
-        stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes);
+        stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
+        stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes) : std::string("in-core"),
+        stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads, stats.prefetch_hits,
+        stats.stall_seconds);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -137,6 +191,18 @@ Status RunRender(const RenderOptions& o) {
                  FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),
                  FormatBytes(stats.bytes_read).c_str(), FormatBytes(stats.peak_rss_bytes).c_str(),
                  FormatBytes(stats.peak_queue_bytes).c_str());
+    std::fprintf(stderr, "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
+                 "resident when needed %s of %s, workers stalled on loads %s\n",
+                 paging ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")").c_str()
+                        : "in-core",
+                 FormatBytes(stats.peak_brick_bytes).c_str(),
+                 paging ? fmt::format(" ({:.0f}% of budget)",
+                                      100.0 * double(stats.peak_brick_bytes) / double(stats.brick_budget_bytes))
+                              .c_str()
+                        : "",
+                 FormatCount(double(stats.brick_evictions)).c_str(), FormatCount(double(stats.brick_reloads)).c_str(),
+                 FormatCount(double(stats.prefetch_loads)).c_str(), FormatCount(double(stats.prefetch_hits)).c_str(),
+                 FormatCount(double(stats.brick_acquires)).c_str(), FormatDuration(stats.stall_seconds).c_str());
     if (textures) {
         std::fprintf(stderr, "  textures: read %s through a %s tile cache (%s held at the end)\n",
                      FormatBytes(textures->bytes_read()).c_str(), FormatBytes(textures->max_memory_bytes()).c_str(),
@@ -164,6 +230,16 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
+    cmd->add_option("--wave-paths", opts->wave_paths,
+                    "Camera paths (or photons) in flight at once (default 1048576): more rays per brick visit, so "
+                    "fewer loads under --memory, for more ray-queue memory")
+        ->check(CLI::Range(uint64_t(1024), uint64_t(1) << 31));
+    cmd->add_option("--memory", opts->memory,
+                    "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
+                    "Default: every brick stays resident once loaded");
+    cmd->add_option("--pager", opts->pager,
+                    "Pager tunables with --memory: prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION "
+                    "(comma separated; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }

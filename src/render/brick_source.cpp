@@ -9,6 +9,10 @@
 
 
 namespace nave::render {
+namespace {
+// Embree's BVH takes roughly 40-60 bytes per triangle for a medium-quality build.
+constexpr uint64_t kBvhBytesPerTriangle = 56;
+}  // namespace
 
 // ---------------------------------------------------------------------------------------------- Embree
 
@@ -130,9 +134,17 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     }
     rtcCommitScene(scene);
     NAVE_RETURN_IF_ERROR(device.TakeError(context));
-    // Embree's BVH takes roughly 40-60 bytes per triangle for a medium-quality build.
-    brick->memory_bytes_ = m.MemoryBytes() + 56 * uint64_t(m.TriangleCount());
+    brick->memory_bytes_ = m.MemoryBytes() + kBvhBytesPerTriangle * uint64_t(m.TriangleCount());
     return brick;
+}
+
+uint64_t ResidentBrick::EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
+                                            bool has_uvs) {
+    // Build's vectors as BrickMesh::MemoryBytes counts them: positions hold one spare vertex (the reserve
+    // above), the other vectors exactly their size.
+    uint64_t per_vertex = sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) + (has_uvs ? 2 * sizeof(float) : 0);
+    return vertex_count * per_vertex + sizeof(Vec3f) + triangle_count * (4 * sizeof(uint32_t)) +
+           kBvhBytesPerTriangle * triangle_count;
 }
 
 bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const {
@@ -316,6 +328,11 @@ MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store
     : BrickSource(std::move(device), tree, tree.BrickCells(uint32_t(meshes.size())), std::move(materials),
                   MeshesBounds(meshes)),
       meshes_(std::move(meshes)) {}
+
+uint64_t MemoryBrickSource::EstimatedResidentBytes(uint32_t id) const {
+    const store::BrickMesh& m = meshes_[id];
+    return ResidentBrick::EstimateMemoryBytes(m.VertexCount(), m.TriangleCount(), m.HasNormals(), m.HasUvs());
+}
 
 StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
     *bytes_read += meshes_[id].MemoryBytes();

@@ -65,6 +65,10 @@ class ResidentBrick {
     const store::BrickMesh& mesh() const { return mesh_; }
     /// Bytes of the mesh plus an estimate of Embree's BVH (for budgets and statistics).
     uint64_t memory_bytes() const { return memory_bytes_; }
+    /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory says). Exact
+    /// for meshes whose vectors hold no spare capacity (decoded and copied meshes); the pager checks it.
+    static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
+                                        bool has_uvs);
 
     /// The nearest hit with t in [t0, t1], or false. Thread-safe.
     bool Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const;
@@ -143,6 +147,8 @@ class BrickSource {
     /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's tool;
     /// the default policy never calls it.
     bool Evict(uint32_t id);
+    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes), known without loading it.
+    virtual uint64_t EstimatedResidentBytes(uint32_t id) const = 0;
     BrickSourceStats stats() const;
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon portals).
     EmbreeDevice& device() const { return *device_; }
@@ -186,6 +192,7 @@ class StoreBrickSource final : public BrickSource {
                                                             std::shared_ptr<EmbreeDevice> device);
     ~StoreBrickSource() override;
     const store::Store& store() const { return *store_; }
+    uint64_t EstimatedResidentBytes(uint32_t id) const override;
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
@@ -200,6 +207,7 @@ class MemoryBrickSource final : public BrickSource {
   public:
     MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
                       std::vector<store::BrickMesh> meshes, std::vector<store::MaterialRecord> materials);
+    uint64_t EstimatedResidentBytes(uint32_t id) const override;
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;

@@ -69,16 +69,31 @@ struct SurfaceHit {
 class Engine {
   public:
     Engine(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker)
-        : picker_(picker ? std::move(picker) : BrickPicker(PickFullestBrick)),
+        : custom_picker_(bool(picker)),
+          picker_(picker ? std::move(picker) : BrickPicker(PickFullestBrick)),
           scene_(scene),
           film_(film),
           stats_(stats),
           tree_(scene.source->tree()),
           queues_(scene.source->brick_count()) {}
 
+    /// Pages bricks under `options` (before Run); refuses an impossible budget.
+    Status EnablePaging(const PagerOptions& options) {
+        NAVE_ASSIGN_OR_RETURN(pager_, Pager::Create(*scene_.source, options,
+                                                    [this](uint32_t b) { return queues_.Waiting(b); }));
+        return Status::Ok();
+    }
     Status Run();
 
   private:
+    /// Pins brick `b` for a batch or a pass, through the pager when paging; counts the wait.
+    StatusOr<BrickHandle> AcquireBrick(uint32_t b) {
+        if (pager_) return pager_->Acquire(b);
+        const auto start = std::chrono::steady_clock::now();
+        StatusOr<BrickHandle> h = scene_.source->Acquire(b);
+        stall_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return h;
+    }
     Status RunPath();
     Status RunPhoton();
     /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or the
@@ -96,8 +111,14 @@ class Engine {
         r.t_exit = s.t_exit;
         return s.brick;
     }
-    /// Runs the scheduler until every queue is empty.
-    Status Drain();
+    /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty).
+    Status Drain(size_t stop_below = 0);
+    /// Rays left waiting when the next wave is generated: under paging the next wave joins the tail of the
+    /// previous one, whose few scattered rays would otherwise cost a load each (docs/pager.md); in-core,
+    /// waves do not overlap.
+    size_t WaveOverlap() const {
+        return pager_ ? size_t(pager_->options().wave_overlap * double(scene_.settings.wave_paths)) : 0;
+    }
     void Flush(Outbox& out, const LocalCounters& c);
     void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, Outbox& out, LocalCounters& c);
     /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if the path ends.
@@ -137,12 +158,16 @@ class Engine {
         return RngKey{scene_.settings.seed, r.pixel, r.sample, r.vertex, iteration_, stream};
     }
 
+    bool custom_picker_;
     BrickPicker picker_;
+    double stall_seconds_ = 0;      // in-core
     const RenderScene& scene_;
     Film* film_;
     RenderStats* stats_;
     const store::BrickTree& tree_;
     BrickQueues<RayRecord> queues_;
+    // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
+    std::unique_ptr<Pager> pager_;  // null: in-core
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
     uint32_t iteration_ = 0;
     bool has_thin_glass_ = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const SurfaceMaterial& m) {
@@ -532,20 +557,27 @@ void Engine::Flush(Outbox& out, const LocalCounters& c) {
     rays_.fetch_add(c.rays, std::memory_order_relaxed);
 }
 
-Status Engine::Drain() {
+Status Engine::Drain(size_t stop_below) {
     std::vector<RayRecord> batch;
     std::vector<size_t> waiting(queues_.brick_count());
     for (;;) {
         size_t total = 0;
         for (uint32_t i = 0; i < queues_.brick_count(); ++i) total += waiting[i] = queues_.Waiting(i);
-        if (total == 0) break;
-        const uint32_t b = picker_(waiting, *scene_.source);
+        if (total <= stop_below) break;
+        const uint32_t b = pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, *scene_.source);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0) << "the brick picker chose brick " << b
                                                          << " which has no rays waiting";
         stats_->peak_queue_bytes = std::max<uint64_t>(stats_->peak_queue_bytes, queues_.MemoryBytes());
-        NAVE_ASSIGN_OR_RETURN(BrickHandle handle, scene_.source->Acquire(b));
+        // If b must be loaded now, the loader loads the next brick meanwhile: two loads at once while the
+        // workers would idle anyway.
+        if (pager_ && !scene_.source->IsResident(b)) pager_->Prefetch(waiting, b, 0);
+        NAVE_ASSIGN_OR_RETURN(BrickHandle handle, AcquireBrick(b));
         queues_.Take(b, kMaxBatch, &batch);
         batches_.fetch_add(1, std::memory_order_relaxed);
+        if (pager_) {
+            waiting[b] -= batch.size();
+            pager_->Prefetch(waiting, b, batch.size());  // loads the next brick while this batch is traced
+        }
         const ResidentBrick& brick = *handle;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), kChunk), [&](const tbb::blocked_range<size_t>& range) {
             Outbox out;
@@ -553,6 +585,10 @@ Status Engine::Drain() {
             for (size_t i = range.begin(); i != range.end(); ++i) ProcessRay(batch[i], b, brick, out, c);
             Flush(out, c);
         });
+        if (pager_) {
+            handle.Reset();
+            pager_->BatchDone();
+        }
     }
     return Status::Ok();
 }
@@ -597,13 +633,14 @@ Status Engine::RunPath() {
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
             for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(WaveOverlap()));
             progress.Add((last - first) * uint64_t(s_end - s));
         }
         passes = s_end;
         double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
     }
+    NAVE_RETURN_IF_ERROR(Drain());  // the last wave's tail
     progress.Finish();
     stats_->samples_per_pixel = passes;
     stats_->camera_paths = pixels * uint64_t(passes);
@@ -728,7 +765,7 @@ Status Engine::BuildEmitters() {
     std::vector<std::array<Vec3f, 3>> portal_triangles;
     if (any_emissive || (want_portals && any_portal)) {
         for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
-            NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
+            NAVE_ASSIGN_OR_RETURN(BrickHandle h, AcquireBrick(b));  // released at the end of the iteration
             const store::BrickMesh& m = h->mesh();
             for (size_t t = 0; t < m.TriangleCount(); ++t) {
                 uint32_t mat = m.material_ids[t];
@@ -959,14 +996,15 @@ Status Engine::RunPhoton() {
             SampledWavelengths::SampleVisible(VertexRng(RngKey{scene_.settings.seed, 0, 0, 0, iteration_,
                                                                kStreamLambda}).Uniform(0));
         visible_->BeginIteration(lambda);
+        // Visible points must all be in place before photons arrive: waves overlap within each pass only.
         for (uint64_t first = 0; first < pixels; first += wave) {
             GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(first + wave < pixels ? WaveOverlap() : 0));
         }
         visible_->BuildBrickGrids(tree_);
         for (uint64_t first = 0; first < photons; first += wave) {
             EmitPhotons(first, std::min(photons, first + wave), lambda);
-            NAVE_RETURN_IF_ERROR(Drain());
+            NAVE_RETURN_IF_ERROR(Drain(first + wave < photons ? WaveOverlap() : 0));
         }
         visible_->EndIteration(scene_.settings.alpha);
         done = it + 1;
@@ -1003,6 +1041,23 @@ Status Engine::Run() {
     stats_->batches = batches_.load();
     stats_->brick_loads = after.loads - before.loads;
     stats_->bytes_read = after.bytes_read - before.bytes_read;
+    stats_->brick_acquires = after.acquires - before.acquires;
+    if (pager_) {
+        const PagerStats p = pager_->stats();
+        stats_->brick_budget_bytes = p.brick_budget_bytes;
+        stats_->peak_brick_bytes = p.peak_resident_bytes;
+        stats_->brick_evictions = p.evictions;
+        stats_->brick_reloads = p.reloads;
+        stats_->prefetch_loads = p.prefetch_loads;
+        stats_->prefetch_hits = p.prefetch_hits;
+        stats_->brick_acquires = p.acquires;
+        stats_->stall_seconds = p.stall_seconds;
+    } else {
+        stats_->peak_brick_bytes = after.peak_resident_bytes;
+        stats_->brick_evictions = after.evictions - before.evictions;
+        stats_->stall_seconds = stall_seconds_;
+        stats_->prefetch_hits = stats_->brick_acquires - std::min(stats_->brick_acquires, stats_->brick_loads);
+    }
     stats_->peak_rss_bytes = PeakRssBytes();
     return Status::Ok();
 }
@@ -1013,14 +1068,16 @@ uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource&
     return uint32_t(std::max_element(waiting.begin(), waiting.end()) - waiting.begin());
 }
 
-Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker) {
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker,
+                     const PagerOptions* paging) {
     NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
     int threads = scene.settings.threads > 0 ? scene.settings.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     Status status;
     arena.execute([&] {
         Engine engine(scene, film, stats, std::move(picker));
-        status = engine.Run();
+        status = paging != nullptr ? engine.EnablePaging(*paging) : Status::Ok();
+        if (status.ok()) status = engine.Run();
     });
     return status;
 }

@@ -19,6 +19,7 @@
 #include "core/spectrum.h"
 #include "core/status.h"
 #include "render/film.h"
+#include "render/pager.h"
 #include "render/scene.h"
 
 namespace nave::render {
@@ -36,6 +37,15 @@ struct RenderStats {
     uint64_t batches = 0;          ///< brick visits by the scheduler
     uint64_t brick_loads = 0;
     uint64_t bytes_read = 0;
+    // Residency (docs/pager.md). In-core: no budget, no evictions; stall = time the scheduler waited for loads.
+    uint64_t brick_budget_bytes = 0;   ///< 0: in-core (no --memory)
+    uint64_t peak_brick_bytes = 0;     ///< peak bytes of resident bricks (pager: plus the load being made)
+    uint64_t brick_evictions = 0;
+    uint64_t brick_reloads = 0;        ///< loads of a brick already loaded before during this render
+    uint64_t prefetch_loads = 0;       ///< loads done by the background loader
+    uint64_t prefetch_hits = 0;        ///< bricks already resident when the scheduler asked for them
+    uint64_t brick_acquires = 0;
+    double stall_seconds = 0;          ///< time the workers idled while the scheduler waited for a load
     uint64_t peak_rss_bytes = 0;
     uint64_t peak_queue_bytes = 0;
     int samples_per_pixel = 0;     ///< path mode: passes completed
@@ -52,7 +62,10 @@ using BrickPicker = std::function<uint32_t(const std::vector<size_t>& waiting, c
 uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource& source);
 
 /// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's resolution.
-/// Thread count: scene.settings.threads (0: all cores). `picker` empty: PickFullestBrick.
-Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker = {});
+/// Thread count: scene.settings.threads (0: all cores). `picker` empty: PickFullestBrick, or with paging the
+/// pager's choice. `paging` null: in-core (bricks stay once loaded); else bricks are paged under
+/// paging->brick_budget_bytes (pager.h), and an impossible budget is refused before anything is traced.
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker = {},
+                     const PagerOptions* paging = nullptr);
 
 }  // namespace nave::render

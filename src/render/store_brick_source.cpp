@@ -18,6 +18,11 @@ StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(const std::fi
     return std::unique_ptr<StoreBrickSource>(new StoreBrickSource(std::move(st), std::move(device)));
 }
 
+uint64_t StoreBrickSource::EstimatedResidentBytes(uint32_t id) const {
+    const store::BrickInfo& b = store_->bricks()[id];
+    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
+}
+
 StatusOr<store::BrickMesh> StoreBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
     NAVE_ASSIGN_OR_RETURN(store::BrickMesh mesh, store_->ReadBrick(id));
     *bytes_read += store_->bricks()[id].BytesOnDisk();

@@ -1,0 +1,443 @@
+#include "render/pager.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+
+#include "core/log.h"
+#include "core/memory.h"
+#include "render/ray.h"
+#include "render/scene_config.h"
+
+namespace nave::render {
+
+// ----------------------------------------------------------------------------------------------
+// options
+
+Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
+    constexpr const char* kKeys =
+        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, "
+        "overlap=FRACTION";
+    size_t pos = 0;
+    while (pos <= text.size() && !text.empty()) {
+        size_t comma = text.find(',', pos);
+        std::string_view item =
+            text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos);
+        pos = comma == std::string_view::npos ? text.size() + 1 : comma + 1;
+        if (item.empty()) continue;
+        size_t eq = item.find('=');
+        if (eq == std::string_view::npos) {
+            return InvalidArgumentError("pager tunable '{}': expected KEY=VALUE ({})", item, kKeys);
+        }
+        std::string_view key = item.substr(0, eq), value = item.substr(eq + 1);
+        if (key == "prefetch") {
+            if (value == "on") {
+                options->prefetch = true;
+            } else if (value == "off") {
+                options->prefetch = false;
+            } else {
+                return InvalidArgumentError("pager tunable prefetch={}: expected on or off", value);
+            }
+        } else if (key == "evict") {
+            if (value == "lru") {
+                options->evict_least_traffic = false;
+            } else if (value == "traffic") {
+                options->evict_least_traffic = true;
+            } else {
+                return InvalidArgumentError("pager tunable evict={}: expected lru or traffic",
+                                            value);
+            }
+        } else if (key == "nearly_empty") {
+            uint64_t rays = 0;
+            auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), rays);
+            if (ec != std::errc() || end != value.data() + value.size()) {
+                return InvalidArgumentError("pager tunable nearly_empty={}: expected a ray count",
+                                            value);
+            }
+            options->nearly_empty_rays = size_t(rays);
+        } else if (key == "overlap") {
+            std::string v(value);
+            char* end = nullptr;
+            double f = std::strtod(v.c_str(), &end);
+            if (v.empty() || end != v.c_str() + v.size() || !(f >= 0 && f <= 1)) {
+                return InvalidArgumentError(
+                    "pager tunable overlap={}: expected a fraction in [0, 1]", value);
+            }
+            options->wave_overlap = f;
+        } else if (key == "prefer_resident") {
+            std::string v(value);
+            char* end = nullptr;
+            double f = std::strtod(v.c_str(), &end);
+            if (v.empty() || end != v.c_str() + v.size() || !(f >= 0)) {
+                return InvalidArgumentError(
+                    "pager tunable prefer_resident={}: expected a fraction >= 0", value);
+            }
+            options->prefer_resident = f;
+        } else {
+            return InvalidArgumentError("unknown pager tunable '{}' (accepted: {})", key, kKeys);
+        }
+    }
+    return Status::Ok();
+}
+
+BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) {
+    BrickBudgetMinimum m;
+    for (uint32_t b = 0; b < source.brick_count(); ++b) {
+        uint64_t bytes = source.EstimatedResidentBytes(b);
+        m.total_bytes += bytes;
+        if (b == 0 || bytes > m.largest_bytes) {
+            if (b > 0) {
+                m.second_brick = m.largest_brick;
+                m.second_bytes = m.largest_bytes;
+            }
+            m.largest_brick = b;
+            m.largest_bytes = bytes;
+        } else if (b == 1 || bytes > m.second_bytes) {
+            m.second_brick = b;
+            m.second_bytes = bytes;
+        }
+    }
+    if (source.brick_count() < 2) {
+        m.second_brick = m.largest_brick;
+        m.second_bytes = 0;
+    }
+    m.min_bytes = m.largest_bytes + (prefetch ? m.second_bytes : 0);
+    return m;
+}
+
+uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
+                            uint32_t brick_count, double wave_overlap) {
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    // The process without bricks: code, Embree's device, TBB's threads, the store's tables,
+    // allocator slack, and the image writer's OpenImageIO plugin loaded after the render (~40 MiB
+    // resident, measured).
+    const uint64_t kProcess = (56ull << 20) + uint64_t(brick_count) * 256;
+    // Film: 3 doubles of XYZ, 7 floats of AOVs and a counter per pixel (film.h).
+    const uint64_t film = pixels * (3 * 8 + 7 * 4 + 4);
+    // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken
+    // from a queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on
+    // the abbey.
+    const uint64_t per_pass =
+        settings.mode == RenderSettings::Mode::kPath ? uint64_t(std::max(1, settings.spp)) : 1;
+    uint64_t in_flight = std::min<uint64_t>(settings.wave_paths, pixels * per_pass);
+    if (settings.mode == RenderSettings::Mode::kPhoton) {
+        in_flight = std::max<uint64_t>(
+            in_flight, std::min<uint64_t>(settings.wave_paths, settings.photons_per_iteration));
+    }
+    // Under paging the next wave is generated while wave_overlap of a wave is still waiting.
+    in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) *
+                          std::clamp(wave_overlap, 0.0, 1.0));
+    const uint64_t queues = 3 * in_flight * sizeof(RayRecord);
+    // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and
+    // references to the points in the brick grids.
+    const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton ? pixels * 256 : 0;
+    return kProcess + film + queues + sppm;
+}
+
+// ----------------------------------------------------------------------------------------------
+// pager
+
+Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting)
+    : source_(source),
+      options_(options),
+      waiting_(std::move(waiting)),
+      state_(source.brick_count(), State::kAbsent),
+      bytes_(source.brick_count(), 0),
+      last_used_(source.brick_count(), 0),
+      traffic_(source.brick_count(), 0),
+      load_count_(source.brick_count(), 0),
+      request_(store::kNoBrick),
+      loader_target_(store::kNoBrick) {
+    estimate_.reserve(source.brick_count());
+    for (uint32_t b = 0; b < source.brick_count(); ++b)
+        estimate_.push_back(source.EstimatedResidentBytes(b));
+    stats_.brick_budget_bytes = options.brick_budget_bytes;
+}
+
+StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerOptions& options,
+                                               WaitingFn waiting) {
+    BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
+    if (source.brick_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
+        return InvalidArgumentError(
+            "brick memory budget {} ({} bytes) is too small for this model: its largest brick, "
+            "brick {}, takes {} "
+            "({} bytes) when resident{}; the minimum brick budget is {} ({} bytes)",
+            FormatBytes(options.brick_budget_bytes), options.brick_budget_bytes, need.largest_brick,
+            FormatBytes(need.largest_bytes), need.largest_bytes,
+            options.prefetch && need.second_bytes > 0
+                ? fmt::format(" and prefetching needs room for the next-largest, brick {} ({})",
+                              need.second_brick, FormatBytes(need.second_bytes))
+                : std::string(),
+            FormatBytes(need.min_bytes), need.min_bytes);
+    }
+    std::unique_ptr<Pager> pager(new Pager(source, options, std::move(waiting)));
+    // Bricks an earlier render left resident: keep those that fit, drop the rest.
+    for (uint32_t b = 0; b < source.brick_count(); ++b) {
+        if (!source.IsResident(b)) continue;
+        uint64_t bytes = 0;
+        {
+            StatusOr<BrickHandle> h = source.Acquire(b);
+            if (!h.ok()) continue;
+            bytes = (*h)->memory_bytes();
+        }
+        if (pager->committed_bytes_ + bytes <= options.brick_budget_bytes || !source.Evict(b)) {
+            pager->state_[b] = State::kResident;
+            pager->bytes_[b] = bytes;
+            pager->committed_bytes_ += bytes;
+        }
+    }
+    pager->stats_.peak_resident_bytes = pager->committed_bytes_;
+    if (options.prefetch) pager->loader_ = std::thread([p = pager.get()] { p->LoaderLoop(); });
+    return pager;
+}
+
+Pager::~Pager() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    loader_cv_.notify_all();
+    if (loader_.joinable()) loader_.join();
+}
+
+uint32_t Pager::Pick(const std::vector<size_t>& waiting) {
+    uint32_t fullest = 0;
+    uint32_t resident = store::kNoBrick;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (uint32_t b = 0; b < waiting.size(); ++b) {
+        if (waiting[b] > waiting[fullest]) fullest = b;
+        if (waiting[b] > 0 && state_[b] == State::kResident &&
+            (resident == store::kNoBrick || waiting[b] > waiting[resident])) {
+            resident = b;
+        }
+    }
+    if (state_[fullest] == State::kResident) return fullest;
+    // Tracing a resident brick's rays now costs no load and may let the loader bring the fullest
+    // brick in meanwhile; it pays when the resident brick's batch is large enough to be worth a
+    // visit.
+    if (resident != store::kNoBrick &&
+        double(waiting[resident]) >= options_.prefer_resident * double(waiting[fullest])) {
+        return resident;
+    }
+    return fullest;
+}
+
+void Pager::Reserve(uint32_t id, uint64_t bytes) {
+    state_[id] = State::kLoading;
+    bytes_[id] = bytes;
+    committed_bytes_ += bytes;
+    stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, committed_bytes_);
+}
+
+void Pager::Loaded(uint32_t id, uint64_t bytes, bool prefetched) {
+    committed_bytes_ = committed_bytes_ - bytes_[id] + bytes;
+    if (bytes > bytes_[id]) {
+        ++stats_.estimate_misses;
+        if (!warned_estimate_) {
+            warned_estimate_ = true;
+            log::Warning(
+                "pager: brick {} takes {} bytes resident, more than the {} estimated before "
+                "loading",
+                id, bytes, bytes_[id]);
+        }
+        // Keep the budget on real numbers: make up for the difference at once.
+        MakeRoom(0, id, false);
+    }
+    state_[id] = State::kResident;
+    bytes_[id] = bytes;
+    last_used_[id] = ++tick_;
+    stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, committed_bytes_);
+    ++stats_.loads;
+    if (prefetched) ++stats_.prefetch_loads;
+    if (++load_count_[id] > 1) ++stats_.reloads;
+}
+
+bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
+    const uint64_t budget = options_.brick_budget_bytes;
+    if (committed_bytes_ + need <= budget) return true;
+    struct Candidate {
+        size_t waiting;
+        uint64_t traffic;
+        uint64_t last_used;
+        uint32_t id;
+    };
+    std::vector<Candidate> candidates;
+    for (uint32_t b = 0; b < state_.size(); ++b) {
+        if (state_[b] != State::kResident || b == exclude) continue;
+        size_t w = waiting_ ? waiting_(b) : 0;
+        if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
+        // Nearly empty queues count as empty when traffic decides: their few rays matter less than
+        // how busy the brick is.
+        if (options_.evict_least_traffic && w < options_.nearly_empty_rays) w = 0;
+        candidates.push_back({w, options_.evict_least_traffic ? traffic_[b] : 0, last_used_[b], b});
+    }
+    // Emptiest queue first: the fewer rays wait for a brick, the fewer need it back soon (the paper
+    // unloads a sub-model once almost all its rays are handled); least recently used breaks ties.
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+        if (a.waiting != b.waiting) return a.waiting < b.waiting;
+        if (a.traffic != b.traffic) return a.traffic < b.traffic;
+        return a.last_used < b.last_used;
+    });
+    for (const Candidate& c : candidates) {
+        if (committed_bytes_ + need <= budget) break;
+        if (!source_.Evict(c.id)) continue;  // pinned: the batch being traced
+        state_[c.id] = State::kAbsent;
+        committed_bytes_ -= bytes_[c.id];
+        bytes_[c.id] = 0;
+        ++stats_.evictions;
+    }
+    return committed_bytes_ + need <= budget;
+}
+
+StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
+    if (id >= state_.size()) return source_.Acquire(id);  // the source's error names the brick
+    const auto start = std::chrono::steady_clock::now();
+    auto stalled = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    std::unique_lock<std::mutex> lock(mutex_);
+    last_used_[id] = ++tick_;
+    ++stats_.acquires;
+    if (state_[id] == State::kResident) ++stats_.prefetch_hits;
+    bool waited = false;
+    for (;;) {
+        if (state_[id] == State::kResident) {
+            // Pinned under the lock: evictions take it too, so the brick cannot go between check
+            // and pin.
+            if (waited) stats_.stall_seconds += stalled();
+            return source_.Acquire(id);
+        }
+        if (state_[id] == State::kLoading) {
+            waited = true;
+            loaded_cv_.wait(lock);  // the loader is loading it
+            continue;
+        }
+        if (request_ == id) request_ = store::kNoBrick;
+        if (loader_target_ == id) {
+            // The loader is still making room for it: take over (loads here may evict any unpinned
+            // brick).
+            loader_cancel_ = true;
+            loader_cv_.notify_all();
+        }
+        const uint64_t need = estimate_[id];
+        if (!MakeRoom(need, id, false)) {
+            bool loader_loading = loader_target_ != store::kNoBrick && loader_target_ != id &&
+                                  state_[loader_target_] == State::kLoading;
+            if (loader_loading) {
+                waited = true;
+                loaded_cv_.wait(lock);  // its brick becomes evictable once loaded
+                continue;
+            }
+            return ResourceExhaustedError(
+                "brick memory budget {}: cannot make room for brick {} ({}): {} of bricks are "
+                "pinned",
+                FormatBytes(options_.brick_budget_bytes), id, FormatBytes(need),
+                FormatBytes(committed_bytes_));
+        }
+        Reserve(id, need);
+        lock.unlock();
+        StatusOr<BrickHandle> handle = source_.Acquire(id);
+        lock.lock();
+        if (!handle.ok()) {
+            committed_bytes_ -= bytes_[id];
+            bytes_[id] = 0;
+            state_[id] = State::kAbsent;
+            loaded_cv_.notify_all();
+            stats_.stall_seconds += stalled();
+            return handle.status();
+        }
+        Loaded(id, (*handle)->memory_bytes(), false);
+        loaded_cv_.notify_all();
+        stats_.stall_seconds += stalled();
+        return handle;
+    }
+}
+
+void Pager::Prefetch(const std::vector<size_t>& waiting, uint32_t current, size_t batch_rays) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (current < traffic_.size()) traffic_[current] += batch_rays;
+    if (!options_.prefetch) return;
+    uint32_t best = store::kNoBrick;
+    for (uint32_t b = 0; b < waiting.size(); ++b) {
+        if (b == current || waiting[b] == 0 || state_[b] != State::kAbsent) continue;
+        if (best == store::kNoBrick || waiting[b] > waiting[best]) best = b;
+    }
+    if (best == store::kNoBrick || best == loader_target_) return;
+    request_ = best;
+    loader_cv_.notify_all();
+}
+
+void Pager::BatchDone() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++batch_epoch_;
+    }
+    loader_cv_.notify_all();
+}
+
+PagerStats Pager::stats() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stats_;
+}
+
+void Pager::LoaderLoop() {
+    // Loads run in a one-thread arena of their own: the render's workers are busy tracing, and
+    // Embree builds the brick's BVH with the threads of the arena it is called from (outside any
+    // arena it would use TBB's default pool: more threads than cores, each with its own build
+    // buffers).
+    tbb::task_arena arena(1);
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+        loader_cv_.wait(lock, [&] { return stop_ || request_ != store::kNoBrick; });
+        if (stop_) return;
+        const uint32_t target = request_;
+        request_ = store::kNoBrick;
+        if (state_[target] != State::kAbsent) continue;
+        loader_target_ = target;
+        loader_cancel_ = false;
+        const uint64_t need = estimate_[target];
+        bool reserved = false;
+        for (;;) {
+            if (stop_ || loader_cancel_ || request_ != store::kNoBrick)
+                break;  // given up or superseded
+            if (MakeRoom(need, target, true)) {
+                Reserve(target, need);
+                reserved = true;
+                break;
+            }
+            // Nothing nearly empty to evict: wait for the batch to end (its brick is unpinned
+            // then).
+            const uint64_t epoch = batch_epoch_;
+            loader_cv_.wait(lock, [&] {
+                return stop_ || loader_cancel_ || request_ != store::kNoBrick ||
+                       batch_epoch_ != epoch;
+            });
+        }
+        if (reserved) {
+            lock.unlock();
+            StatusOr<BrickHandle> handle = BrickHandle();
+            arena.execute([&] { handle = source_.Acquire(target); });
+            const bool ok = handle.ok();
+            const uint64_t bytes = ok ? (*handle)->memory_bytes() : 0;
+            // Unpinned at once: the brick stays resident until the scheduler picks it or a load
+            // evicts it.
+            if (ok) (*handle).Reset();
+            lock.lock();
+            if (ok) {
+                Loaded(target, bytes, true);
+            } else {
+                // The source keeps the error (naming the brick) for the scheduler's own Acquire.
+                committed_bytes_ -= bytes_[target];
+                bytes_[target] = 0;
+                state_[target] = State::kAbsent;
+            }
+        }
+        loader_target_ = store::kNoBrick;
+        loader_cancel_ = false;
+        loaded_cv_.notify_all();
+    }
+}
+
+}  // namespace nave::render

@@ -1,0 +1,467 @@
+// The out-of-core pager: a render under a small brick budget gives the image of an in-core render,
+// never holds more than the budget, evicts and reloads at small budgets and not at an in-core one,
+// refuses an impossible budget naming the largest brick, and returns a corrupt brick's error when
+// it meets it.
+
+#include "render/pager.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "common/run_nave.h"
+#include "core/memory.h"
+#include "core/progress.h"
+#include "render/procedural_meshes.h"
+#include "render_test_util.h"
+#include "store/store_reader.h"
+#include "store/store_writer.h"
+
+namespace nave::render {
+namespace {
+
+using testing::MeanY;
+
+class PagerTest : public ::testing::Test {
+  protected:
+    void SetUp() override { ProgressBar::SetEnabled(false); }
+};
+
+// A floor with a 4 x 4 grid of balls, cut into 4 x 4 x 2 bricks: one ball per brick, so the largest
+// bricks are about 1/16 of the model and a budget of ~15 % of the in-core size is feasible. Ball
+// (0, 0) glows (photon mode then reads every brick to find its triangles).
+store::BrickMesh BallGrid() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {4, 0, 0}, {0, 4, 0}, 6, 0);
+    for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+            AppendSphere(&m, {-3 + 2.f * float(i), -3 + 2.f * float(j), 0.7f}, 0.6f, 16, 32,
+                         i == 0 && j == 0 ? 2 : 1);
+        }
+    }
+    return m;
+}
+const std::vector<std::string> kNames = {"floor", "ball", "lamp"};
+constexpr const char* kBallGrid = R"(
+[camera]
+position = [7, 6, 5]
+look_at = [0, 0, 0.5]
+fov_deg = 50
+resolution = [32, 24]
+[sun]
+direction = [0.4, -0.5, 0.75]
+[sky]
+radiance = 0.05
+[materials.floor]
+reflectance = 0.7
+[materials.ball]
+reflectance = {{ wavelengths_nm = [400, 550, 700], values = [0.1, 0.5, 0.9] }}
+[materials.lamp]
+reflectance = 0.5
+emission = 2.0
+[render]
+mode = "{}"
+spp = 4
+iterations = 2
+photons_per_iteration = 20000
+seed = 5
+)";
+
+double MaxRelativeDifference(const Film& a, const Film& b) {
+    double worst = 0;
+    for (size_t p = 0; p < a.pixel_count(); ++p) {
+        Vec3d x = a.PixelXYZ(uint32_t(p)), y = b.PixelXYZ(uint32_t(p));
+        for (int c = 0; c < 3; ++c) {
+            double d = std::abs(x[c] - y[c]) / std::max(1e-3, std::abs(x[c]) + std::abs(y[c]));
+            worst = std::max(worst, d);
+        }
+    }
+    return worst;
+}
+
+/// A fresh source over the ball grid (fresh so that its own peak counter covers this render only).
+std::unique_ptr<MemoryBrickSource> BallGridSource() {
+    auto device = EmbreeDevice::Create();
+    EXPECT_TRUE(device.ok());
+    GridBricks grid = SplitIntoGridBricks(BallGrid(), 4, 4, 2);
+    std::vector<store::MaterialRecord> materials;
+    for (const auto& name : kNames) {
+        store::MaterialRecord r;
+        r.name = name;
+        materials.push_back(r);
+    }
+    return std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
+}
+
+struct Rendered {
+    std::unique_ptr<MemoryBrickSource> source;
+    std::unique_ptr<Film> film;
+    RenderStats stats;
+    Status status;
+};
+
+Rendered RenderBallGrid(const std::string& mode, const PagerOptions* paging, int threads = 2,
+                        uint32_t wave_paths = 0) {
+    Rendered r;
+    r.source = BallGridSource();
+    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), mode), "balls.toml");
+    EXPECT_TRUE(config.ok()) << config.status().ToString();
+    config->render.threads = threads;
+    if (wave_paths > 0) config->render.wave_paths = wave_paths;
+    auto scene = BuildRenderScene(*config, *r.source);
+    EXPECT_TRUE(scene.ok()) << scene.status().ToString();
+    r.film = std::make_unique<Film>(config->camera.width, config->camera.height, config->output);
+    r.status = RenderStreams(*scene, r.film.get(), &r.stats, {}, paging);
+    return r;
+}
+
+/// A budget of about 15 % of the in-core size, or the minimum if that is more.
+PagerOptions SmallBudget(const BrickSource& source, bool prefetch = true) {
+    BrickBudgetMinimum m = MinimumBrickBudget(source, prefetch);
+    PagerOptions o;
+    o.prefetch = prefetch;
+    o.brick_budget_bytes = std::max(m.min_bytes, m.total_bytes * 15 / 100);
+    return o;
+}
+
+void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
+    Rendered in_core = RenderBallGrid(mode, nullptr);
+    ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
+    const BrickBudgetMinimum m = MinimumBrickBudget(*in_core.source, true);
+    EXPECT_GE(in_core.source->brick_count(), 30u);
+    // Prefetching on and off; then small waves (the in-core render has one), which under paging
+    // overlap.
+    for (int variant = 0; variant < 3; ++variant) {
+        const bool prefetch = variant != 1;
+        const uint32_t wave_paths = variant == 2 ? 500 : 0;
+        PagerOptions options = SmallBudget(*in_core.source, prefetch);
+        EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4)
+            << "the test scene should allow a small budget";
+        Rendered paged = RenderBallGrid(mode, &options, 2, wave_paths);
+        ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
+        EXPECT_GT(MeanY(*paged.film), 0.0);
+        // Same bounds as the brick-count and brick-order tests (render_test.cpp): path mode differs
+        // only by double summation order; photon deposits add floats atomically.
+        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound)
+            << mode << " variant " << variant;
+        // The budget holds, by the pager's count and by the source's own.
+        EXPECT_LE(paged.stats.peak_brick_bytes, options.brick_budget_bytes);
+        EXPECT_LE(paged.source->stats().peak_resident_bytes, options.brick_budget_bytes);
+        EXPECT_GT(paged.stats.brick_evictions, 0u);
+        EXPECT_GT(paged.stats.brick_reloads, 0u);
+        EXPECT_GT(paged.stats.brick_loads, in_core.stats.brick_loads);
+        EXPECT_EQ(paged.stats.prefetch_loads > 0, prefetch);
+        EXPECT_EQ(paged.stats.brick_budget_bytes, options.brick_budget_bytes);
+    }
+}
+
+TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
+
+TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-4); }
+
+TEST_F(PagerTest, InCoreBudgetLoadsEveryBrickOnceAndEvictsNothing) {
+    Rendered in_core = RenderBallGrid("path", nullptr);
+    ASSERT_TRUE(in_core.status.ok());
+    PagerOptions options;
+    options.brick_budget_bytes = MinimumBrickBudget(*in_core.source, true).total_bytes;
+    Rendered paged = RenderBallGrid("path", &options);
+    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
+    EXPECT_EQ(paged.stats.brick_evictions, 0u);
+    EXPECT_EQ(paged.stats.brick_reloads, 0u);
+    EXPECT_EQ(paged.stats.brick_loads, in_core.stats.brick_loads);
+    EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
+}
+
+TEST_F(PagerTest, CustomPickerWithPagingRendersTheSameImage) {
+    // Emptiest brick first: the worst order for paging, still the same image within budget.
+    Rendered in_core = RenderBallGrid("path", nullptr);
+    ASSERT_TRUE(in_core.status.ok());
+    auto source = BallGridSource();
+    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), "path"), "balls.toml");
+    ASSERT_TRUE(config.ok());
+    auto scene = BuildRenderScene(*config, *source);
+    ASSERT_TRUE(scene.ok());
+    Film film(config->camera.width, config->camera.height, config->output);
+    RenderStats stats;
+    PagerOptions options = SmallBudget(*source);
+    BrickPicker emptiest = [](const std::vector<size_t>& waiting, const BrickSource&) {
+        uint32_t best = store::kNoBrick;
+        for (uint32_t b = 0; b < waiting.size(); ++b) {
+            if (waiting[b] > 0 && (best == store::kNoBrick || waiting[b] < waiting[best])) best = b;
+        }
+        return best;
+    };
+    ASSERT_TRUE(RenderStreams(*scene, &film, &stats, emptiest, &options).ok());
+    EXPECT_LT(MaxRelativeDifference(*in_core.film, film), 1e-9);
+    EXPECT_LE(source->stats().peak_resident_bytes, options.brick_budget_bytes);
+}
+
+TEST_F(PagerTest, ImpossibleBudgetNamesTheLargestBrickAndTheMinimum) {
+    auto source = BallGridSource();
+    const BrickBudgetMinimum m = MinimumBrickBudget(*source, true);
+    // The estimates are the real sizes: the largest brick is the one the message names.
+    uint64_t largest = 0;
+    for (uint32_t b = 0; b < source->brick_count(); ++b) {
+        largest = std::max(largest, source->EstimatedResidentBytes(b));
+    }
+    EXPECT_EQ(m.largest_bytes, largest);
+    EXPECT_EQ(source->EstimatedResidentBytes(m.largest_brick), largest);
+    EXPECT_GT(m.second_bytes, 0u);
+    EXPECT_LE(m.second_bytes, m.largest_bytes);
+    EXPECT_EQ(m.min_bytes, m.largest_bytes + m.second_bytes);
+    PagerOptions options;
+    options.brick_budget_bytes = m.min_bytes - 1;
+    auto pager = Pager::Create(*source, options, {});
+    ASSERT_FALSE(pager.ok());
+    const std::string& msg = pager.status().message();
+    EXPECT_NE(msg.find(fmt::format("brick {}", m.largest_brick)), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::to_string(m.largest_bytes) + " bytes"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::to_string(m.min_bytes) + " bytes"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::to_string(options.brick_budget_bytes) + " bytes"), std::string::npos)
+        << msg;
+    // Without prefetching the largest brick alone is the minimum.
+    options.prefetch = false;
+    options.brick_budget_bytes = m.largest_bytes;
+    EXPECT_TRUE(Pager::Create(*source, options, {}).ok());
+    // RenderStreams refuses it before tracing anything.
+    options.prefetch = true;
+    Rendered r = RenderBallGrid("path", &options);
+    EXPECT_FALSE(r.status.ok());
+    EXPECT_EQ(r.stats.rays, 0u);
+    EXPECT_EQ(r.source->stats().loads, 0u);
+}
+
+TEST_F(PagerTest, EstimatesMatchTheRealSizes) {
+    auto source = BallGridSource();
+    for (uint32_t b = 0; b < source->brick_count(); ++b) {
+        auto h = source->Acquire(b);
+        ASSERT_TRUE(h.ok());
+        EXPECT_EQ((*h)->memory_bytes(), source->EstimatedResidentBytes(b)) << "brick " << b;
+    }
+}
+
+// Eviction order: emptiest queue first, least recently used on ties; pinned bricks stay.
+TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
+    auto source = BallGridSource();
+    // Four bricks of the same size: balls (1, 1), (1, 2), (2, 1), (2, 2) have the same triangles.
+    std::vector<uint32_t> same;
+    std::map<uint64_t, std::vector<uint32_t>> by_size;
+    for (uint32_t b = 0; b < source->brick_count(); ++b)
+        by_size[source->EstimatedResidentBytes(b)].push_back(b);
+    for (const auto& [bytes, ids] : by_size) {
+        if (ids.size() >= 4) same = ids;
+    }
+    ASSERT_GE(same.size(), 4u);
+    const uint64_t size = source->EstimatedResidentBytes(same[0]);
+    std::vector<size_t> waiting(source->brick_count(), 0);
+    PagerOptions options;
+    options.prefetch = false;
+    options.brick_budget_bytes = 3 * size;
+    auto pager = Pager::Create(*source, options, [&](uint32_t b) { return waiting[b]; });
+    ASSERT_TRUE(pager.ok()) << pager.status().ToString();
+    const uint32_t a = same[0], b = same[1], c = same[2], d = same[3];
+    for (uint32_t id : {a, b, c})
+        ASSERT_TRUE((*pager)->Acquire(id).ok());  // handles dropped at once
+    waiting[a] = 10;
+    waiting[b] = 5;
+    waiting[c] = 10;
+    // d needs room: b has the fewest rays waiting.
+    {
+        auto h = (*pager)->Acquire(d);
+        ASSERT_TRUE(h.ok());
+        EXPECT_FALSE(source->IsResident(b));
+        EXPECT_TRUE(source->IsResident(a) && source->IsResident(c));
+        // b back: a and c tie on rays, a was used longest ago. d is pinned and stays.
+        waiting[d] = 0;
+        ASSERT_TRUE((*pager)->Acquire(b).ok());
+        EXPECT_FALSE(source->IsResident(a));
+        EXPECT_TRUE(source->IsResident(c) && source->IsResident(d));
+        // Pin b and c as well: nothing can make room for a.
+        auto hb = (*pager)->Acquire(b);
+        auto hc = (*pager)->Acquire(c);
+        ASSERT_TRUE(hb.ok() && hc.ok());
+        auto ha = (*pager)->Acquire(a);
+        ASSERT_FALSE(ha.ok());
+        EXPECT_EQ(ha.status().code(), StatusCode::kResourceExhausted);
+    }
+    const PagerStats s = (*pager)->stats();
+    EXPECT_EQ(s.evictions, 2u);
+    EXPECT_EQ(s.loads, 5u);
+    EXPECT_EQ(s.reloads, 1u);
+    EXPECT_LE(s.peak_resident_bytes, options.brick_budget_bytes);
+}
+
+TEST_F(PagerTest, PickPrefersAResidentBrickWithEnoughRays) {
+    auto source = BallGridSource();
+    PagerOptions options;
+    options.prefetch = false;
+    options.brick_budget_bytes = MinimumBrickBudget(*source, false).total_bytes;
+    options.prefer_resident = 0.25;
+    auto pager = Pager::Create(*source, options, {});
+    ASSERT_TRUE(pager.ok());
+    ASSERT_TRUE((*pager)->Acquire(3).ok());
+    std::vector<size_t> waiting(source->brick_count(), 0);
+    waiting[3] = 30;
+    waiting[7] = 100;
+    EXPECT_EQ((*pager)->Pick(waiting), 3u);  // resident, 30 % of the fullest's rays
+    waiting[3] = 20;
+    EXPECT_EQ((*pager)->Pick(waiting), 7u);  // too few: load the fullest
+    ASSERT_TRUE((*pager)->Acquire(7).ok());
+    waiting[3] = 99;
+    EXPECT_EQ((*pager)->Pick(waiting), 7u);  // the fullest is resident
+}
+
+TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
+    PagerOptions o;
+    ASSERT_TRUE(ParsePagerTunables(
+                    "prefetch=off,nearly_empty=100,prefer_resident=0.5,evict=traffic,overlap=0", &o)
+                    .ok());
+    EXPECT_FALSE(o.prefetch);
+    EXPECT_TRUE(o.evict_least_traffic);
+    EXPECT_EQ(o.wave_overlap, 0.0);
+    EXPECT_EQ(o.nearly_empty_rays, 100u);
+    EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
+    ASSERT_TRUE(ParsePagerTunables("", &o).ok());
+    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11",
+                            "prefetch", "evict=random", "overlap=2"}) {
+        Status s = ParsePagerTunables(bad, &o);
+        EXPECT_FALSE(s.ok()) << bad;
+        const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
+        EXPECT_NE(s.message().find(key), std::string::npos) << s.message();
+    }
+}
+
+// ----------------------------------------------------------------------------------------------
+// store
+
+/// Writes `mesh` as a store cut into nx * ny * nz bricks.
+Status WriteStore(const std::filesystem::path& path, const store::BrickMesh& mesh, int nx, int ny,
+                  int nz) {
+    GridBricks grid = SplitIntoGridBricks(mesh, nx, ny, nz);
+    store::GlobalGrid g;
+    g.origin = Vec3d(-10, -10, -10);
+    g.step = 1e-4;
+    NAVE_ASSIGN_OR_RETURN(auto writer,
+                          store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
+    std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
+    for (size_t b = 0; b < grid.meshes.size(); ++b) {
+        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e,
+                              store::EncodeBrick(grid.meshes[b], cells[b], g, {}));
+        NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(e));
+        NAVE_CHECK_EQ(id, uint32_t(b));
+    }
+    std::vector<store::MaterialRecord> materials;
+    for (const auto& name : kNames) {
+        store::MaterialRecord r;
+        r.name = name;
+        materials.push_back(r);
+    }
+    return writer->Finish(materials, grid.tree, mesh.TriangleCount());
+}
+
+class PagerStoreTest : public PagerTest {
+  protected:
+    void SetUp() override {
+        PagerTest::SetUp();
+        dir_ = std::filesystem::temp_directory_path() / fmt::format("nave_pager_test_{}", getpid());
+        std::filesystem::create_directories(dir_);
+        path_ = dir_ / "balls.nave";
+        Status s = WriteStore(path_, BallGrid(), 4, 4, 2);
+        ASSERT_TRUE(s.ok()) << s.ToString();
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    std::filesystem::path dir_, path_;
+};
+
+TEST_F(PagerStoreTest, StoreEstimatesMatchTheRealSizes) {
+    auto device = EmbreeDevice::Create();
+    ASSERT_TRUE(device.ok());
+    auto source = StoreBrickSource::Open(path_, *device);
+    ASSERT_TRUE(source.ok()) << source.status().ToString();
+    for (uint32_t b = 0; b < (*source)->brick_count(); ++b) {
+        auto h = (*source)->Acquire(b);
+        ASSERT_TRUE(h.ok());
+        EXPECT_EQ((*h)->memory_bytes(), (*source)->EstimatedResidentBytes(b)) << "brick " << b;
+    }
+}
+
+TEST_F(PagerStoreTest, CorruptBrickMetWhilePagingNamesIt) {
+    // Corrupt the brick with the most triangles (a ball in view): a byte in the middle of its mesh
+    // section.
+    uint32_t victim = 0;
+    uint64_t offset = 0;
+    {
+        auto st = store::Store::Open(path_);
+        ASSERT_TRUE(st.ok()) << st.status().ToString();
+        for (const store::BrickInfo& b : (*st)->bricks()) {
+            if (b.triangle_count > (*st)->bricks()[victim].triangle_count) victim = b.id;
+        }
+        const store::BrickInfo& b = (*st)->bricks()[victim];
+        offset = b.mesh.offset + b.mesh.length / 2;
+    }
+    {
+        std::fstream f(path_, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekg(std::streamoff(offset));
+        char c = 0;
+        f.read(&c, 1);
+        c = char(c ^ 0x5a);
+        f.seekp(std::streamoff(offset));
+        f.write(&c, 1);
+    }
+    auto device = EmbreeDevice::Create();
+    ASSERT_TRUE(device.ok());
+    auto source = StoreBrickSource::Open(path_, *device);
+    ASSERT_TRUE(source.ok()) << source.status().ToString();
+    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), "path"), "balls.toml");
+    ASSERT_TRUE(config.ok());
+    auto scene = BuildRenderScene(*config, **source);
+    ASSERT_TRUE(scene.ok());
+    Film film(config->camera.width, config->camera.height, config->output);
+    RenderStats stats;
+    PagerOptions options = SmallBudget(**source);
+    Status s = RenderStreams(*scene, &film, &stats, {}, &options);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find(fmt::format("brick {}", victim)), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("balls.nave"), std::string::npos) << s.message();
+}
+
+// ----------------------------------------------------------------------------------------------
+// CLI
+
+TEST(PagerCliTest, TooSmallMemoryIsRefusedNamingTheBrickAndTheMinimum) {
+    const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_memory_" + std::to_string(getpid()) + ".exr");
+    const test::CommandResult r =
+        test::RunNave("render --procedural clutter:bricks=4 --config " + config +
+                      " --resolution 16x12 --spp 1 --memory 1M -o " + out.string());
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("--memory 1M"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("largest brick, brick "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("at least"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(PagerCliTest, MemoryBudgetRendersAndReportsPaging) {
+    const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_memory_ok_" + std::to_string(getpid()) + ".exr");
+    const test::CommandResult r = test::RunNave(
+        "render --procedural clutter:bricks=4 --config " + config +
+        " --resolution 16x12 --spp 1 --memory 64M --pager prefetch=off -o " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("(--memory 64M)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("evictions"), std::string::npos) << r.output;
+    const test::CommandResult bad =
+        test::RunNave("render --procedural clutter:bricks=4 --config " + config +
+                      " --memory 64M --pager speed=11 -o " + out.string());
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.output.find("speed"), std::string::npos) << bad.output;
+    std::filesystem::remove(out);
+    std::filesystem::remove(std::filesystem::path(out).replace_extension(".png"));
+}
+
+}  // namespace
+}  // namespace nave::render
