@@ -90,7 +90,14 @@ Status RunRender(const RenderOptions& o) {
     const bool any_texture = std::any_of(source->materials().begin(), source->materials().end(),
                                          [](const store::MaterialRecord& m) { return !m.textures.empty(); });
     if (config.textures.enabled && any_texture) {
-        NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(config.textures.cache_bytes));
+        // Its cap: [textures] cache, or under --memory the share [textures] memory_share of the budget, which
+        // the pager then counts as reserved (below).
+        uint64_t cap = config.textures.cache_bytes;
+        if (!o.memory.empty()) {
+            NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
+            cap = uint64_t(double(memory) * config.textures.memory_share);
+        }
+        NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(cap));
         std::filesystem::path base = std::filesystem::path(o.model).parent_path();
         std::vector<std::string> warnings;
         NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures, &scene, &warnings));
@@ -115,7 +122,7 @@ Status RunRender(const RenderOptions& o) {
                                  texture_bytes;
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
         if (memory < reserve + need.min_bytes) {
-            return InvalidArgumentError(
+            return ResourceExhaustedError(
                 "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
                 "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes){}: at least {} "
                 "({} bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
@@ -132,9 +139,10 @@ Status RunRender(const RenderOptions& o) {
         }
         options.brick_budget_bytes = memory - reserve;
         log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
-                  "reserved", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
+                  "reserved{}", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
                   FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
-                  reserve);
+                  reserve, texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
+                                             : std::string());
         paging = options;
     }
 
@@ -176,6 +184,7 @@ Status RunRender(const RenderOptions& o) {
     }
     NAVE_RETURN_IF_ERROR(film.Write(out, metadata));
 
+    if (log::GetLevel() > log::Level::kInfo) return Status::Ok();  // -q: errors only, no summary
     std::filesystem::path png = out;
     png.replace_extension(".png");
     std::fprintf(stderr,

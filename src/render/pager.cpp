@@ -160,7 +160,7 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
                                                WaitingFn waiting) {
     BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
     if (source.brick_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
-        return InvalidArgumentError(
+        return ResourceExhaustedError(
             "brick memory budget {} ({} bytes) is too small for this model: its largest brick, "
             "brick {}, takes {} "
             "({} bytes) when resident{}; the minimum brick budget is {} ({} bytes)",

@@ -95,7 +95,7 @@ class Pager {
     /// Rays waiting in the queue of a brick now (thread-safe snapshot).
     using WaitingFn = std::function<size_t(uint32_t brick)>;
 
-    /// Checks the budget against the largest bricks (an InvalidArgument error naming the budget,
+    /// Checks the budget against the largest bricks (a ResourceExhausted error naming the budget,
     /// the largest brick and its size, and the minimum that would work) and starts the loader
     /// thread. Bricks already resident in `source` are kept while they fit the budget and evicted
     /// otherwise.

@@ -78,6 +78,13 @@ TEST_F(CliRenderTest, PreprocessedTexturesAppearInTheRender) {
     EXPECT_GT(sky[1], 0.8f);
     EXPECT_GT(sky[2], 0.6f * sky[0]);
 
+    // Under --memory the texture cache gets [textures] memory_share (0.2) of the budget, counted as reserved.
+    CommandResult budget = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " +
+                                   out.string() + " --memory 400M");
+    ASSERT_EQ(budget.exit_code, 0) << budget.output;
+    EXPECT_NE(budget.output.find("of which 80.0 MiB for the texture cache"), std::string::npos) << budget.output;
+    EXPECT_NE(budget.output.find("through a 80.0 MiB tile cache"), std::string::npos) << budget.output;
+
     // --no-textures: the flat grey material everywhere, the quad whole.
     CommandResult flat = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " +
                                  out.string() + " --no-textures");
