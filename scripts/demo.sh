@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # nave's main job, end to end, on the built-in default: installs what is missing, builds, generates the procedural
 # abbey and preprocesses it into a brick store under a memory budget (streamed, no OBJ in between), verifies the
-# store, renders the nave looking east on a June morning at Royaumont, and writes the image.
+# store, renders the nave looking east on a June morning at Royaumont under a render memory budget (bricks are
+# paged in and out: docs/pager.md), and writes the image.
 #
 #   bash scripts/demo.sh                 # -> out/abbey.png (tone-mapped sRGB) and out/abbey.exr (linear, spectral -> XYZ)
 #
@@ -9,12 +10,17 @@
 #   NAVE_OUT=out          where the store and the images go
 #   NAVE_DETAIL=1         abbey detail (1: ~1.5 M triangles; 9: ~8 M; 110: ~96 M; see docs/abbey.md)
 #   NAVE_MEMORY=2G        preprocess memory budget
+#   NAVE_BRICK_TRIANGLES=100000   target triangles per brick (detail 1 gives 16 bricks)
+#   NAVE_RENDER_MEMORY=640M       render memory budget (at 960x640: ~60 MiB of it for bricks, a third of the
+#                                 200 MiB all bricks take; the rest is the film, ray queues and process)
 #   NAVE_RESOLUTION=960x640, NAVE_SPP=16, NAVE_MODE=path (or photon)   render settings (configs/abbey.toml has the rest)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${NAVE_OUT:-out}
 detail=${NAVE_DETAIL:-1}
 memory=${NAVE_MEMORY:-2G}
+brick_triangles=${NAVE_BRICK_TRIANGLES:-100000}
+render_memory=${NAVE_RENDER_MEMORY:-640M}
 resolution=${NAVE_RESOLUTION:-960x640}
 spp=${NAVE_SPP:-16}
 mode=${NAVE_MODE:-path}
@@ -24,10 +30,11 @@ nave=build/release/src/cli/nave
 mkdir -p "$out"
 
 echo "== 1/3 generate the abbey (detail $detail) and preprocess it into bricks (budget $memory)" >&2
-"$nave" preprocess --generate "abbey:detail=$detail" --memory "$memory" -o "$out/abbey.nave"
+"$nave" preprocess --generate "abbey:detail=$detail" --memory "$memory" --brick-triangles "$brick_triangles" \
+  -o "$out/abbey.nave"
 echo "== 2/3 verify every brick" >&2
 "$nave" verify "$out/abbey.nave"
-echo "== 3/3 render ($mode, $spp samples per pixel, $resolution)" >&2
+echo "== 3/3 render ($mode, $spp samples per pixel, $resolution, memory budget $render_memory)" >&2
 "$nave" render "$out/abbey.nave" --config configs/abbey.toml --mode "$mode" --spp "$spp" \
-  --resolution "$resolution" -o "$out/abbey.exr"
+  --resolution "$resolution" --memory "$render_memory" -o "$out/abbey.exr"
 echo "nave demo: wrote $out/abbey.png and $out/abbey.exr" >&2

@@ -102,6 +102,11 @@ Status RunRender(const RenderOptions& o) {
         std::vector<std::string> warnings;
         NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures, &scene, &warnings));
         for (const std::string& w : warnings) log::Warning("{}", w);
+        // A cap above what all the textures take decoded buys nothing and, under --memory, would only take
+        // room from the bricks.
+        if (textures->opened_pixel_bytes() < textures->max_memory_bytes()) {
+            NAVE_RETURN_IF_ERROR(textures->SetMaxMemoryBytes(textures->opened_pixel_bytes()));
+        }
     }
     log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(), scene.materials.size(),
               config.camera.width, config.camera.height, ModeName(config.render.mode),

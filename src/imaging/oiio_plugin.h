@@ -23,7 +23,7 @@ class TextureCache;
 struct FloatImage;
 
 /// Bumped whenever OiioPlugin's methods or the types they take change.
-inline constexpr int kOiioPluginVersion = 2;
+inline constexpr int kOiioPluginVersion = 3;
 
 /// The pixel type a channel is stored as in the file.
 enum class StoredPixel { kFloat, kHalf, kUint8 };

@@ -49,6 +49,8 @@ struct TextureInfo {
     int width = 0, height = 0, channels = 0;
     int mip_levels = 1;
     bool tiled = false;
+    /// Bytes of all its pixels decoded, every MIP level included: what caching the whole texture takes.
+    uint64_t pixel_bytes = 0;
 };
 
 /// Filtered, cached texture lookups with a memory cap. Thread-safe: Open and Lookup may be called
@@ -80,6 +82,10 @@ class TextureCache {
 
     /// The effective cap of the tile cache in bytes.
     virtual size_t max_memory_bytes() const = 0;
+    /// Changes the cap (OpenImageIO's floor of 10 MiB applies); tiles beyond it are evicted as lookups go.
+    virtual Status SetMaxMemoryBytes(size_t max_memory_bytes) = 0;
+    /// Sum of TextureInfo::pixel_bytes over the textures opened so far: a cap above it buys nothing.
+    virtual uint64_t opened_pixel_bytes() const = 0;
     /// Bytes of tiles held now (OpenImageIO "stat:cache_memory_used").
     virtual size_t memory_used_bytes() const = 0;
     /// Bytes read from texture files so far ("stat:bytes_read").

@@ -28,6 +28,13 @@ class OiioTextureCache final : public TextureCache {
     StatusOr<std::string> StringAttribute(TextureRef texture,
                                           const std::string& name) const override;
     size_t max_memory_bytes() const override { return max_memory_bytes_; }
+    Status SetMaxMemoryBytes(size_t max_memory_bytes) override { return Configure(max_memory_bytes); }
+    uint64_t opened_pixel_bytes() const override {
+        std::lock_guard<std::mutex> lock(mutex_);
+        uint64_t sum = 0;
+        for (const auto& e : entries_) sum += e->info.pixel_bytes;
+        return sum;
+    }
     size_t memory_used_bytes() const override;
     uint64_t bytes_read() const override;
     std::string StatsReport(int level) const override { return system_->getstats(level); }
@@ -86,6 +93,8 @@ StatusOr<TextureRef> OiioTextureCache::Open(const std::filesystem::path& path) {
     if (ts->get_texture_info(handle, nullptr, 0, OIIO::ustring("miplevels"), OIIO::TypeInt,
                              &levels))
         entry->info.mip_levels = levels;
+    // The finest level's bytes and a third more for the coarser ones (each a quarter of the one before).
+    entry->info.pixel_bytes = uint64_t(spec.image_bytes()) * (levels > 1 ? 4 : 3) / 3;
     std::lock_guard<std::mutex> lock(mutex_);
     entries_.push_back(std::move(entry));
     return TextureRef{entries_.back().get()};
