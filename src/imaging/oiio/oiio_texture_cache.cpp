@@ -66,13 +66,24 @@ Status OiioTextureCache::Configure(size_t max_memory_bytes) {
     return Status::Ok();
 }
 
+// Texture systems are never destroyed: a destroyed one leaves tile references in the per-thread data of the
+// worker threads that used it, and OpenImageIO 2.4 then drives another cache's memory count below zero (an
+// assertion in imagecache_pvt.h when a process makes caches one after another). A finished cache's system
+// is emptied and kept here for the next cache; the pool lives as long as the process (reachable, not leaked).
+std::mutex& PoolMutex() {
+    static std::mutex mutex;
+    return mutex;
+}
+std::vector<OIIO::TextureSystem*>& Pool() {
+    static auto* pool = new std::vector<OIIO::TextureSystem*>();
+    return *pool;
+}
+
 OiioTextureCache::~OiioTextureCache() {
-    // The system was created unshared, so it owns a private ImageCache: ask destroy() to tear that down
-    // too, or every TextureCache leaks its ImageCache (LeakSanitizer found it).
-    // Drop every tile first: per-thread tile references that outlive the cache otherwise corrupt the next
-    // cache's memory accounting (an OIIO assertion when tests create caches one after another).
     system_->invalidate_all(/*force=*/true);
-    OIIO::TextureSystem::destroy(system_, /*teardown_imagecache=*/true);
+    system_->reset_stats();
+    std::lock_guard<std::mutex> lock(PoolMutex());
+    Pool().push_back(system_);
 }
 
 StatusOr<TextureRef> OiioTextureCache::Open(const std::filesystem::path& path) {
@@ -158,7 +169,15 @@ uint64_t OiioTextureCache::bytes_read() const {
 
 StatusOr<std::unique_ptr<TextureCache>> CreateOiioTextureCache(size_t max_memory_bytes) {
     // Not the shared TextureSystem: each cache has its own ImageCache and so its own budget.
-    OIIO::TextureSystem* ts = OIIO::TextureSystem::create(/*shared=*/false);
+    OIIO::TextureSystem* ts = nullptr;
+    {
+        std::lock_guard<std::mutex> lock(PoolMutex());
+        if (!Pool().empty()) {
+            ts = Pool().back();
+            Pool().pop_back();
+        }
+    }
+    if (ts == nullptr) ts = OIIO::TextureSystem::create(/*shared=*/false);
     if (ts == nullptr) return InternalError("OpenImageIO: cannot create a texture system");
     auto cache = std::make_unique<OiioTextureCache>(ts);
     NAVE_RETURN_IF_ERROR(cache->Configure(max_memory_bytes));
