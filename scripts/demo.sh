@@ -11,8 +11,8 @@
 #   NAVE_DETAIL=1         abbey detail (1: ~1.5 M triangles; 9: ~8 M; 110: ~96 M; see docs/abbey.md)
 #   NAVE_MEMORY=2G        preprocess memory budget
 #   NAVE_BRICK_TRIANGLES=100000   target triangles per brick (detail 1 gives 16 bricks)
-#   NAVE_RENDER_MEMORY=640M       render memory budget (at 960x640: ~60 MiB of it for bricks, a third of the
-#                                 200 MiB all bricks take; the rest is the film, ray queues and process)
+#   NAVE_RENDER_MEMORY=640M       render memory budget (at 960x640: ~35 MiB of it for bricks, a sixth of the
+#                                 200 MiB all bricks take; the rest is the film, ray queues, textures, process)
 #   NAVE_RESOLUTION=960x640, NAVE_SPP=16, NAVE_MODE=path (or photon)   render settings (configs/abbey.toml has the rest)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -104,9 +104,9 @@ Status RunRender(const RenderOptions& o) {
         for (const std::string& w : warnings) log::Warning("{}", w);
         // A cap above what all the textures take decoded buys nothing and, under --memory, would only take
         // room from the bricks.
-        if (textures->opened_pixel_bytes() < textures->max_memory_bytes()) {
-            NAVE_RETURN_IF_ERROR(textures->SetMaxMemoryBytes(textures->opened_pixel_bytes()));
-        }
+        // Twice what they take leaves room for the cache's own bookkeeping and for tiles in flight.
+        const uint64_t enough = 2 * textures->opened_pixel_bytes() + (uint64_t(4) << 20);
+        if (enough < textures->max_memory_bytes()) NAVE_RETURN_IF_ERROR(textures->SetMaxMemoryBytes(enough));
     }
     log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(), scene.materials.size(),
               config.camera.width, config.camera.height, ModeName(config.render.mode),

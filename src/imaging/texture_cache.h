@@ -49,7 +49,8 @@ struct TextureInfo {
     int width = 0, height = 0, channels = 0;
     int mip_levels = 1;
     bool tiled = false;
-    /// Bytes of all its pixels decoded, every MIP level included: what caching the whole texture takes.
+    /// What caching the whole texture takes, every MIP level included (whole tiles of floats: an upper
+    /// bound).
     uint64_t pixel_bytes = 0;
 };
 

@@ -104,8 +104,14 @@ StatusOr<TextureRef> OiioTextureCache::Open(const std::filesystem::path& path) {
     if (ts->get_texture_info(handle, nullptr, 0, OIIO::ustring("miplevels"), OIIO::TypeInt,
                              &levels))
         entry->info.mip_levels = levels;
-    // The finest level's bytes and a third more for the coarser ones (each a quarter of the one before).
-    entry->info.pixel_bytes = uint64_t(spec.image_bytes()) * (levels > 1 ? 4 : 3) / 3;
+    // What the cache holds for it: whole tiles (64 when the file is untiled: autotile) of 4-byte floats, as
+    // OpenImageIO's cache may widen half and 8-bit texels; the finest level and a third more for the coarser
+    // ones (each a quarter of the one before).
+    const uint64_t tile_w = spec.tile_width > 0 ? uint64_t(spec.tile_width) : 64;
+    const uint64_t tile_h = spec.tile_height > 0 ? uint64_t(spec.tile_height) : 64;
+    const uint64_t padded = (uint64_t(spec.width) + tile_w - 1) / tile_w * tile_w *
+                            ((uint64_t(spec.height) + tile_h - 1) / tile_h * tile_h);
+    entry->info.pixel_bytes = padded * uint64_t(spec.nchannels) * 4 * 4 / 3;
     std::lock_guard<std::mutex> lock(mutex_);
     entries_.push_back(std::move(entry));
     return TextureRef{entries_.back().get()};
