@@ -147,13 +147,31 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         stats.warnings.push_back(w);
     }
     auto materials = source->materials();
-    NAVE_RETURN_IF_ERROR(source->WriteGeneratedTextures(temp.path()));
+    if (options.convert_textures) NAVE_RETURN_IF_ERROR(source->WriteGeneratedTextures(temp.path()));
     source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
 
     // Textures the materials reference become tiled, MIP-mapped files beside the store, and the material
     // table points at them (texture_convert.h). Texture names are relative to their model's directory.
     TextureFolderGuard texture_folder(TextureFolderFor(options.output));
-    {
+    uint64_t texture_reserve = 0;  // taken from the budget of the work that follows
+    const bool any_texture = std::any_of(materials.begin(), materials.end(),
+                                         [](const store::MaterialRecord& m) { return !m.textures.empty(); });
+    if (any_texture && !options.convert_textures) {
+        for (store::MaterialRecord& m : materials) m.textures.clear();
+    } else if (any_texture) {
+        // OpenImageIO stays loaded to the end of the run: the rest of the work gets the budget minus its cost.
+        const uint64_t leaf_max = options.brick_triangles + options.brick_triangles / 4;
+        const uint64_t need = kFixedBytes + leaf_max * kEncodeBytesPerTriangle + kTextureConversionBytes;
+        if (stats.memory_budget < need) {
+            return ResourceExhaustedError(
+                "--memory {} cannot hold texture conversion ({} for OpenImageIO) beside the work for one brick "
+                "({}): raise --memory to at least {}, or pass --no-textures to store flat colours only",
+                FormatBytes(stats.memory_budget), FormatBytes(kTextureConversionBytes),
+                FormatBytes(need - kTextureConversionBytes), FormatBytes(need));
+        }
+        texture_reserve = kTextureConversionBytes;
+    }
+    if (any_texture && options.convert_textures) {
         std::vector<std::filesystem::path> source_dirs;
         for (const auto& input : options.inputs)
             source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));
@@ -201,7 +219,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
 
     // Phase 3: encode on several threads, append as bricks finish. Each thread keeps its buffers
     // (sized by the largest brick it met), so the budget bounds the number of encoding threads.
-    const uint64_t encode_budget = stats.memory_budget - kFixedBytes;
+    const uint64_t encode_budget = stats.memory_budget - kFixedBytes - texture_reserve;
     uint64_t largest = 0;
     for (const LeafBin& leaf : leaves) largest = std::max(largest, leaf.triangles);
     const int encode_threads = int(std::clamp<uint64_t>(
@@ -216,7 +234,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 "overlap) needs {} to "
                 "encode, more than --memory {} allows; raise --memory to at least {}",
                 leaf.triangles, fmt::streamed(leaf.cell), FormatBytes(need),
-                FormatBytes(stats.memory_budget), FormatBytes(need + kFixedBytes));
+                FormatBytes(stats.memory_budget), FormatBytes(need + kFixedBytes + texture_reserve));
         }
     }
     store::StoreProvenance provenance;

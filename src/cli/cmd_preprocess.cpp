@@ -19,6 +19,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
         double precision = 0;
         int threads = 0;
         int draco_speed = store::EncodeOptions{}.draco_speed;
+        bool no_textures = false;
     };
     auto opt = std::make_shared<Options>();
     cmd->add_option("inputs", opt->inputs, "Model files; several are merged into one model");
@@ -38,6 +39,9 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--draco-speed", opt->draco_speed,
                     "Draco encoder speed 0 (smallest) .. 10 (fastest)")
         ->check(CLI::Range(0, 10));
+    cmd->add_flag("--no-textures", opt->no_textures,
+                  "Do not convert textures (the store's materials keep their flat colours; OpenImageIO, "
+                  "~160 MB, is then never loaded)");
     cmd->callback([&run, opt] {
         run = [opt]() -> Status {
             preprocess::PreprocessOptions o;
@@ -59,6 +63,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             o.threads = opt->threads;
             o.temp_dir = opt->temp_dir;
             o.encode.draco_speed = opt->draco_speed;
+            o.convert_textures = !opt->no_textures;
             o.tool_version = std::string("nave ") + NAVE_VERSION;
             NAVE_ASSIGN_OR_RETURN(auto stats, preprocess::RunPreprocess(o));
             log::Info("wrote {}\n{}", o.output.string(), preprocess::FormatSummary(stats));

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <string>
 
+#include "core/file.h"
 #include "imaging/image_io.h"
 
 namespace nave::render {
@@ -78,12 +79,15 @@ TEST_F(CliRenderTest, PreprocessedTexturesAppearInTheRender) {
     EXPECT_GT(sky[1], 0.8f);
     EXPECT_GT(sky[2], 0.6f * sky[0]);
 
-    // Under --memory the texture cache gets [textures] memory_share (0.2) of the budget, counted as reserved.
-    CommandResult budget = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " +
+    // Under --memory the texture cache gets [textures] memory_share of the budget (1 % of 400 MiB here, below
+    // what the two tiny textures would use), counted as reserved.
+    const std::string shared_config = ReadFileToString(config).value() + "[textures]\nmemory_share = 0.01\n";
+    const auto share = Write("share.toml", shared_config);
+    CommandResult budget = RunNave("render " + (dir_ / "q.nave").string() + " -c " + share.string() + " -o " +
                                    out.string() + " --memory 400M");
     ASSERT_EQ(budget.exit_code, 0) << budget.output;
-    EXPECT_NE(budget.output.find("of which 80.0 MiB for the texture cache"), std::string::npos) << budget.output;
-    EXPECT_NE(budget.output.find("through a 80.0 MiB tile cache"), std::string::npos) << budget.output;
+    EXPECT_NE(budget.output.find("of which 4.0 MiB for the texture cache"), std::string::npos) << budget.output;
+    EXPECT_NE(budget.output.find("through a 4.0 MiB tile cache"), std::string::npos) << budget.output;
 
     // --no-textures: the flat grey material everywhere, the quad whole.
     CommandResult flat = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " +
