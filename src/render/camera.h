@@ -16,6 +16,8 @@ class Camera {
     int height() const { return height_; }
     const Vec3f& position() const { return position_; }
     const Vec3f& forward() const { return forward_; }
+    /// The angle one pixel subtends at the centre of the image, in radians (the spread of a pixel's ray cone).
+    float PixelSpreadAngle() const { return 2.f * tan_half_fov_ / float(height_); }
 
     /// The primary ray through raster point (x, y) (continuous: pixel (i, j) spans [i, i+1) x [j, j+1)),
     /// with `u_lens` in [0,1)^2 choosing the point on the lens. `dir` is unit length.

@@ -63,6 +63,7 @@ struct SurfaceHit {
     Vec3f p, ng, ns;
     std::array<float, 2> uv{};  ///< [texture] interpolated texture coordinates, when has_uv
     bool has_uv = false;
+    TextureFootprint footprint;  ///< texture filter footprint at the hit (with uv on a textured material)
     const SurfaceMaterial* material = nullptr;
 };
 
@@ -153,7 +154,8 @@ class Engine {
     /// ray from p crosses (each crossing could have been the sampled point; Veach 1997 §9.2 area-to-solid-angle
     /// conversion).
     float SkyPdf(const Vec3f& p, const Vec3f& w) const;
-    SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const;
+    /// The hit's geometry; `dir` is the ray's direction (for the texture footprint).
+    SurfaceHit MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit, const Vec3f& dir) const;
     RngKey Key(const RayRecord& r, uint32_t stream) const {
         return RngKey{scene_.settings.seed, r.pixel, r.sample, r.vertex, iteration_, stream};
     }
@@ -203,7 +205,7 @@ class Engine {
     float scene_radius_ = 1;
 };
 
-SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit) const {
+SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hit, const Vec3f& dir) const {
     const store::BrickMesh& m = brick.mesh();
     const uint32_t i0 = m.indices[3 * hit.triangle], i1 = m.indices[3 * hit.triangle + 1],
                    i2 = m.indices[3 * hit.triangle + 2];
@@ -230,6 +232,20 @@ SurfaceHit Engine::MakeSurfaceHit(const ResidentBrick& brick, const BrickHit& hi
         return s;
     }();
     h.material = mat < scene_.materials.size() ? &scene_.materials[mat] : &kBlack;
+    if (h.has_uv && h.material->textures) {
+        // The texture filter footprint as the camera would see this point (pbrt-v4's approximation for every
+        // vertex of a path, Camera::Approximate_dp_dxy): a cone of one pixel's spread from the camera, widened
+        // by the incidence and carried to texture space by the triangle's texture-to-world scale (Ray Tracing
+        // Gems ch. 20). Secondary vertices see a sharper texture than their real footprint: conservative.
+        const auto& t0 = m.uvs[i0];
+        const auto& t1 = m.uvs[i1];
+        const auto& t2 = m.uvs[i2];
+        const float uv_area = 0.5f * std::abs((t1[0] - t0[0]) * (t2[1] - t0[1]) - (t2[0] - t0[0]) * (t1[1] - t0[1]));
+        const float world_area =
+            0.5f * Length(Cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+        const float cone_width = Length(h.p - scene_.camera->position()) * scene_.camera->PixelSpreadAngle();
+        h.footprint = imaging::RayConeFootprint(cone_width, Dot(dir, h.ng), uv_area, world_area);
+    }
     return h;
 }
 
@@ -267,7 +283,7 @@ bool Engine::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float 
         if (!has_thin_glass_) return !brick.Occluded(r.origin, r.dir, t0, t1);
         BrickHit hit;
         if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
-        SurfaceHit h = MakeSurfaceHit(brick, hit);
+        SurfaceHit h = MakeSurfaceHit(brick, hit, r.dir);
         const SurfaceMaterial& m = *h.material;
         const ThinGlassMaterial* glass = m.thin_glass();
         if (glass == nullptr) return false;
@@ -389,7 +405,7 @@ void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, c
 
 bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit, Outbox& out,
                        LocalCounters& c) {
-    SurfaceHit h = MakeSurfaceHit(brick, hit);
+    SurfaceHit h = MakeSurfaceHit(brick, hit, r.dir);
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
     if (r.depth == 0) film_->AddAov(r.pixel, Vec3f(1, 1, 1) * mat.AlbedoForAov(), h.ns, hit.t);
@@ -403,7 +419,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     // the light that next-event estimation left to BSDF sampling through a window would be lost.
     const bool last = r.depth >= uint32_t(scene_.settings.max_depth);
     if (last && mat.thin_glass() == nullptr) return false;
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(Key(r, kStreamPath));
@@ -419,7 +435,7 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
     }
     if (visible_point) {
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from photons.
-        visible_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, r.beta);
+        visible_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, h.footprint, r.beta);
         return false;
     }
     std::optional<BsdfSample> bs = bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice),
@@ -456,10 +472,10 @@ bool Engine::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, con
 }
 
 bool Engine::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit) {
-    SurfaceHit h = MakeSurfaceHit(brick, hit);
+    SurfaceHit h = MakeSurfaceHit(brick, hit, r.dir);
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr);  // [texture] uv
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     // Direct light from the sun and the other delta or disc lights is next-event estimated at the visible

@@ -40,11 +40,13 @@ struct SurfaceMaterial {
         if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
         return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
     }
-    /// The BSDF at a hit with texture coordinates `uv` (null when the mesh has none).
-    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda, const std::array<float, 2>* uv) const {
+    /// The BSDF at a hit with texture coordinates `uv` (null when the mesh has none), textures filtered over
+    /// `footprint`.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda, const std::array<float, 2>* uv,
+                  const TextureFootprint& footprint = {}) const {
         if (textures && textures->albedo && uv != nullptr && !black &&
             std::holds_alternative<DiffuseMaterial>(material))
-            return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(textures->Albedo(*uv, *lambda))));
+            return Bsdf(ns, Vec3f(0, 0, 0), Bxdf(DiffuseBxdf(textures->Albedo(*uv, footprint, *lambda))));
         if (const ThinGlassMaterial* glass = thin_glass(); glass && textures && textures->transmittance && uv) {
             SampledSpectrum tau = textures->Transmittance(*uv, *lambda);
             return Bsdf(ns, Vec3f(0, 0, 0), glass->GetBxdf(*lambda, &tau));

@@ -44,7 +44,8 @@ void VisiblePoints::BeginIteration(const SampledWavelengths& lambda) {
 
 void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
                         const SurfaceMaterial& material, const std::array<float, 2>* uv,
-                        const SampledSpectrum& beta) {
+                        const imaging::TextureFootprint& footprint, const SampledSpectrum& beta) {
+    points_[pixel].footprint = footprint;
     Point& vp = points_[pixel];
     vp.has_uv = uv != nullptr;
     if (uv != nullptr) vp.uv = *uv;
@@ -104,7 +105,7 @@ void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, con
         Vec3f d = vp.p - p;
         if (Dot(d, d) > px.radius * px.radius) continue;
         SampledWavelengths l = lambda;
-        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr).Eval(vp.wo, wi, l);
+        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint).Eval(vp.wo, wi, l);
         if (f.IsZero()) continue;
         SampledSpectrum phi = beta * f;
         for (int k = 0; k < kNumWavelengths; ++k) {

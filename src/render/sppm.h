@@ -18,6 +18,7 @@
 
 #include "core/spectrum.h"
 #include "core/vecmath.h"
+#include "imaging/texture_cache.h"
 #include "store/brick_tree.h"
 
 namespace nave::render {
@@ -33,7 +34,7 @@ class VisiblePoints {
     /// Records pixel's visible point, with its texture coordinates `uv` (null when the mesh has none).
     /// Thread-safe for distinct pixels (one camera path per pixel).
     void Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo, const SurfaceMaterial& material,
-             const std::array<float, 2>* uv, const SampledSpectrum& beta);
+             const std::array<float, 2>* uv, const imaging::TextureFootprint& footprint, const SampledSpectrum& beta);
     /// Registers every visible point in the bricks its gather sphere overlaps (after the camera pass).
     void BuildBrickGrids(const store::BrickTree& tree);
     /// A photon of power `beta` arriving from direction `wi` (pointing away from the surface) at `p` in
@@ -54,6 +55,7 @@ class VisiblePoints {
         const SurfaceMaterial* material = nullptr;
         std::array<float, 2> uv{};  // texture coordinates, when has_uv
         bool has_uv = false;
+        imaging::TextureFootprint footprint;
         SampledSpectrum beta;
         bool valid = false;
     };

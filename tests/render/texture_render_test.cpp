@@ -151,6 +151,36 @@ TEST_F(TextureRenderTest, CheckerboardLandsAtItsTextureCoordinates) {
     EXPECT_NEAR(a.x / a.z, e.x / e.z, 0.1);
 }
 
+// Textures are filtered over the pixel's footprint: a checkerboard of 512 x 512 texels alternating 0.05 and
+// 0.95 (about 12 texels under each pixel here) renders like flat 0.5 with the same random numbers; bilinear
+// point samples of the finest level would differ by tens of per cent per sample.
+TEST_F(TextureRenderTest, FineTextureIsFilteredOverThePixelFootprint) {
+    const int n = 512;
+    std::vector<float> checker(size_t(n) * n * 3), grey(size_t(n) * n * 3, 0.5f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            for (int c = 0; c < 3; ++c) checker[(size_t(y) * n + size_t(x)) * 3 + size_t(c)] = (x + y) % 2 ? 0.95f : 0.05f;
+    WriteImage(dir_ / "fine.exr", n, n, 3, checker);
+    WriteImage(dir_ / "grey.exr", n, n, 3, grey);
+    store::MaterialRecord fine, flat;
+    fine.name = flat.name = "m";
+    fine.textures["map_Kd"] = "fine.exr";
+    flat.textures["map_Kd"] = "grey.exr";
+    // One sample per pixel, so that point samples would not average out.
+    std::string config = BaseConfig();
+    config.replace(config.find("spp = 16"), std::string("spp = 16").size(), "spp = 1");
+    std::unique_ptr<Film> a = Render(Quad(), fine, config), b = Render(Quad(), flat, config);
+    ASSERT_TRUE(a && b);
+    double diff = 0, sum = 0;
+    for (int y = 4; y < 28; ++y)
+        for (int x = 4; x < 28; ++x) {
+            const uint32_t p = uint32_t(y * 32 + x);
+            diff += std::abs(a->PixelXYZ(p).y - b->PixelXYZ(p).y);
+            sum += b->PixelXYZ(p).y;
+        }
+    EXPECT_LT(diff / sum, 0.05) << "mean relative difference per pixel";
+}
+
 // Photon mode: the camera's visible points see the texture (direct sky at the visible point, and photon
 // deposits evaluated with the visible point's texture coordinates).
 TEST_F(TextureRenderTest, CheckerboardInPhotonMode) {
