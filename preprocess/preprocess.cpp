@@ -160,8 +160,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         for (store::MaterialRecord& m : materials) m.textures.clear();
     } else if (any_texture) {
         // OpenImageIO stays loaded to the end of the run: the rest of the work gets the budget minus its cost.
-        const uint64_t leaf_max = options.brick_triangles + options.brick_triangles / 4;
-        const uint64_t need = kFixedBytes + leaf_max * kEncodeBytesPerTriangle + kTextureConversionBytes;
+        const uint64_t need = kFixedBytes + per_brick + kTextureConversionBytes;
         if (stats.memory_budget < need) {
             return ResourceExhaustedError(
                 "--memory {} cannot hold texture conversion ({} for OpenImageIO) beside the work for one brick "
@@ -170,8 +169,6 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 FormatBytes(need - kTextureConversionBytes), FormatBytes(need));
         }
         texture_reserve = kTextureConversionBytes;
-    }
-    if (any_texture && options.convert_textures) {
         std::vector<std::filesystem::path> source_dirs;
         for (const auto& input : options.inputs)
             source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));

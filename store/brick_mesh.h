@@ -23,6 +23,10 @@ struct BrickMesh {
     size_t VertexCount() const { return positions.size(); }
     bool HasNormals() const { return !normals.empty(); }
     bool HasUvs() const { return !uvs.empty(); }
+    /// The corners of triangle `t`.
+    std::array<Vec3f, 3> TrianglePositions(size_t t) const {
+        return {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
+    }
     /// Bytes held by the vectors (for memory budgets).
     size_t MemoryBytes() const {
         return positions.capacity() * sizeof(Vec3f) + normals.capacity() * sizeof(Vec3f) +

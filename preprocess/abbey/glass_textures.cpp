@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/pane.h"
 #include "core/spectrum.h"
 #include "core/spectrum_data.h"
 #include "imaging/image_io.h"
@@ -37,15 +38,6 @@ double Undulation(uint64_t seed, double u, double v) {
     return 2 * (top + (bottom - top) * fy) - 1;
 }
 
-/// The internal transmittance τ of one pass through a pane whose total normal-incidence transmittance is T,
-/// with single-face reflectance R: T = (1-R)² τ / (1 - R² τ²) (the two-face pane with multiple reflections,
-/// as data/stained_glass_approx.csv was built), solved for τ: R² T τ² + (1-R)² τ - T = 0.
-double InternalFromTotal(double total, double r) {
-    total = std::clamp(total, 1e-6, 1.0);
-    const double a = r * r * total, b = (1 - r) * (1 - r);
-    return std::min(1.0, (-b + std::sqrt(b * b + 4 * a * total)) / (2 * a));
-}
-
 }  // namespace
 
 std::string GlassTextureName(std::string_view material) {
@@ -62,9 +54,10 @@ Status WriteGlassTextures(const std::filesystem::path& dir) {
     uint64_t seed = 1;
     for (const char* name : {"glass_clear", "glass_blue", "glass_red", "glass_yellow", "glass_green"}) {
         NAVE_ASSIGN_OR_RETURN(Spectrum total, table.ToSpectrum(name));
-        // R = 0.04: the single-face Fresnel reflectance at normal incidence for n = 1.5, as in the CSV.
+        // The CSV's total transmittance was built for faces of R = 0.04 (n = 1.5): inverted with the same R.
         double tau0[kBands];
-        for (int b = 0; b < kBands; ++b) tau0[b] = InternalFromTotal(total.Evaluate(kFirstBandNm + b * kBandStepNm), 0.04);
+        for (int b = 0; b < kBands; ++b)
+            tau0[b] = PaneInternalTransmittance(total.Evaluate(kFirstBandNm + b * kBandStepNm), 0.04);
         imaging::FloatImage image;
         image.width = kWidth;
         image.height = kHeight;

@@ -75,6 +75,12 @@ Status RunRender(const RenderOptions& o) {
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
+    std::optional<uint64_t> memory_limit;  // --memory, in bytes
+    if (!o.memory.empty()) {
+        NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
+        memory_limit = bytes;
+    }
+    if (!o.pager.empty() && !memory_limit) return InvalidArgumentError("--pager {}: tunables need --memory SIZE", o.pager);
 
     NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create());
     std::unique_ptr<render::BrickSource> source;
@@ -93,10 +99,7 @@ Status RunRender(const RenderOptions& o) {
         // Its cap: [textures] cache, or under --memory the share [textures] memory_share of the budget, which
         // the pager then counts as reserved (below).
         uint64_t cap = config.textures.cache_bytes;
-        if (!o.memory.empty()) {
-            NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
-            cap = uint64_t(double(memory) * config.textures.memory_share);
-        }
+        if (memory_limit) cap = uint64_t(double(*memory_limit) * config.textures.memory_share);
         NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(cap));
         std::filesystem::path base = std::filesystem::path(o.model).parent_path();
         std::vector<std::string> warnings;
@@ -115,9 +118,8 @@ Status RunRender(const RenderOptions& o) {
     // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process); the
     // bricks get what is left (docs/pager.md).
     std::optional<render::PagerOptions> paging;
-    if (!o.memory.empty() || !o.pager.empty()) {
-        if (o.memory.empty()) return InvalidArgumentError("--pager {}: tunables need --memory SIZE", o.pager);
-        NAVE_ASSIGN_OR_RETURN(uint64_t memory, ParseByteSize(o.memory));
+    if (memory_limit) {
+        const uint64_t memory = *memory_limit;
         render::PagerOptions options;
         NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
         // The texture cache's cap comes out of --memory too (docs/pager.md).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "core/log.h"
@@ -146,6 +147,26 @@ class Engine {
     void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Outbox& out, LocalCounters& c);
     /// Builds the portal scene and area CDF from the triangles of portal materials.
     Status SetPortals(const std::vector<std::array<Vec3f, 3>>& triangles);
+    /// A point uniform on the portals' total area from `u_triangle` (picks a triangle by area) and `u`; its
+    /// triangle in `triangle` if given.
+    Vec3f SamplePortalPoint(double u_triangle, Point2f u, size_t* triangle = nullptr) const;
+    /// Calls `visit(hit)` for each portal triangle the ray o + t d crosses with t in [0, t_max] (at most 64),
+    /// front to back; returns how many.
+    template <typename Visit>
+    int ForEachPortalCrossing(const Vec3f& o, const Vec3f& d, float t_max, Visit visit) const {
+        int count = 0;
+        BrickHit hit;
+        for (float t0 = 0; count < 64 && portal_scene_->Intersect(o, d, t0, t_max, &hit); ++count) {
+            visit(hit);
+            t0 = hit.t + 1e-6f * (1.f + hit.t);
+        }
+        return count;
+    }
+    /// One pass over the bricks (pinned through the pager when paging) calling `visit(mesh, t, b)` for every
+    /// triangle t of brick b whose material passes `want`. A triangle stored in several bricks (it crosses
+    /// cells) is visited once: in the brick whose cell holds its centroid.
+    Status ForEachOwnedTriangle(const std::function<bool(const SurfaceMaterial&)>& want,
+                                const std::function<void(const store::BrickMesh&, size_t, uint32_t)>& visit);
     /// With render.sky_sampling = "portals": gathers the portal triangles (one pass over the bricks, unless
     /// the photon emitters gathered them already) so that sky next-event estimation aims at the windows.
     Status BuildSkyPortals();
@@ -375,13 +396,7 @@ void Engine::SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo, c
     const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
     Vec3f wi;
     if (sky_portals_ && rng.Uniform(dim + 2) < kPortalSkyShare) {
-        // A uniform point on the portals (a triangle by area, then Turk 1990's square-root parameterisation).
-        const double u = rng.Uniform(dim + 3);
-        size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(), u) -
-                          (portal_area_cdf_.begin() + 1));
-        const auto& t = portal_triangles_[std::min(i, portal_triangles_.size() - 1)];
-        const float su = std::sqrt(rng.Uniform(dim)), v = rng.Uniform(dim + 1);
-        const Vec3f q = t[0] * (1 - su) + t[1] * (su * (1 - v)) + t[2] * (su * v);
+        const Vec3f q = SamplePortalPoint(rng.Uniform(dim + 3), Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
         const float d = Length(q - h.p);
         if (!(d > 0)) return;
         wi = (q - h.p) / d;
@@ -688,6 +703,31 @@ float EmissionPower(const SurfaceMaterial& m) {
 }
 }  // namespace
 
+Status Engine::ForEachOwnedTriangle(const std::function<bool(const SurfaceMaterial&)>& want,
+                                    const std::function<void(const store::BrickMesh&, size_t, uint32_t)>& visit) {
+    for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
+        NAVE_ASSIGN_OR_RETURN(BrickHandle h, AcquireBrick(b));  // released at the end of the iteration
+        const store::BrickMesh& m = h->mesh();
+        for (size_t t = 0; t < m.TriangleCount(); ++t) {
+            const uint32_t mat = m.material_ids[t];
+            if (mat >= scene_.materials.size() || !want(scene_.materials[mat])) continue;
+            const std::array<Vec3f, 3> v = m.TrianglePositions(t);
+            if (tree_.Locate((v[0] + v[1] + v[2]) * (1.f / 3.f)) == b) visit(m, t, b);
+        }
+    }
+    return Status::Ok();
+}
+
+Vec3f Engine::SamplePortalPoint(double u_triangle, Point2f u, size_t* triangle) const {
+    size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(), u_triangle) -
+                      (portal_area_cdf_.begin() + 1));
+    i = std::min(i, portal_triangles_.size() - 1);
+    if (triangle != nullptr) *triangle = i;
+    const std::array<float, 3> w = SampleUniformTriangle(u);
+    const auto& t = portal_triangles_[i];
+    return t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+}
+
 Status Engine::SetPortals(const std::vector<std::array<Vec3f, 3>>& triangles) {
     store::BrickMesh mesh;
     portal_area_ = 0;
@@ -723,18 +763,10 @@ Status Engine::BuildSkyPortals() {
     if (std::none_of(scene_.materials.begin(), scene_.materials.end(), [](const auto& m) { return m.portal; })) {
         return InvalidArgumentError("render.sky_sampling = \"portals\" but no material has portal = true");
     }
-    for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(BrickHandle h, scene_.source->Acquire(b));
-        const store::BrickMesh& m = h->mesh();
-        for (size_t t = 0; t < m.TriangleCount(); ++t) {
-            const uint32_t mat = m.material_ids[t];
-            if (mat >= scene_.materials.size() || !scene_.materials[mat].portal) continue;
-            const Vec3f v0 = m.positions[m.indices[3 * t]], v1 = m.positions[m.indices[3 * t + 1]],
-                        v2 = m.positions[m.indices[3 * t + 2]];
-            // A triangle stored in several bricks (it crosses cells) counts once: in its centroid's brick.
-            if (tree_.Locate((v0 + v1 + v2) * (1.f / 3.f)) == b) triangles.push_back({v0, v1, v2});
-        }
-    }
+    NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle([](const SurfaceMaterial& m) { return m.portal; },
+                                              [&](const store::BrickMesh& m, size_t t, uint32_t) {
+                                                  triangles.push_back(m.TrianglePositions(t));
+                                              }));
     if (triangles.empty()) {
         return InvalidArgumentError("render.sky_sampling = \"portals\" but the model has no triangle of a "
                                     "portal material");
@@ -747,13 +779,10 @@ Status Engine::BuildSkyPortals() {
 float Engine::SkyPdf(const Vec3f& p, const Vec3f& w) const {
     if (!sky_portals_) return UniformSpherePdf();
     double portal_pdf = 0;
-    BrickHit hit;
-    int crossings = 0;
-    for (float t0 = 0; crossings < 64 && portal_scene_->Intersect(p, w, t0, kInfinity, &hit); ++crossings) {
+    ForEachPortalCrossing(p, w, kInfinity, [&](const BrickHit& hit) {
         const float cos_theta = std::abs(Dot(Normalize(hit.ng), w));
         if (cos_theta > 1e-6f) portal_pdf += double(hit.t) * hit.t / (double(cos_theta) * portal_area_);
-        t0 = hit.t * (1 + 1e-6f) + 1e-6f;
-    }
+    });
     return float((1 - kPortalSkyShare) * UniformSpherePdf() + kPortalSkyShare * portal_pdf);
 }
 
@@ -780,27 +809,26 @@ Status Engine::BuildEmitters() {
     std::vector<double> triangle_weights;
     std::vector<std::array<Vec3f, 3>> portal_triangles;
     if (any_emissive || (want_portals && any_portal)) {
-        for (uint32_t b = 0; b < scene_.source->brick_count(); ++b) {
-            NAVE_ASSIGN_OR_RETURN(BrickHandle h, AcquireBrick(b));  // released at the end of the iteration
-            const store::BrickMesh& m = h->mesh();
-            for (size_t t = 0; t < m.TriangleCount(); ++t) {
-                uint32_t mat = m.material_ids[t];
-                if (mat >= scene_.materials.size()) continue;
-                const SurfaceMaterial& sm = scene_.materials[mat];
-                if (!sm.emissive && !(want_portals && sm.portal)) continue;
-                Vec3f v0 = m.positions[m.indices[3 * t]], v1 = m.positions[m.indices[3 * t + 1]],
-                      v2 = m.positions[m.indices[3 * t + 2]];
-                if (tree_.Locate((v0 + v1 + v2) * (1.f / 3.f)) != b) continue;
-                if (want_portals && sm.portal) portal_triangles.push_back({v0, v1, v2});
-                if (!sm.emissive) continue;
+        // Per material, not per triangle: an emission texture's mean takes texture lookups.
+        std::vector<float> power(scene_.materials.size(), 0.f);
+        for (size_t i = 0; i < power.size(); ++i) {
+            if (scene_.materials[i].emissive) power[i] = EmissionPower(scene_.materials[i]);
+        }
+        NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
+            [&](const SurfaceMaterial& sm) { return sm.emissive || (want_portals && sm.portal); },
+            [&](const store::BrickMesh& m, size_t t, uint32_t) {
+                const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
+                const std::array<Vec3f, 3> v = m.TrianglePositions(t);
+                if (want_portals && sm.portal) portal_triangles.push_back(v);
+                if (!sm.emissive) return;
                 Emitter e;
                 e.kind = Emitter::Kind::kTriangle;
-                e.v0 = v0;
-                e.v1 = v1;
-                e.v2 = v2;
-                Vec3f c = Cross(v1 - v0, v2 - v0);
+                e.v0 = v[0];
+                e.v1 = v[1];
+                e.v2 = v[2];
+                Vec3f c = Cross(v[1] - v[0], v[2] - v[0]);
                 e.area = 0.5f * Length(c);
-                if (e.area <= 0) continue;
+                if (e.area <= 0) return;
                 e.n = Normalize(c);
                 e.material = &sm;
                 if (m.HasUvs()) {
@@ -809,9 +837,8 @@ Status Engine::BuildEmitters() {
                 }
                 triangles.push_back(e);
                 // Two-sided Lambertian emitter: power = L pi A per side.
-                triangle_weights.push_back(EmissionPower(sm) * 2 * kPiF * e.area);
-            }
-        }
+                triangle_weights.push_back(power[m.material_ids[t]] * 2 * kPiF * e.area);
+            }));
     }
     for (const Light& l : scene_.lights) {
         Emitter e;
@@ -945,22 +972,15 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
                 // A point uniform on the portals' area, a cosine-weighted direction on a random side: the
                 // line's density is count / (2 pi A) in the measure dA_perp dw, count = portals the line
                 // crosses (Veach's balance heuristic over the portals), so the power is L 2 pi A / count.
-                size_t i = size_t(std::upper_bound(portal_area_cdf_.begin() + 1, portal_area_cdf_.end(),
-                                                   double(rng.Uniform(6))) - (portal_area_cdf_.begin() + 1));
-                const auto& t = portal_triangles_[std::min(i, portal_triangles_.size() - 1)];
-                float su = std::sqrt(u1.x);
-                Vec3f p = t[0] * (1 - su) + t[1] * (su * (1 - u1.y)) + t[2] * (su * u1.y);
+                size_t i = 0;
+                const Vec3f p = SamplePortalPoint(rng.Uniform(6), u1, &i);
+                const auto& t = portal_triangles_[i];
                 Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
                 if (rng.Uniform(5) < 0.5f) n = -n;
                 Vec3f d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
                 r.origin = p - d * (2 * scene_radius_);
                 r.dir = d;
-                int count = 0;
-                BrickHit hit;
-                for (float t0 = 0; count < 64 && portal_scene_->Intersect(r.origin, d, t0, 4 * scene_radius_, &hit);) {
-                    ++count;
-                    t0 = hit.t + 1e-6f * (1.f + hit.t);
-                }
+                const int count = ForEachPortalCrossing(r.origin, d, 4 * scene_radius_, [](const BrickHit&) {});
                 r.beta = scene_.SkyRadiance(-d, lambda) * float(2 * kPiF * portal_area_ / std::max(1, count));
             } else if (e.kind == Emitter::Kind::kSky) {
                 Vec3f to = SampleUniformSphere(u2);
@@ -972,15 +992,14 @@ void Engine::EmitPhotons(uint64_t first, uint64_t last, const SampledWavelengths
             } else {
                 // Uniform point on the triangle (Turk 1990 square-root parameterisation), cosine-weighted
                 // direction on a side chosen with probability 1/2.
-                float su = std::sqrt(u1.x);
-                Vec3f p = e.v0 * (1 - su) + e.v1 * (su * (1 - u1.y)) + e.v2 * (su * u1.y);
+                const std::array<float, 3> w = SampleUniformTriangle(u1);
+                Vec3f p = e.v0 * w[0] + e.v1 * w[1] + e.v2 * w[2];
                 Vec3f n = rng.Uniform(5) < 0.5f ? e.n : -e.n;
                 r.dir = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
                 r.origin = OffsetOrigin(p, n, r.dir);
                 // L cos / (1/A * cos/pi * 1/2).
                 std::array<float, 2> uv;
-                for (int k = 0; k < 2; ++k)
-                    uv[k] = e.uv[0][k] * (1 - su) + e.uv[1][k] * (su * (1 - u1.y)) + e.uv[2][k] * (su * u1.y);
+                for (int k = 0; k < 2; ++k) uv[k] = e.uv[0][k] * w[0] + e.uv[1][k] * w[1] + e.uv[2][k] * w[2];
                 r.beta = e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPiF * e.area);
                 r.flags = kFromAreaLight;
             }

@@ -1,7 +1,10 @@
 #include "render/photon_portals.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include "core/sampling.h"
 
 namespace nave::render {
 
@@ -71,9 +74,9 @@ Vec3f PortalProjection::Sample(float u_choice, float u0, float u1, int* coverage
     size_t i = size_t(std::upper_bound(cdf_.begin() + 1, cdf_.end(), double(u_choice)) - (cdf_.begin() + 1));
     i = std::min(i, tris_.size() - 1);
     const Tri2& t = tris_[i];
-    // Uniform on the triangle (Turk 1990); an affine projection keeps it uniform on the projection.
-    float su = std::sqrt(u0);
-    Vec3f p = t.v0 * (1 - su) + t.v1 * (su * (1 - u1)) + t.v2 * (su * u1);
+    // Uniform on the triangle; an affine projection keeps it uniform on the projection.
+    const std::array<float, 3> w = SampleUniformTriangle(Point2f(u0, u1));
+    Vec3f p = t.v0 * w[0] + t.v1 * w[1] + t.v2 * w[2];
     *coverage = std::max(1, Coverage(p));
     return p;
 }

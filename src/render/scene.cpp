@@ -121,15 +121,10 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
         SurfaceTextureOptions options;
         options.use_albedo = std::holds_alternative<DiffuseMaterial>(m.material);
         options.use_transmittance = std::holds_alternative<ThinGlassMaterial>(m.material);
+        options.use_emission = !mc.emission;  // the config's emission overrides the model's, texture included
         options.emission_scale = mc.emission_scale;
         std::shared_ptr<const SurfaceTextures> t = OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
         if (t == nullptr) continue;
-        if (t->emission && mc.emission) {
-            // The config's emission overrides the model's, texture included.
-            auto copy = std::make_shared<SurfaceTextures>(*t);
-            copy->emission = {};
-            t = copy;
-        }
         if (t->emission) m.emissive = true;
         if (t->alpha) {
             masks[i] = t;

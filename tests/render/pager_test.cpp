@@ -22,6 +22,7 @@
 namespace nave::render {
 namespace {
 
+using testing::MaxRelativeDifference;
 using testing::MeanY;
 
 class PagerTest : public ::testing::Test {
@@ -68,18 +69,6 @@ iterations = 2
 photons_per_iteration = 20000
 seed = 5
 )";
-
-double MaxRelativeDifference(const Film& a, const Film& b) {
-    double worst = 0;
-    for (size_t p = 0; p < a.pixel_count(); ++p) {
-        Vec3d x = a.PixelXYZ(uint32_t(p)), y = b.PixelXYZ(uint32_t(p));
-        for (int c = 0; c < 3; ++c) {
-            double d = std::abs(x[c] - y[c]) / std::max(1e-3, std::abs(x[c]) + std::abs(y[c]));
-            worst = std::max(worst, d);
-        }
-    }
-    return worst;
-}
 
 /// A fresh source over the ball grid (fresh so that its own peak counter covers this render only).
 std::unique_ptr<MemoryBrickSource> BallGridSource() {

@@ -12,6 +12,7 @@
 namespace nave::render {
 namespace {
 
+using testing::MaxRelativeDifference;
 using testing::MeanY;
 using testing::Render;
 
@@ -196,18 +197,6 @@ iterations = 3
 photons_per_iteration = 20000
 seed = 11
 )";
-
-double MaxRelativeDifference(const Film& a, const Film& b) {
-    double worst = 0;
-    for (size_t p = 0; p < a.pixel_count(); ++p) {
-        Vec3d x = a.PixelXYZ(uint32_t(p)), y = b.PixelXYZ(uint32_t(p));
-        for (int c = 0; c < 3; ++c) {
-            double d = std::abs(x[c] - y[c]) / std::max(1e-3, std::abs(x[c]) + std::abs(y[c]));
-            worst = std::max(worst, d);
-        }
-    }
-    return worst;
-}
 
 TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePath) {
     std::string config = fmt::format(fmt::runtime(kClutter), "path");

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/pane.h"
 #include "core/spectrum_data.h"
 #include "render/materials/ior.h"
 
@@ -12,17 +13,7 @@ Bxdf GetBxdf(const Material& m, SampledWavelengths& lambda) {
 }
 
 float ThinGlassMaterial::InternalFromTotalTransmittance(float total_t, float eta) {
-    double r = FrDielectric(1.f, eta);
-    double t = std::clamp(double(total_t), 0.0, 1.0);
-    double one_r2 = (1.0 - r) * (1.0 - r);
-    // The largest total transmittance a lossless pane can have is (1 - R) / (1 + R).
-    if (t >= (1.0 - r) / (1.0 + r)) return 1.f;
-    if (r == 0.0) return float(t);
-    // Solve R² T τ² + (1 - R)² τ - T = 0 for the positive root (from T = (1-R)² τ / (1 - R² τ²)).
-    double a = r * r * t;
-    if (a == 0.0) return 0.f;
-    double tau = (-one_r2 + std::sqrt(one_r2 * one_r2 + 4.0 * a * t)) / (2.0 * a);
-    return float(std::clamp(tau, 0.0, 1.0));
+    return PaneInternalTransmittance(total_t, FrDielectric(1.f, eta));
 }
 
 ThinGlassMaterial ThinGlassMaterial::FromTotalTransmittance(const Spectrum& eta,

@@ -108,7 +108,7 @@ std::shared_ptr<const SurfaceTextures> OpenSurfaceTextures(TextureCache& cache,
         // An RGB image named as a glTF alpha source has no alpha channel: the surface is opaque.
         if (record.textures.count("alphaMask") && channels < 4) t->alpha = {};
     }
-    t->emission = open({"map_Ke", "emissiveTexture"}, &t->emission_top_left);
+    if (options.use_emission) t->emission = open({"map_Ke", "emissiveTexture"}, &t->emission_top_left);
     if (options.use_transmittance) {
         if (auto it = record.textures.find("nave:transmittance"); it != record.textures.end()) {
             StatusOr<SpectralTexture> tex = SpectralTexture::Open(cache, base_dir / it->second);

@@ -74,6 +74,7 @@ struct SurfaceTextures final : public AlphaMask {
 struct SurfaceTextureOptions {
     bool use_albedo = true;         ///< the config material is diffuse (others keep their physics)
     bool use_transmittance = false; ///< the config material is thin glass
+    bool use_emission = true;       ///< the config gives no emission of its own
     float emission_scale = 1.f;
 };
 
