@@ -29,6 +29,9 @@ constexpr draco::GeometryAttribute::Type kUvType = draco::GeometryAttribute::TEX
 // reordering, so a face's material is the value at any of its corners (Draco splits a vertex shared
 // by two materials).
 constexpr draco::GeometryAttribute::Type kMaterialType = draco::GeometryAttribute::GENERIC;
+// A face is flat when every corner normal is within 0.8 degrees of its geometric normal (cos >=
+// 0.9999): ten-bit octahedral normals, what smooth faces keep, already err by up to ~0.2 degrees.
+constexpr double kFlatCosine = 0.9999;
 
 Vec3f Normalized(const Vec3f& n) {
     const double len = std::sqrt(double(n.x) * n.x + double(n.y) * n.y + double(n.z) * n.z);
@@ -41,6 +44,49 @@ std::unique_ptr<draco::PointAttribute> NewAttribute(draco::GeometryAttribute::Ty
     auto att = std::make_unique<draco::PointAttribute>();
     att->Init(type, int8_t(components), data_type, false, values);
     return att;
+}
+
+/// Direct access to a decoded attribute's values by point: the point's value index (identity or
+/// explicit mapping), then the value's bytes in the attribute's buffer.
+class PlainAttribute {
+  public:
+    explicit PlainAttribute(const draco::PointAttribute& att) : att_(att) {}
+    template <typename T>
+    const T* Value(uint32_t point) const {
+        const draco::AttributeValueIndex v = att_.mapped_index(draco::PointIndex(point));
+        return reinterpret_cast<const T*>(att_.GetAddress(v));
+    }
+
+  private:
+    const draco::PointAttribute& att_;
+};
+
+/// Whether point a's grid position is lexicographically below point b's.
+bool LessPosition(const PlainAttribute& positions, uint32_t a, uint32_t b) {
+    const int32_t* pa = positions.Value<int32_t>(a);
+    const int32_t* pb = positions.Value<int32_t>(b);
+    return std::lexicographical_compare(pa, pa + 3, pb, pb + 3);
+}
+
+/// Copies N float components per point into `out`; float attributes (what Draco gives back for
+/// quantized normals and uvs) are copied as they are, other types converted.
+template <int N>
+Status CopyFloatValues(const draco::PointAttribute& att, uint32_t point_count,
+                       const std::string& what, const char* name, float* out) {
+    if (att.data_type() == draco::DT_FLOAT32) {
+        const PlainAttribute plain(att);
+        for (uint32_t p = 0; p < point_count; ++p) {
+            std::memcpy(out + size_t(N) * p, plain.Value<float>(p), N * sizeof(float));
+        }
+        return Status::Ok();
+    }
+    for (uint32_t p = 0; p < point_count; ++p) {
+        if (!att.ConvertValue<float, N>(att.mapped_index(draco::PointIndex(p)),
+                                        out + size_t(N) * p)) {
+            return DataLossError("{}: cannot read the {} of vertex {}", what, name, p);
+        }
+    }
+    return Status::Ok();
 }
 
 }  // namespace
@@ -123,53 +169,115 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         out.max_material_id = std::max(out.max_material_id, mesh.material_ids[t]);
     }
     out.dropped_triangle_count = triangle_count - kept.size();
-    if (out.max_material_id > uint32_t(std::numeric_limits<int32_t>::max())) {
+    if (out.max_material_id > kMaxMaterialId) {
         return InvalidArgumentError("material id {} exceeds the largest storable id {}",
-                                    out.max_material_id, std::numeric_limits<int32_t>::max());
+                                    out.max_material_id, kMaxMaterialId);
     }
 
-    // 4. Points: one per (vertex, material) pair in use. Most vertices have one material; the rare
-    // ones on a material border get extra points through a small map.
+    // 4. Flat faces: a face whose corner normals all lie along its geometric normal (within
+    // kFlatCosine) needs no normals, since the renderer falls back to the geometric normal. Its
+    // corners are then joined by grid point (and texture coordinates) rather than by input vertex,
+    // so the faces of faceted stones, whose inputs split every corner by normal, share their
+    // vertices again: fewer points to decode, store and keep resident (docs/store-format.md).
+    std::vector<uint8_t> flat(kept.size(), 1);
+    size_t flat_count = kept.size();
+    if (mesh.HasNormals()) {
+        flat_count = 0;
+        for (size_t k = 0; k < kept.size(); ++k) {
+            const uint32_t* corner = &mesh.indices[3 * size_t(kept[k])];
+            const Vec3i &q0 = q[corner[0]], &q1 = q[corner[1]], &q2 = q[corner[2]];
+            const double e1[3] = {double(q1.x) - q0.x, double(q1.y) - q0.y, double(q1.z) - q0.z};
+            const double e2[3] = {double(q2.x) - q0.x, double(q2.y) - q0.y, double(q2.z) - q0.z};
+            const double ng[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                  e1[0] * e2[1] - e1[1] * e2[0]};
+            const double ng_len = std::sqrt(ng[0] * ng[0] + ng[1] * ng[1] + ng[2] * ng[2]);
+            bool is_flat = ng_len > 0;
+            for (int c = 0; c < 3 && is_flat; ++c) {
+                const Vec3f& n = mesh.normals[corner[c]];
+                const double n_len =
+                    std::sqrt(double(n.x) * n.x + double(n.y) * n.y + double(n.z) * n.z);
+                const double cosine = (ng[0] * n.x + ng[1] * n.y + ng[2] * n.z) / (ng_len * n_len);
+                is_flat = std::fabs(cosine) >= kFlatCosine;  // the renderer orients by winding
+            }
+            flat[k] = uint8_t(is_flat);
+            flat_count += flat[k];
+        }
+    }
+    out.has_normals = mesh.HasNormals() && flat_count < kept.size();
+    // Flat faces are marked in the material attribute only when some faces keep normals.
+    const bool mark_flat = out.has_normals && flat_count > 0;
+
+    // 5. Points: a smooth face's corner is one point per (input vertex, material) pair (its normal
+    // and uv are the vertex's); a flat face's corner is one point per (grid point, material, uv).
+    // A point is never shared by a flat and a smooth face (their material values differ when
+    // marked), so decoding can clear the normals of flat faces' points.
     constexpr uint32_t kUnset = 0xffffffffu;
     std::vector<uint32_t> point_of_vertex(vertex_count, kUnset);
     std::vector<uint32_t> material_of_vertex(vertex_count, 0);
     std::unordered_map<uint64_t, uint32_t> extra_points;
+    struct FlatKey {
+        uint32_t position, material;
+        uint64_t uv_bits;
+        bool operator==(const FlatKey& o) const {
+            return position == o.position && material == o.material && uv_bits == o.uv_bits;
+        }
+    };
+    struct FlatKeyHash {
+        size_t operator()(const FlatKey& k) const {
+            uint64_t h = (uint64_t(k.position) << 32 | k.material) * 0x9e3779b97f4a7c15ull;
+            return size_t(h ^ (k.uv_bits + 0x7f4a7c159e3779b9ull + (h << 6) + (h >> 2)));
+        }
+    };
+    std::unordered_map<FlatKey, uint32_t, FlatKeyHash> flat_points;
+    flat_points.reserve(flat_count);
     std::vector<uint32_t> point_vertex, point_material;
+    std::vector<uint8_t> point_flat;
     std::vector<uint32_t> faces(3 * kept.size());
     Vec3i lo{std::numeric_limits<int32_t>::max(), std::numeric_limits<int32_t>::max(),
              std::numeric_limits<int32_t>::max()};
     Vec3i hi{std::numeric_limits<int32_t>::min(), std::numeric_limits<int32_t>::min(),
              std::numeric_limits<int32_t>::min()};
+    auto new_point = [&](uint32_t v, uint32_t material, bool is_flat) {
+        point_vertex.push_back(v);
+        point_material.push_back(material);
+        point_flat.push_back(uint8_t(is_flat));
+        lo = Min(lo, q[v]);
+        hi = Max(hi, q[v]);
+        return uint32_t(point_vertex.size() - 1);
+    };
     for (size_t k = 0; k < kept.size(); ++k) {
         const uint32_t t = kept[k];
         const uint32_t material = mesh.material_ids[t];
         for (int c = 0; c < 3; ++c) {
             const uint32_t v = mesh.indices[3 * size_t(t) + c];
             uint32_t point;
-            if (point_of_vertex[v] == kUnset) {
-                point = point_of_vertex[v] = uint32_t(point_vertex.size());
+            if (flat[k]) {
+                uint64_t uv_bits = 0;
+                if (out.has_uvs) std::memcpy(&uv_bits, mesh.uvs[v].data(), sizeof(uv_bits));
+                const FlatKey key{position_value[v], material, uv_bits};
+                auto it = flat_points.find(key);
+                point = it != flat_points.end()
+                            ? it->second
+                            : flat_points.emplace(key, new_point(v, material, true)).first->second;
+            } else if (point_of_vertex[v] == kUnset) {
+                point = point_of_vertex[v] = new_point(v, material, false);
                 material_of_vertex[v] = material;
-                point_vertex.push_back(v);
-                point_material.push_back(material);
-                lo = Min(lo, q[v]);
-                hi = Max(hi, q[v]);
             } else if (material_of_vertex[v] == material) {
                 point = point_of_vertex[v];
             } else {
-                auto [it, inserted] = extra_points.try_emplace((uint64_t(v) << 32) | material,
-                                                               uint32_t(point_vertex.size()));
-                if (inserted) {
-                    point_vertex.push_back(v);
-                    point_material.push_back(material);
-                }
-                point = it->second;
+                const uint64_t key = (uint64_t(v) << 32) | material;
+                auto it = extra_points.find(key);
+                point =
+                    it != extra_points.end()
+                        ? it->second
+                        : extra_points.emplace(key, new_point(v, material, false)).first->second;
             }
             faces[3 * k + c] = point;
         }
     }
     const size_t point_count = point_vertex.size();
 
-    // 5. Positions are stored relative to the brick's smallest grid point.
+    // 6. Positions are stored relative to the brick's smallest grid point.
     const Vec3i base = point_count > 0 ? lo : Vec3i{0, 0, 0};
     for (int a = 0; a < 3; ++a) {
         if (point_count > 0 && int64_t(hi[a]) - int64_t(lo[a]) >= kMaxBrickSpanSteps) {
@@ -181,7 +289,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         }
     }
     out.bytes.resize(kMeshPrefixBytes);
-    const int32_t prefix[4] = {base.x, base.y, base.z, 0};
+    const int32_t prefix[4] = {base.x, base.y, base.z,
+                               int32_t(mark_flat ? kMeshFlagFlatFaces : 0u)};
     std::memcpy(out.bytes.data(), prefix, kMeshPrefixBytes);
 
     if (!kept.empty()) {
@@ -204,7 +313,9 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         if (out.has_normals) {
             auto att = NewAttribute(kNormalType, 3, draco::DT_FLOAT32, point_count);
             for (size_t p = 0; p < point_count; ++p) {
-                const Vec3f n = Normalized(mesh.normals[point_vertex[p]]);
+                // Flat faces' points carry one constant (cheap to code); decoding clears them.
+                const Vec3f n =
+                    point_flat[p] ? Vec3f(0, 0, 1) : Normalized(mesh.normals[point_vertex[p]]);
                 const float value[3] = {n.x, n.y, n.z};
                 att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), value);
             }
@@ -221,7 +332,8 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         {
             auto att = NewAttribute(kMaterialType, 1, draco::DT_INT32, point_count);
             for (size_t p = 0; p < point_count; ++p) {
-                const int32_t m = int32_t(point_material[p]);
+                const int32_t m = mark_flat ? int32_t(point_material[p] << 1 | point_flat[p])
+                                            : int32_t(point_material[p]);
                 att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), &m);
             }
             dm.AddAttribute(std::move(att));
@@ -233,6 +345,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
 
         draco::ExpertEncoder encoder(dm);
         encoder.SetSpeedOptions(options.draco_speed, options.draco_speed);
+        if (options.sequential) encoder.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
         if (normal_id >= 0) encoder.SetAttributeQuantization(normal_id, options.normal_bits);
         if (uv_id >= 0) encoder.SetAttributeQuantization(uv_id, options.uv_bits);
         (void)pos_id;  // positions are integers: no quantization, lossless
@@ -246,7 +359,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         out.bytes.append(buffer.data(), buffer.size());
     }
 
-    // 6. Decode once: the store must never hold a brick that does not decode to what was given, and
+    // 7. Decode once: the store must never hold a brick that does not decode to what was given, and
     // the decoded vertex count (Draco splits vertices at attribute seams and non-manifold edges) is
     // only known after decoding.
     NAVE_ASSIGN_OR_RETURN(
@@ -282,6 +395,13 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     int32_t prefix[4];
     std::memcpy(prefix, bytes.data(), kMeshPrefixBytes);
     const Vec3i base{prefix[0], prefix[1], prefix[2]};
+    const uint32_t flags = uint32_t(prefix[3]);
+    if ((flags & ~kMeshFlagFlatFaces) != 0) {
+        return DataLossError(
+            "{}: mesh section flags 0x{:x} hold bits this nave does not know (0x{:x})", what, flags,
+            flags & ~kMeshFlagFlatFaces);
+    }
+    const bool flat_marked = (flags & kMeshFlagFlatFaces) != 0;
     BrickMesh out;
     if (bytes.size() == kMeshPrefixBytes)
         return out;  // a brick whose triangles all collapsed on the grid
@@ -323,27 +443,23 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     if (uv != nullptr) out.uvs.resize(point_count);
     out.indices.resize(3 * size_t(face_count));
     out.material_ids.resize(face_count);
+    // Values are read straight from the attributes' buffers (the point-to-value mapping, then the
+    // value's address): Draco's per-value GetValue/ConvertValue calls cost more than the decode
+    // itself on large bricks (bench_brick_load).
+    const PlainAttribute positions(*pos);
     for (uint32_t p = 0; p < point_count; ++p) {
-        const draco::PointIndex pi(p);
-        int32_t g[3];
-        pos->GetMappedValue(pi, g);
+        const int32_t* g = positions.Value<int32_t>(p);
         out.positions[p] = grid.Dequantize({base.x + g[0], base.y + g[1], base.z + g[2]});
-        if (normal != nullptr) {
-            float n[3] = {0, 0, 0};
-            if (!normal->ConvertValue<float, 3>(normal->mapped_index(pi), n)) {
-                return DataLossError("{}: cannot read the normal of vertex {}", what, p);
-            }
-            out.normals[p] = {n[0], n[1], n[2]};
-        }
-        if (uv != nullptr) {
-            float t[2] = {0, 0};
-            if (!uv->ConvertValue<float, 2>(uv->mapped_index(pi), t)) {
-                return DataLossError("{}: cannot read the texture coordinates of vertex {}", what,
-                                     p);
-            }
-            out.uvs[p] = {t[0], t[1]};
-        }
     }
+    if (normal != nullptr) {
+        NAVE_RETURN_IF_ERROR(CopyFloatValues<3>(*normal, point_count, what, "normal",
+                                                reinterpret_cast<float*>(out.normals.data())));
+    }
+    if (uv != nullptr) {
+        NAVE_RETURN_IF_ERROR(CopyFloatValues<2>(*uv, point_count, what, "texture coordinates",
+                                                reinterpret_cast<float*>(out.uvs.data())));
+    }
+    const PlainAttribute materials(*material);
     for (uint32_t f = 0; f < face_count; ++f) {
         const draco::Mesh::Face& face = dm->face(draco::FaceIndex(f));
         for (int c = 0; c < 3; ++c) {
@@ -354,13 +470,27 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
             }
             out.indices[3 * size_t(f) + c] = p;
         }
-        int32_t m = 0;
-        material->GetMappedValue(face[0], &m);
+        // Draco's traversal may start a triangle at any corner, and differently in two bricks
+        // that hold the same triangle: start every triangle at its lowest grid point, so that
+        // Embree sees the same corners in the same order everywhere and a ray gets the same t and
+        // barycentrics from every brick (the image must not depend on the decomposition).
+        uint32_t* tri = &out.indices[3 * size_t(f)];
+        int first = 0;
+        for (int c = 1; c < 3; ++c) {
+            if (LessPosition(positions, tri[c], tri[first])) first = c;
+        }
+        std::rotate(tri, tri + first, tri + 3);
+        const int32_t value = *materials.Value<int32_t>(face[0].value());
+        const int32_t m = flat_marked ? value >> 1 : value;
         if (m < 0 || uint64_t(m) >= material_count) {
             return DataLossError("{}: triangle {} has material {} but the store has {} materials",
                                  what, f, m, material_count);
         }
         out.material_ids[f] = uint32_t(m);
+        if (flat_marked && (value & 1) != 0 && normal != nullptr) {
+            // A flat face: zero normals tell the renderer to shade with the geometric normal.
+            for (int c = 0; c < 3; ++c) out.normals[face[c].value()] = Vec3f(0, 0, 0);
+        }
     }
     return out;
 }

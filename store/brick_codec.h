@@ -16,6 +16,12 @@ namespace nave::store::codec {
 
 /// Bytes of the mesh section's prefix (int32 base x, y, z; uint32 flags).
 inline constexpr size_t kMeshPrefixBytes = 16;
+/// Mesh section flag (prefix word 3, format 2.0): the material attribute holds material * 2 + 1
+/// on flat faces (shaded with their geometric normal; their decoded normals are zero) and
+/// material * 2 on smooth ones. Unset: the attribute is the material.
+inline constexpr uint32_t kMeshFlagFlatFaces = 1u;
+/// Largest material id a brick can store (the flat-face bit takes one bit of the int32 value).
+inline constexpr uint32_t kMaxMaterialId = (1u << 30) - 1;
 /// Largest span of a brick's positions along one axis, in grid steps. Keeps Draco's integer
 /// prediction (a + b - c, in int32) far from overflow.
 inline constexpr int64_t kMaxBrickSpanSteps = int64_t(1) << 29;

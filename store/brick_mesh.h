@@ -14,7 +14,9 @@ namespace nave::store {
 /// material_ids.size() == T, every index < positions.size(), normals and uvs empty or one per position.
 struct BrickMesh {
     std::vector<Vec3f> positions;              ///< world coordinates (metres in nave's own models)
-    std::vector<Vec3f> normals;                ///< optional shading normals, unit length
+    /// Optional shading normals, unit length; zero at the corners of flat faces in decoded bricks
+    /// (shade those with the geometric normal).
+    std::vector<Vec3f> normals;
     std::vector<std::array<float, 2>> uvs;     ///< optional texture coordinates
     std::vector<uint32_t> indices;             ///< 3 per triangle, counter-clockwise seen from the front
     std::vector<uint32_t> material_ids;        ///< per triangle, an index into the store's material table

@@ -154,12 +154,12 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     RawHeader h;
     NAVE_RETURN_IF_ERROR(r.Get(&h.major));
     NAVE_RETURN_IF_ERROR(r.Get(&h.minor));
-    if (h.major != kFormatMajor) {
+    if (h.major < kOldestReadableMajor || h.major > kFormatMajor) {
         return UnsupportedError(
-            "{}: store format version {}.{} cannot be read by this nave, which reads version {}.x "
-            "(up to {}.{}); "
+            "{}: store format version {}.{} cannot be read by this nave, which reads versions "
+            "{}.x to {}.x (up to {}.{}); "
             "{}",
-            name, h.major, h.minor, kFormatMajor, kFormatMajor, kFormatMinor,
+            name, h.major, h.minor, kOldestReadableMajor, kFormatMajor, kFormatMajor, kFormatMinor,
             h.major > kFormatMajor ? "use a newer nave"
                                    : "re-create the store with `nave preprocess`");
     }

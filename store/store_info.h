@@ -11,8 +11,12 @@
 namespace nave::store {
 
 /// Current format version. Readers refuse another major version; a newer minor version only adds fields.
-inline constexpr uint16_t kFormatMajor = 1;
-inline constexpr uint16_t kFormatMinor = 1;  // 1.1: material alpha_cutoff
+/// The version this nave writes. 2.0: flat faces marked in the mesh section (no normals, shared
+/// corners). 1.1: material alpha_cutoff.
+inline constexpr uint16_t kFormatMajor = 2;
+inline constexpr uint16_t kFormatMinor = 0;
+/// The oldest major version this nave still reads (1.x stores decode as before).
+inline constexpr uint16_t kOldestReadableMajor = 1;
 
 /// Header fields that the writer's caller provides: how the store was made and from what.
 struct StoreProvenance {

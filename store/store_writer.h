@@ -22,6 +22,9 @@ struct EncodeOptions {
     int draco_speed = 6;        ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
     int normal_bits = 10;       ///< octahedral quantization of normals
     int uv_bits = 14;           ///< quantization of texture coordinates
+    /// Draco's sequential connectivity coding instead of edgebreaker: larger, but decodes faster
+    /// on meshes of many small parts with split vertices (bench_brick_load).
+    bool sequential = false;
 };
 
 /// A brick ready to be appended: encoded bytes and the directory fields known before writing.

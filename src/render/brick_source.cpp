@@ -9,10 +9,16 @@
 
 
 namespace nave::render {
-namespace {
-// Embree's BVH takes roughly 40-60 bytes per triangle for a medium-quality build.
-constexpr uint64_t kBvhBytesPerTriangle = 56;
-}  // namespace
+uint64_t BvhSettings::BytesPerTriangle() const {
+    // Embree's own count of its allocations (its memory monitor) after building abbey bricks of
+    // 0.1-1 M triangles, rounded up: bench_brick_load's bvh_bytes/triangle (docs/pager.md).
+    switch (quality) {
+        case Quality::kLow: return compact ? 56 : 72;
+        case Quality::kMedium: return compact ? 56 : 72;
+        case Quality::kHigh: return compact ? 64 : 80;
+    }
+    return 80;
+}
 
 // ---------------------------------------------------------------------------------------------- Embree
 
@@ -105,7 +111,7 @@ bool ResidentBrick::SurfacePresent(uint32_t triangle, float u, float v) const {
 
 StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
                                                               Bounds3f cell, store::BrickMesh mesh,
-                                                              const AlphaMasks* masks) {
+                                                              const AlphaMasks* masks, const BvhSettings& bvh) {
     // Embree reads vertex buffers with 16-byte loads: the last vertex needs 4 readable bytes after it.
     mesh.positions.reserve(mesh.positions.size() + 1);
     std::unique_ptr<ResidentBrick> brick(new ResidentBrick(id, cell, std::move(mesh)));
@@ -115,9 +121,15 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     brick->scene_ = scene;
     const std::string context = fmt::format("building the Embree scene of brick {}", id);
     if (scene == nullptr) return device.TakeError(context);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(scene,
+                     RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | (bvh.compact ? RTC_SCENE_FLAG_COMPACT : 0)));
+    const RTCBuildQuality quality = bvh.quality == BvhSettings::Quality::kLow      ? RTC_BUILD_QUALITY_LOW
+                                    : bvh.quality == BvhSettings::Quality::kMedium ? RTC_BUILD_QUALITY_MEDIUM
+                                                                                   : RTC_BUILD_QUALITY_HIGH;
+    rtcSetSceneBuildQuality(scene, quality);
     if (m.TriangleCount() > 0) {
         RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetGeometryBuildQuality(geom, quality);
         rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0,
                                    sizeof(Vec3f), m.positions.size());
         rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0,
@@ -134,17 +146,17 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     }
     rtcCommitScene(scene);
     NAVE_RETURN_IF_ERROR(device.TakeError(context));
-    brick->memory_bytes_ = m.MemoryBytes() + kBvhBytesPerTriangle * uint64_t(m.TriangleCount());
+    brick->memory_bytes_ = m.MemoryBytes() + bvh.BytesPerTriangle() * uint64_t(m.TriangleCount());
     return brick;
 }
 
 uint64_t ResidentBrick::EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                                            bool has_uvs) {
+                                            bool has_uvs, const BvhSettings& bvh) {
     // Build's vectors as BrickMesh::MemoryBytes counts them: positions hold one spare vertex (the reserve
     // above), the other vectors exactly their size.
     uint64_t per_vertex = sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) + (has_uvs ? 2 * sizeof(float) : 0);
     return vertex_count * per_vertex + sizeof(Vec3f) + triangle_count * (4 * sizeof(uint32_t)) +
-           kBvhBytesPerTriangle * triangle_count;
+           bvh.BytesPerTriangle() * triangle_count;
 }
 
 bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const {
@@ -248,7 +260,7 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     uint64_t bytes = 0;
     StatusOr<store::BrickMesh> mesh = LoadMesh(id, &bytes);
     StatusOr<std::unique_ptr<ResidentBrick>> built =
-        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(), &alpha_masks_)
+        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(), &alpha_masks_, bvh_)
                   : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
@@ -273,6 +285,12 @@ void BrickSource::SetAlphaMasks(AlphaMasks masks) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "alpha masks set while bricks are resident";
     alpha_masks_ = std::move(masks);
+}
+
+void BrickSource::SetBvhSettings(const BvhSettings& bvh) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "BVH settings changed while bricks are resident";
+    bvh_ = bvh;
 }
 
 void BrickSource::Release(uint32_t id) {
@@ -331,7 +349,8 @@ MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store
 
 uint64_t MemoryBrickSource::EstimatedResidentBytes(uint32_t id) const {
     const store::BrickMesh& m = meshes_[id];
-    return ResidentBrick::EstimateMemoryBytes(m.VertexCount(), m.TriangleCount(), m.HasNormals(), m.HasUvs());
+    return ResidentBrick::EstimateMemoryBytes(m.VertexCount(), m.TriangleCount(), m.HasNormals(), m.HasUvs(),
+                                              bvh_settings());
 }
 
 StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {

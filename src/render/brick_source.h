@@ -37,6 +37,16 @@ class AlphaMask {
 /// Alpha masks by material id; a null entry (or an id past the end) is an opaque material.
 using AlphaMasks = std::vector<std::shared_ptr<const AlphaMask>>;
 
+/// How Embree builds a brick's BVH. Quality trades build time for trace speed; compact nodes trade
+/// trace speed for memory. Measured on abbey bricks by bench_brick_load (docs/pager.md, "Brick loads").
+struct BvhSettings {
+    enum class Quality : uint8_t { kLow, kMedium, kHigh };
+    Quality quality = Quality::kMedium;
+    bool compact = false;
+    /// Bytes Embree's BVH takes per triangle with these settings (measured upper bound, for budgets).
+    uint64_t BytesPerTriangle() const;
+};
+
 /// The nearest hit of a ray inside one brick.
 struct BrickHit {
     float t = 0;          ///< ray parameter of the hit
@@ -58,7 +68,8 @@ class ResidentBrick {
     /// materials where the mask says the surface is absent are skipped by every query (the masks must outlive
     /// the brick).
     static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id, Bounds3f cell,
-                                                          store::BrickMesh mesh, const AlphaMasks* masks = nullptr);
+                                                          store::BrickMesh mesh, const AlphaMasks* masks = nullptr,
+                                                          const BvhSettings& bvh = {});
 
     uint32_t id() const { return id_; }
     const Bounds3f& cell() const { return cell_; }
@@ -68,7 +79,7 @@ class ResidentBrick {
     /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory says). Exact
     /// for meshes whose vectors hold no spare capacity (decoded and copied meshes); the pager checks it.
     static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                                        bool has_uvs);
+                                        bool has_uvs, const BvhSettings& bvh = {});
 
     /// The nearest hit with t in [t0, t1], or false. Thread-safe.
     bool Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const;
@@ -155,6 +166,10 @@ class BrickSource {
     /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is loaded
     /// (checked): a resident brick keeps the masks it was built with.
     void SetAlphaMasks(AlphaMasks masks);
+    /// How bricks built from now on build their BVH (and what EstimatedResidentBytes assumes). Call
+    /// before any brick is loaded (checked).
+    void SetBvhSettings(const BvhSettings& bvh);
+    const BvhSettings& bvh_settings() const { return bvh_; }
 
   protected:
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
@@ -179,6 +194,7 @@ class BrickSource {
     std::vector<store::MaterialRecord> materials_;
     Bounds3f bounds_;
     AlphaMasks alpha_masks_;
+    BvhSettings bvh_;
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;

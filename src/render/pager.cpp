@@ -18,8 +18,8 @@ namespace nave::render {
 
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
-        "prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, "
-        "overlap=FRACTION";
+        "prefetch=on|off, loaders=N, nearly_empty=RAYS, prefer_resident=FRACTION, "
+        "evict=lru|traffic, overlap=FRACTION";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -57,6 +57,14 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                                             value);
             }
             options->nearly_empty_rays = size_t(rays);
+        } else if (key == "loaders") {
+            int n = 0;
+            auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
+            if (ec != std::errc() || end != value.data() + value.size() || n < 1 || n > 64) {
+                return InvalidArgumentError(
+                    "pager tunable loaders={}: expected a thread count from 1 to 64", value);
+            }
+            options->loaders = n;
         } else if (key == "overlap") {
             std::string v(value);
             char* end = nullptr;
@@ -148,8 +156,7 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       last_used_(source.brick_count(), 0),
       traffic_(source.brick_count(), 0),
       load_count_(source.brick_count(), 0),
-      request_(store::kNoBrick),
-      loader_target_(store::kNoBrick) {
+      prefetch_current_(store::kNoBrick) {
     estimate_.reserve(source.brick_count());
     for (uint32_t b = 0; b < source.brick_count(); ++b)
         estimate_.push_back(source.EstimatedResidentBytes(b));
@@ -189,7 +196,13 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
         }
     }
     pager->stats_.peak_resident_bytes = pager->committed_bytes_;
-    if (options.prefetch) pager->loader_ = std::thread([p = pager.get()] { p->LoaderLoop(); });
+    if (options.prefetch) {
+        pager->loaders_.resize(size_t(std::max(1, options.loaders)));
+        for (size_t i = 0; i < pager->loaders_.size(); ++i) {
+            pager->loaders_[i].target = store::kNoBrick;
+            pager->loaders_[i].thread = std::thread([p = pager.get(), i] { p->LoaderLoop(i); });
+        }
+    }
     return pager;
 }
 
@@ -199,7 +212,26 @@ Pager::~Pager() {
         stop_ = true;
     }
     loader_cv_.notify_all();
-    if (loader_.joinable()) loader_.join();
+    for (Loader& l : loaders_) {
+        if (l.thread.joinable()) l.thread.join();
+    }
+}
+
+bool Pager::Claimed(uint32_t id) const {
+    return std::any_of(loaders_.begin(), loaders_.end(),
+                       [id](const Loader& l) { return l.target == id; });
+}
+
+uint32_t Pager::NextPrefetchTarget() const {
+    uint32_t best = store::kNoBrick;
+    for (uint32_t b = 0; b < prefetch_waiting_.size(); ++b) {
+        if (b == prefetch_current_ || prefetch_waiting_[b] == 0 || state_[b] != State::kAbsent ||
+            Claimed(b)) {
+            continue;
+        }
+        if (best == store::kNoBrick || prefetch_waiting_[b] > prefetch_waiting_[best]) best = b;
+    }
+    return best;
 }
 
 uint32_t Pager::Pick(const std::vector<size_t>& waiting) {
@@ -314,17 +346,21 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
             loaded_cv_.wait(lock);  // the loader is loading it
             continue;
         }
-        if (request_ == id) request_ = store::kNoBrick;
-        if (loader_target_ == id) {
-            // The loader is still making room for it: take over (loads here may evict any unpinned
-            // brick).
-            loader_cancel_ = true;
-            loader_cv_.notify_all();
+        for (Loader& l : loaders_) {
+            if (l.target == id) {
+                // A loader is still making room for it: take over (loads here may evict any
+                // unpinned brick).
+                l.cancel = true;
+                loader_cv_.notify_all();
+            }
         }
         const uint64_t need = estimate_[id];
         if (!MakeRoom(need, id, false)) {
-            bool loader_loading = loader_target_ != store::kNoBrick && loader_target_ != id &&
-                                  state_[loader_target_] == State::kLoading;
+            const bool loader_loading =
+                std::any_of(loaders_.begin(), loaders_.end(), [&](const Loader& l) {
+                    return l.target != store::kNoBrick && l.target != id &&
+                           state_[l.target] == State::kLoading;
+                });
             if (loader_loading) {
                 waited = true;
                 loaded_cv_.wait(lock);  // its brick becomes evictable once loaded
@@ -356,16 +392,14 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
 }
 
 void Pager::Prefetch(const std::vector<size_t>& waiting, uint32_t current, size_t batch_rays) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (current < traffic_.size()) traffic_[current] += batch_rays;
-    if (!options_.prefetch) return;
-    uint32_t best = store::kNoBrick;
-    for (uint32_t b = 0; b < waiting.size(); ++b) {
-        if (b == current || waiting[b] == 0 || state_[b] != State::kAbsent) continue;
-        if (best == store::kNoBrick || waiting[b] > waiting[best]) best = b;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (current < traffic_.size()) traffic_[current] += batch_rays;
+        if (!options_.prefetch) return;
+        prefetch_waiting_ = waiting;
+        prefetch_current_ = current;
+        ++request_epoch_;
     }
-    if (best == store::kNoBrick || best == loader_target_) return;
-    request_ = best;
     loader_cv_.notify_all();
 }
 
@@ -382,38 +416,43 @@ PagerStats Pager::stats() const {
     return stats_;
 }
 
-void Pager::LoaderLoop() {
-    // Loads run in a one-thread arena of their own: the render's workers are busy tracing, and
+void Pager::LoaderLoop(size_t index) {
+    // Each load runs in a one-thread arena of its own: the render's workers are busy tracing, and
     // Embree builds the brick's BVH with the threads of the arena it is called from (outside any
     // arena it would use TBB's default pool: more threads than cores, each with its own build
     // buffers).
     tbb::task_arena arena(1);
+    Loader& self = loaders_[index];
+    uint64_t seen_epoch = 0;
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-        loader_cv_.wait(lock, [&] { return stop_ || request_ != store::kNoBrick; });
+        loader_cv_.wait(lock, [&] { return stop_ || request_epoch_ != seen_epoch; });
         if (stop_) return;
-        const uint32_t target = request_;
-        request_ = store::kNoBrick;
-        if (state_[target] != State::kAbsent) continue;
-        loader_target_ = target;
-        loader_cancel_ = false;
+        seen_epoch = request_epoch_;
+        const uint32_t target = NextPrefetchTarget();
+        if (target == store::kNoBrick) continue;
+        self.target = target;
+        self.cancel = false;
         const uint64_t need = estimate_[target];
         bool reserved = false;
         for (;;) {
-            if (stop_ || loader_cancel_ || request_ != store::kNoBrick)
-                break;  // given up or superseded
+            if (stop_ || self.cancel) break;  // given up, or taken over by the scheduler
             if (MakeRoom(need, target, true)) {
                 Reserve(target, need);
                 reserved = true;
                 break;
             }
             // Nothing nearly empty to evict: wait for the batch to end (its brick is unpinned
-            // then).
-            const uint64_t epoch = batch_epoch_;
+            // then), or for a newer view of the queues (which may prefer another brick).
+            const uint64_t batch = batch_epoch_;
+            const uint64_t request = request_epoch_;
             loader_cv_.wait(lock, [&] {
-                return stop_ || loader_cancel_ || request_ != store::kNoBrick ||
-                       batch_epoch_ != epoch;
+                return stop_ || self.cancel || batch_epoch_ != batch || request_epoch_ != request;
             });
+            if (request_epoch_ != request) {
+                seen_epoch = request_epoch_ - 1;  // look again at once, with the newer view
+                break;
+            }
         }
         if (reserved) {
             lock.unlock();
@@ -433,9 +472,11 @@ void Pager::LoaderLoop() {
                 bytes_[target] = 0;
                 state_[target] = State::kAbsent;
             }
+            // Another brick may be worth loading from the same view: look again.
+            seen_epoch = request_epoch_ - 1;
         }
-        loader_target_ = store::kNoBrick;
-        loader_cancel_ = false;
+        self.target = store::kNoBrick;
+        self.cancel = false;
         loaded_cv_.notify_all();
     }
 }

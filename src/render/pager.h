@@ -31,8 +31,12 @@ struct PagerOptions {
     /// a brick being loaded). The caller computes it from the user's --memory, minus what it
     /// reserves for the rest.
     uint64_t brick_budget_bytes = 0;
-    /// Load the next brick in a background thread while the workers trace the current one.
+    /// Load the next bricks in background threads while the workers trace the current one.
     bool prefetch = true;
+    /// Background loader threads (with prefetch): how many bricks may load at once beside the
+    /// tracing. Each load is one thread (read, decode, BVH build); two keep a 2-core machine busy
+    /// when the workers stall, and share the cores with tracing otherwise.
+    int loaders = 2;
     /// A resident brick with fewer rays waiting than this counts as nearly empty: a prefetch may
     /// evict it. (Loads the scheduler cannot avoid evict whatever is unpinned, emptiest first.)
     size_t nearly_empty_rays = 4096;
@@ -134,7 +138,12 @@ class Pager {
     /// Records a finished load of `id` (real size `bytes`). Holds mutex_.
     void Loaded(uint32_t id, uint64_t bytes, bool prefetched);
     void Reserve(uint32_t id, uint64_t bytes);
-    void LoaderLoop();
+    /// The fullest brick of the last Prefetch snapshot that nobody loads or claims, or kNoBrick.
+    /// Holds mutex_.
+    uint32_t NextPrefetchTarget() const;
+    /// Whether a loader has claimed brick `id` (making room for it or loading it). Holds mutex_.
+    bool Claimed(uint32_t id) const;
+    void LoaderLoop(size_t index);
 
     BrickSource& source_;
     const PagerOptions options_;
@@ -151,14 +160,21 @@ class Pager {
     std::vector<uint32_t> load_count_;
     uint64_t tick_ = 0;
     uint64_t committed_bytes_ = 0;
-    uint32_t request_;            // brick the loader should load next, or kNoBrick
-    uint32_t loader_target_;      // brick the loader is making room for or loading, or kNoBrick
-    bool loader_cancel_ = false;  // the scheduler took over loader_target_
+    // The last Prefetch call's view: rays waiting per brick and the brick being traced. Loaders
+    // pick the fullest brick nobody else loads from it; request_epoch_ counts the calls.
+    std::vector<size_t> prefetch_waiting_;
+    uint32_t prefetch_current_;
+    uint64_t request_epoch_ = 0;
+    struct Loader {
+        uint32_t target;      // brick it is making room for or loading, or kNoBrick
+        bool cancel = false;  // the scheduler took over target
+        std::thread thread;
+    };
+    std::vector<Loader> loaders_;
     uint64_t batch_epoch_ = 0;
     bool stop_ = false;
     PagerStats stats_;
     bool warned_estimate_ = false;
-    std::thread loader_;
 };
 
 }  // namespace nave::render

@@ -20,7 +20,8 @@ StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(const std::fi
 
 uint64_t StoreBrickSource::EstimatedResidentBytes(uint32_t id) const {
     const store::BrickInfo& b = store_->bricks()[id];
-    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
+    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs,
+                                              bvh_settings());
 }
 
 StatusOr<store::BrickMesh> StoreBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
