@@ -1,0 +1,262 @@
+#include "render/path_integrator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "core/progress.h"
+#include "core/sampling.h"
+#include "render/brick_walk.h"
+#include "render/rng.h"
+#include "render/sppm.h"
+#include "render/surface_hit.h"
+#include "render/transport_common.h"
+
+namespace nave::render {
+
+PathIntegrator::PathIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
+                               const LightSampler& lights, VisiblePoints* visible_points)
+    : scene_(scene),
+      film_(film),
+      scheduler_(scheduler),
+      lights_(lights),
+      visible_points_(visible_points),
+      has_thin_glass_(
+          std::any_of(scene.materials.begin(), scene.materials.end(),
+                      [](const SurfaceMaterial& m) { return m.thin_glass() != nullptr; })) {}
+
+Status PathIntegrator::Run(RenderStats* stats) {
+    const Camera& camera = *scene_.camera;
+    const uint64_t pixels = uint64_t(camera.width()) * camera.height();
+    const int spp = scene_.settings.spp;
+    const uint64_t wave = scene_.settings.wave_paths;
+    ProgressBar progress("render", pixels * uint64_t(spp), "paths");
+    auto start = std::chrono::steady_clock::now();
+    int passes = 0;
+    // Small images put several passes in one wave, so that the streams stay long enough to keep
+    // every thread busy; large images split a pass into waves to bound the memory of the queues.
+    const int passes_per_wave = int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
+    for (int s = 0; s < spp; s += passes_per_wave) {
+        const int s_end = std::min(spp, s + passes_per_wave);
+        for (uint64_t first = 0; first < pixels; first += wave) {
+            const uint64_t last = std::min(pixels, first + wave);
+            for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
+            NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
+            progress.Add((last - first) * uint64_t(s_end - s));
+        }
+        passes = s_end;
+        double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+    }
+    NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));  // the last wave's tail
+    progress.Finish();
+    stats->samples_per_pixel = passes;
+    stats->camera_paths = pixels * uint64_t(passes);
+    film_->SetSamplesPerPixel(passes);
+    return Status::Ok();
+}
+
+void PathIntegrator::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
+                                        const SampledWavelengths* lambda) {
+    const Camera& camera = *scene_.camera;
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
+        RayOutbox out;
+        for (uint64_t p = range.begin(); p != range.end(); ++p) {
+            RayRecord r{};
+            r.kind = kPathRay;
+            r.pixel = uint32_t(p);
+            r.sample = sample;
+            VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamCamera));
+            float x = float(p % uint64_t(camera.width())) + rng.Uniform(kDimPixelX);
+            float y = float(p / uint64_t(camera.width())) + rng.Uniform(kDimPixelY);
+            camera.GenerateRay(x, y, rng.Uniform(kDimLens0), rng.Uniform(kDimLens1), &r.origin,
+                               &r.dir);
+            r.lambda =
+                lambda ? *lambda : SampledWavelengths::SampleVisible(rng.Uniform(kDimLambda));
+            r.beta = SampledSpectrum(1.f);
+            r.t_max = kInfinity;
+            Spawn(r, store::kNoBrick, nullptr, out);
+        }
+        scheduler_.Flush(out);
+    });
+}
+
+void PathIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                                  std::span<const RayRecord> rays, RayOutbox& out) {
+    for (const RayRecord& r : rays) ProcessRay(r, brick, resident, out);
+}
+
+void PathIntegrator::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick,
+                                RayOutbox& out) {
+    if (r.kind == kShadowRay) {
+        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
+        const uint32_t next = scheduler_.Route(r, r.t_exit, b);
+        if (next == store::kNoBrick) {
+            film_->AddSample(r.pixel, r.beta, r.lambda);  // unoccluded all the way
+        } else {
+            out.Send(next, b, r);
+        }
+        return;
+    }
+    TraceInBrick(
+        r, b, brick, scheduler_, out,
+        [&](RayRecord& path, const BrickHit& hit) { return ShadePath(path, b, brick, hit, out); },
+        [&](const RayRecord& path) { Escape(path); });
+}
+
+void PathIntegrator::Escape(const RayRecord& r) {
+    SampledSpectrum L;
+    if (scene_.sky) {
+        // The sky is also next-event estimated: weight the BSDF-sampled escape against it, at the
+        // vertex the direction was sampled from.
+        float w = 1;
+        if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
+            w = PowerHeuristic(r.prev_pdf,
+                               lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.dir));
+        }
+        L += scene_.SkyRadiance(r.dir, r.lambda) * w;
+    }
+    if (scene_.sun >= 0) {
+        const Light& sun = scene_.lights[size_t(scene_.sun)];
+        if (Dot(r.dir, sun.to_light) >= sun.cos_sun) {
+            // A BSDF-sampled direction that found the sun: weighted against next-event estimation
+            // of the sun (power heuristic). Camera rays and specular bounces cannot be
+            // light-sampled: weight 1.
+            float w = 1;
+            if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
+                w = PowerHeuristic(r.prev_pdf, UniformConePdf(sun.cos_sun));
+            }
+            L += sun.spectrum.Sample(r.lambda) * w;
+        }
+    }
+    if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda);
+}
+
+bool PathIntegrator::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1,
+                                        RayCounts& c) const {
+    float t0 = r.t_enter;
+    for (;;) {
+        ++c.shadow_segments;
+        if (!has_thin_glass_) return !brick.Occluded(r.origin, r.dir, t0, t1);
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, t0, t1, &hit)) return true;
+        SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
+        const SurfaceMaterial& m = *h.material;
+        const ThinGlassMaterial* glass = m.thin_glass();
+        if (glass == nullptr) return false;
+        SampledSpectrum reflected, transmitted;
+        ThinDielectricBxdf(glass->eta.Sample(r.lambda),
+                           m.GlassInternalTransmittance(h.has_uv ? &h.uv : nullptr, r.lambda))
+            .ReflectanceTransmittance(Dot(r.dir, h.ns), &reflected, &transmitted);
+        r.beta *= transmitted;
+        if (r.beta.IsZero()) return false;
+        t0 = hit.t + 1e-5f * (1.f + std::abs(hit.t));  // past this pane
+    }
+}
+
+void PathIntegrator::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out) {
+    ++out.counts.rays;
+    uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
+    if (next == store::kNoBrick) {
+        if (r.kind == kShadowRay) {
+            film_->AddSample(r.pixel, r.beta, r.lambda);
+        } else {
+            Escape(r);
+        }
+        return;
+    }
+    if (next == b && brick != nullptr && r.kind == kShadowRay) {
+        ProcessRay(r, b, *brick, out);  // same brick, resident now: no need to queue
+        return;
+    }
+    out.Send(next, b, r);
+}
+
+bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                               const BrickHit& hit, RayOutbox& out) {
+    SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    if (r.depth == 0) film_->AddAov(r.pixel, Vec3f(1, 1, 1) * mat.AlbedoForAov(), h.ns, hit.t);
+    if (mat.emissive) {
+        // Emission found by the path itself (two-sided; emissive surfaces are not light-sampled, so
+        // weight 1). In photon mode paths stop at their first diffuse vertex, so this only sees
+        // specular and glossy chains; light reaching diffuse vertices from emitters comes with the
+        // photons.
+        film_->AddSample(r.pixel, r.beta * mat.Emitted(h.has_uv ? &h.uv : nullptr, r.lambda),
+                         r.lambda);
+    }
+    // A path at its last scattering still passes through thin glass (not a scattering event): cut
+    // there, the light that next-event estimation left to BSDF sampling through a window would be
+    // lost.
+    const bool last = r.depth >= uint32_t(scene_.settings.max_depth);
+    if (last && mat.thin_glass() == nullptr) return false;
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamPath));
+    const bool non_specular = flags & (kBxdfDiffuse | kBxdfGlossy);
+    // In photon mode the path stops at its first diffuse vertex: no BSDF-sampled direction will
+    // find the lights from here, so next-event estimation takes the full weight.
+    const bool visible_point =
+        scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse);
+    if (non_specular) {
+        for (size_t i = 0; i < scene_.lights.size(); ++i) {
+            std::optional<RayRecord> shadow =
+                lights_.SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, !visible_point);
+            if (shadow) Spawn(*shadow, b, &brick, out);
+        }
+        if (scene_.sky) {
+            std::optional<RayRecord> shadow =
+                lights_.SampleSky(h, bsdf, wo, r, rng, !visible_point);
+            if (shadow) Spawn(*shadow, b, &brick, out);
+        }
+    }
+    if (visible_point) {
+        // SPPM: the path stops at its first diffuse vertex; indirect light there comes from
+        // photons.
+        visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, h.footprint,
+                             r.beta);
+        return false;
+    }
+    std::optional<BsdfSample> bs =
+        bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice),
+                    Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)), r.lambda);
+    if (!bs) return false;
+    r.beta *= bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        if (r.beta.IsZero()) return false;
+        r.since_vertex += Length(h.p - r.origin);
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
+    if (last) return false;
+    r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
+    r.prev_pdf = bs->pdf;
+    if (r.depth >= 2) {
+        // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1.
+        float m = r.beta.MaxValue();
+        if (m < 1) {
+            float q = std::max(0.f, 1 - m);
+            if (rng.Uniform(kDimRoulette) < q) return false;
+            r.beta /= 1 - q;
+        }
+    }
+    if (r.beta.IsZero()) return false;
+    r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.since_vertex = 0;
+    r.dir = bs->wi;
+    r.t_max = kInfinity;
+    r.depth += 1;
+    return true;
+}
+
+}  // namespace nave::render

@@ -1,0 +1,75 @@
+#pragma once
+// Unidirectional path tracing on the ray streams (docs/render.md, "Light transport"): camera rays,
+// shading of path hits with next-event estimation and MIS, shadow rays through thin glass, escapes
+// to the sky and the sun. Path mode runs it for every pass; photon mode's camera pass uses it to
+// find the visible points.
+
+#include <cstdint>
+#include <span>
+
+#include "core/spectrum.h"
+#include "core/status.h"
+#include "render/brick_source.h"
+#include "render/film.h"
+#include "render/integrator.h"
+#include "render/light_sampling.h"
+#include "render/ray.h"
+#include "render/scene.h"
+#include "render/stream_scheduler.h"
+
+namespace nave::render {
+
+class VisiblePoints;
+
+/// Traces camera paths and their shadow rays: the RayProcessor of path mode and of photon mode's
+/// camera pass. ProcessBatch is thread-safe; the rest is called from the render's thread.
+class PathIntegrator final : public RayProcessor {
+  public:
+    /// Paths of `scene` into `film`, their rays scheduled by `scheduler`, lights sampled by
+    /// `lights` (all must outlive the integrator). `visible_points`: photon mode, where paths stop
+    /// at their first diffuse vertex and leave their visible point there; null in path mode.
+    PathIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
+                   const LightSampler& lights, VisiblePoints* visible_points = nullptr);
+
+    /// Path mode: renders scene.settings.spp passes (fewer if time_limit_s runs out) in waves of
+    /// wave_paths, and fills samples_per_pixel and camera_paths of `stats`.
+    Status Run(RenderStats* stats);
+    /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or
+    /// the iteration's when `lambda` is given).
+    void GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
+                            const SampledWavelengths* lambda);
+    /// Keys the random numbers of the paths generated and traced from now on to SPPM iteration
+    /// `iteration` (path mode: 0).
+    void set_iteration(uint32_t iteration) { iteration_ = iteration; }
+
+    void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                      std::span<const RayRecord> rays, RayOutbox& out) override;
+
+  private:
+    void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, RayOutbox& out);
+    /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if
+    /// the path ends.
+    bool ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit,
+                   RayOutbox& out);
+    /// A path leaving the model: the sky and the sun it finds, weighted against their next-event
+    /// estimation.
+    void Escape(const RayRecord& r);
+    /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin
+    /// glass (windows) lets it through, scaled by the pane's transmittance at that angle: panes do
+    /// not bend rays.
+    bool ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1, RayCounts& c) const;
+    /// Starts path or shadow ray `r` made in brick `b` (pinned as `brick`; kNoBrick and null for
+    /// camera rays): queued at the first brick along it, or ended if it misses the model; a shadow
+    /// ray that starts in `b` is traced at once.
+    void Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out);
+
+    const RenderScene& scene_;
+    Film* film_;
+    StreamScheduler& scheduler_;
+    const LightSampler& lights_;
+    VisiblePoints* visible_points_;  // photon mode
+    uint32_t iteration_ = 0;
+    const bool has_thin_glass_;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,305 @@
+#include "render/photon_emission.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/sampling.h"
+#include "render/materials/frame.h"
+#include "render/stream_scheduler.h"
+#include "render/transport_common.h"
+
+namespace nave::render {
+namespace {
+
+/// A rough power of a spectrum for choosing emitters: its mean over 400-700 nm.
+float MeanVisible(const Spectrum& s) {
+    double sum = 0;
+    for (int l = 400; l <= 700; l += 10) sum += s.Evaluate(float(l));
+    return float(sum / 31);
+}
+
+/// The rough power of an emissive material for choosing emitters: MeanVisible of its spectrum, or
+/// for an emission texture the mean of its mean radiance over a few wavelength sets (any positive
+/// weight keeps the estimate unbiased; a good one only lowers noise).
+float EmissionPower(const SurfaceMaterial& m) {
+    if (!(m.textures && m.textures->emission)) return MeanVisible(m.emission);
+    double sum = 0;
+    for (int i = 0; i < 8; ++i) {
+        SampledWavelengths lambda = SampledWavelengths::SampleVisible((i + 0.5f) / 8);
+        SampledSpectrum s = m.textures->MeanEmission(lambda);
+        for (int k = 0; k < kNumWavelengths; ++k) sum += s[k];
+    }
+    // A black texture would give 0 and never be chosen; keep a floor so its triangles can still
+    // emit.
+    return std::max(float(sum / (8 * kNumWavelengths)), 1e-6f);
+}
+
+}  // namespace
+
+StatusOr<std::unique_ptr<PhotonEmitters>> PhotonEmitters::Build(const RenderScene& scene,
+                                                                StreamScheduler& scheduler) {
+    std::unique_ptr<PhotonEmitters> emitters(new PhotonEmitters(scene));
+    NAVE_RETURN_IF_ERROR(emitters->Gather(scheduler));
+    return emitters;
+}
+
+Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
+    const Bounds3f& bounds = scene_.source->bounds();
+    scene_center_ = bounds.Center();
+    scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
+    const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
+    const float kPiF = 3.14159265358979f;
+
+    // One pass over the bricks that hold emissive or portal materials. A triangle stored in several
+    // bricks (it crosses cells) is kept only in the brick whose cell holds its centroid.
+    const bool want_portals =
+        scene_.settings.photon_target == RenderSettings::PhotonTarget::kPortals;
+    bool any_emissive = false, any_portal = false;
+    for (const SurfaceMaterial& m : scene_.materials) {
+        any_emissive |= m.emissive;
+        any_portal |= m.portal;
+    }
+    if (want_portals && !any_portal) {
+        return InvalidArgumentError(
+            "render.photon_target = \"portals\" but no material has portal = true");
+    }
+    std::vector<double> weights;
+    std::vector<Emitter> triangles;
+    std::vector<double> triangle_weights;
+    std::vector<std::array<Vec3f, 3>> portal_triangles;
+    if (any_emissive || (want_portals && any_portal)) {
+        // Per material, not per triangle: an emission texture's mean takes texture lookups.
+        std::vector<float> power(scene_.materials.size(), 0.f);
+        for (size_t i = 0; i < power.size(); ++i) {
+            if (scene_.materials[i].emissive) power[i] = EmissionPower(scene_.materials[i]);
+        }
+        NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
+            scene_, scheduler,
+            [&](const SurfaceMaterial& sm) { return sm.emissive || (want_portals && sm.portal); },
+            [&](const store::BrickMesh& m, size_t t, uint32_t) {
+                const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
+                const std::array<Vec3f, 3> v = m.TrianglePositions(t);
+                if (want_portals && sm.portal) portal_triangles.push_back(v);
+                if (!sm.emissive) return;
+                Emitter e;
+                e.kind = Emitter::Kind::kTriangle;
+                e.v0 = v[0];
+                e.v1 = v[1];
+                e.v2 = v[2];
+                Vec3f c = Cross(v[1] - v[0], v[2] - v[0]);
+                e.area = 0.5f * Length(c);
+                if (e.area <= 0) return;
+                e.n = Normalize(c);
+                e.material = &sm;
+                if (m.HasUvs()) {
+                    for (int k = 0; k < 3; ++k) e.uv[k] = m.uvs[m.indices[3 * t + k]];
+                    e.has_uv = true;
+                }
+                triangles.push_back(e);
+                // Two-sided Lambertian emitter: power = L pi A per side.
+                triangle_weights.push_back(power[m.material_ids[t]] * 2 * kPiF * e.area);
+            }));
+    }
+    for (const Light& l : scene_.lights) {
+        Emitter e;
+        e.light = &l;
+        float w = MeanVisible(l.spectrum);
+        float target_area = disk_area;
+        if (want_portals && (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional)) {
+            PortalProjection projection(portal_triangles, l.to_light);
+            if (!projection.empty()) {
+                e.portal = int(portals_.size());
+                target_area = float(projection.total_area());
+                portals_.push_back(std::move(projection));
+            }
+        }
+        switch (l.kind) {
+            case Light::Kind::kSun:
+                w *= l.SunSolidAngle() * target_area;
+                break;
+            case Light::Kind::kDirectional:
+                w *= target_area;
+                break;
+            case Light::Kind::kPoint:
+            case Light::Kind::kSpot:
+                w *= 4 * kPiF;
+                break;
+        }
+        emitters_.push_back(e);
+        weights.push_back(w);
+    }
+    if (scene_.sky && want_portals && !portal_triangles.empty()) {
+        NAVE_ASSIGN_OR_RETURN(sky_portals_, SkyPortals::Build(*scene_.source, portal_triangles));
+    }
+    if (scene_.sky) {
+        Emitter e;
+        e.kind = Emitter::Kind::kSky;
+        emitters_.push_back(e);
+        // Mean radiance over the sphere of directions (a fixed 256-direction Fibonacci set for a
+        // sky model).
+        double mean = 0;
+        if (scene_.preetham) {
+            const int n = 256;
+            for (int i = 0; i < n; ++i) {
+                float z = 1 - 2 * (float(i) + 0.5f) / float(n), phi = 2.39996323f * float(i);
+                float rxy = std::sqrt(std::max(0.f, 1 - z * z));
+                mean += MeanVisible(scene_.preetham->RadianceSpectrum(
+                    Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
+            }
+            mean = mean / n * scene_.sky_scale;
+        } else {
+            mean = MeanVisible(scene_.sky_radiance);
+        }
+        // Through portals: lines cross them with measure 2 pi A_portals (both sides), through the
+        // bounds 4 pi A_disc.
+        weights.push_back(mean *
+                          (sky_portals_ ? 2 * kPiF * sky_portals_->area() : 4 * kPiF * disk_area));
+    }
+    emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
+    weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
+    double total = 0;
+    for (double w : weights) total += w;
+    if (emitters_.empty() || !(total > 0)) {
+        return InvalidArgumentError(
+            "photon mode needs a light: the scene has no sun, light, sky or emissive "
+            "material with power");
+    }
+    emitter_cdf_.assign(1, 0.0);
+    for (double w : weights) emitter_cdf_.push_back(emitter_cdf_.back() + w / total);
+    emitter_cdf_.back() = 1.0;
+    return Status::Ok();
+}
+
+void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
+                                 const SampledWavelengths& lambda,
+                                 StreamScheduler& scheduler) const {
+    const float kPiF = 3.14159265358979f;
+    const float disk_area = kPiF * scene_radius_ * scene_radius_;
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
+        RayOutbox out;
+        for (uint64_t i = range.begin(); i != range.end(); ++i) {
+            RayRecord r{};
+            r.kind = kPhotonRay;
+            r.pixel = uint32_t(i);
+            r.lambda = lambda;
+            r.t_max = kInfinity;
+            VertexRng rng(RayKey(scene_.settings.seed, r, iteration, kStreamEmit));
+            float u = rng.Uniform(0);
+            size_t k =
+                size_t(std::upper_bound(emitter_cdf_.begin() + 1, emitter_cdf_.end(), double(u)) -
+                       (emitter_cdf_.begin() + 1));
+            k = std::min(k, emitters_.size() - 1);
+            const float p_choice = float(emitter_cdf_[k + 1] - emitter_cdf_[k]);
+            if (p_choice <= 0) continue;
+            const Emitter& e = emitters_[k];
+            Point2f u1(rng.Uniform(1), rng.Uniform(2)), u2(rng.Uniform(3), rng.Uniform(4));
+            // Photons from distant sources (sun, directional, sky) start on a disc facing the
+            // source that covers the model's bounding sphere: every photon that can reach the model
+            // does (the model's bounds projected onto the light's direction; windows are reached
+            // through them).
+            auto disc_origin = [&](const Vec3f& toward) {
+                Frame f = Frame::FromZ(toward);
+                Point2f d = SampleUniformDiskConcentric(u1);
+                return scene_center_ + toward * (2 * scene_radius_) + f.x * (d.x * scene_radius_) +
+                       f.y * (d.y * scene_radius_);
+            };
+            if (e.kind == Emitter::Kind::kLight) {
+                const Light& l = *e.light;
+                switch (l.kind) {
+                    case Light::Kind::kSun:
+                    case Light::Kind::kDirectional: {
+                        const bool sun = l.kind == Light::Kind::kSun;
+                        Vec3f to = sun ? Frame::FromZ(l.to_light)
+                                             .FromLocal(SampleUniformCone(u2, l.cos_sun))
+                                       : l.to_light;
+                        // Area density of the start point on the plane facing the light: 1/A on the
+                        // disc, count(x)/A_total on the portals' projections (photon_portals.h).
+                        float area = disk_area;
+                        if (e.portal >= 0) {
+                            const PortalProjection& portals = portals_[size_t(e.portal)];
+                            int coverage = 1;
+                            Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
+                            r.origin = p + to * (2 * scene_radius_);
+                            area = float(portals.total_area()) / float(coverage);
+                        } else {
+                            r.origin = disc_origin(l.to_light);
+                        }
+                        r.dir = -to;
+                        // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E /
+                        // p_area.
+                        r.beta = sun ? l.spectrum.Sample(lambda) *
+                                           (Dot(to, l.to_light) * area * l.SunSolidAngle())
+                                     : l.spectrum.Sample(lambda) * area;
+                        break;
+                    }
+                    case Light::Kind::kPoint:
+                    case Light::Kind::kSpot: {
+                        r.origin = l.position;
+                        r.dir = SampleUniformSphere(u2);
+                        float falloff = 1;
+                        if (l.kind == Light::Kind::kSpot) {
+                            float cos_a = Dot(r.dir, l.spot_axis);
+                            float x = std::clamp(
+                                (cos_a - l.cos_cone) / std::max(1e-6f, l.cos_falloff - l.cos_cone),
+                                0.f, 1.f);
+                            falloff = x * x * (3 - 2 * x);
+                        }
+                        r.beta = l.spectrum.Sample(lambda) * (falloff * 4 * kPiF);
+                        break;
+                    }
+                }
+            } else if (e.kind == Emitter::Kind::kSky && sky_portals_) {
+                // A point uniform on the portals' area, a cosine-weighted direction on a random
+                // side: the line's density is count / (2 pi A) in the measure dA_perp dw, count =
+                // portals the line crosses (Veach's balance heuristic over the portals), so the
+                // power is L 2 pi A / count.
+                size_t i = 0;
+                const Vec3f p = sky_portals_->SamplePoint(rng.Uniform(6), u1, &i);
+                const auto& t = sky_portals_->triangle(i);
+                Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
+                if (rng.Uniform(5) < 0.5f) n = -n;
+                Vec3f d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                r.origin = p - d * (2 * scene_radius_);
+                r.dir = d;
+                const int count = sky_portals_->ForEachCrossing(r.origin, d, 4 * scene_radius_,
+                                                                [](const BrickHit&) {});
+                r.beta = scene_.SkyRadiance(-d, lambda) *
+                         float(2 * kPiF * sky_portals_->area() / std::max(1, count));
+            } else if (e.kind == Emitter::Kind::kSky) {
+                Vec3f to = SampleUniformSphere(u2);
+                r.origin = disc_origin(to);
+                r.dir = -to;
+                r.beta = scene_.SkyRadiance(to, lambda) * (4 * kPiF * disk_area);
+                // Direct skylight is next-event estimated at the visible points: sky photons
+                // deposit only after a bounce.
+            } else {
+                // Uniform point on the triangle (Turk 1990 square-root parameterisation),
+                // cosine-weighted direction on a side chosen with probability 1/2.
+                const std::array<float, 3> w = SampleUniformTriangle(u1);
+                Vec3f p = e.v0 * w[0] + e.v1 * w[1] + e.v2 * w[2];
+                Vec3f n = rng.Uniform(5) < 0.5f ? e.n : -e.n;
+                r.dir = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                r.origin = OffsetOrigin(p, n, r.dir);
+                // L cos / (1/A * cos/pi * 1/2).
+                std::array<float, 2> uv;
+                for (int k = 0; k < 2; ++k)
+                    uv[k] = e.uv[0][k] * w[0] + e.uv[1][k] * w[1] + e.uv[2][k] * w[2];
+                r.beta =
+                    e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPiF * e.area);
+                r.flags = kFromAreaLight;
+            }
+            r.beta /= p_choice;
+            if (r.beta.IsZero()) continue;
+            // Queued at the first brick along it; a photon that misses the model carries nothing.
+            ++out.counts.rays;
+            const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);
+            if (next != store::kNoBrick) out.Send(next, store::kNoBrick, r);
+        }
+        scheduler.Flush(out);
+    });
+}
+
+}  // namespace nave::render

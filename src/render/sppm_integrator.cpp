@@ -1,0 +1,139 @@
+#include "render/sppm_integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "core/progress.h"
+#include "render/light_sampling.h"
+#include "render/path_integrator.h"
+#include "render/rng.h"
+#include "render/surface_hit.h"
+#include "render/transport_common.h"
+
+namespace nave::render {
+
+SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler)
+    : scene_(scene), film_(film), scheduler_(scheduler) {}
+
+Status SppmIntegrator::Run(RenderStats* stats) {
+    const Camera& camera = *scene_.camera;
+    const uint64_t pixels = uint64_t(camera.width()) * camera.height();
+    const int iterations = scene_.settings.iterations;
+    const uint64_t photons = scene_.settings.photons_per_iteration;
+    const uint64_t wave = scene_.settings.wave_paths;
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<PhotonEmitters> emitters,
+                          PhotonEmitters::Build(scene_, scheduler_));
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<LightSampler> lights,
+                          LightSampler::Create(scene_, scheduler_, emitters->sky_portals()));
+    float radius = scene_.settings.initial_radius_m > 0 ? scene_.settings.initial_radius_m
+                                                        : 0.01f * 2 * emitters->scene_radius();
+    visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius);
+    PathIntegrator camera_paths(scene_, film_, scheduler_, *lights, visible_.get());
+    ProgressBar progress("photon mapping", uint64_t(iterations), "iterations");
+    auto start = std::chrono::steady_clock::now();
+    int done = 0;
+    for (int it = 0; it < iterations; ++it) {
+        iteration_ = uint32_t(it);
+        camera_paths.set_iteration(iteration_);
+        SampledWavelengths lambda = SampledWavelengths::SampleVisible(
+            VertexRng(RngKey{scene_.settings.seed, 0, 0, 0, iteration_, kStreamLambda}).Uniform(0));
+        visible_->BeginIteration(lambda);
+        // Visible points must all be in place before photons arrive: waves overlap within each pass
+        // only. So the queues hold camera paths and their shadow rays, then photons, never both,
+        // and each pass is drained by its own processor.
+        for (uint64_t first = 0; first < pixels; first += wave) {
+            camera_paths.GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda);
+            NAVE_RETURN_IF_ERROR(scheduler_.Drain(
+                camera_paths, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
+        }
+        visible_->BuildBrickGrids(scheduler_.tree());
+        for (uint64_t first = 0; first < photons; first += wave) {
+            emitters->EmitPhotons(first, std::min(photons, first + wave), iteration_, lambda,
+                                  scheduler_);
+            NAVE_RETURN_IF_ERROR(
+                scheduler_.Drain(*this, first + wave < photons ? scheduler_.WaveOverlap() : 0));
+        }
+        visible_->EndIteration(scene_.settings.alpha);
+        done = it + 1;
+        progress.Add(1);
+        double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+    }
+    progress.Finish();
+    // Direct light and specular chains were summed by the film over `done` iterations; the photon
+    // estimate is added as `done` times the per-iteration mean so the film's division by its sample
+    // count holds.
+    film_->SetSamplesPerPixel(done);
+    const double emitted = double(photons) * done;
+    for (uint64_t p = 0; p < pixels; ++p) {
+        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done));
+    }
+    stats->iterations = done;
+    stats->samples_per_pixel = done;
+    stats->camera_paths = pixels * uint64_t(done);
+    stats->photons = emitted;
+    return Status::Ok();
+}
+
+void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                                  std::span<const RayRecord> rays, RayOutbox& out) {
+    for (RayRecord r : rays) {
+        TraceInBrick(
+            r, brick, resident, scheduler_, out,
+            [&](RayRecord& photon, const BrickHit& hit) {
+                return ShadePhoton(photon, brick, resident, hit);
+            },
+            [](const RayRecord&) {});  // photons leaving the model carry nothing back
+    }
+}
+
+bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                                 const BrickHit& hit) {
+    SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    // Direct light from the sun and the other delta or disc lights is next-event estimated at the
+    // visible points: deposit only photons that bounced, or that come from emitters no estimator
+    // samples.
+    if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
+        visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
+    }
+    // As for paths, a photon at its last bounce still passes through thin glass.
+    const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);
+    if (last && mat.thin_glass() == nullptr) return false;
+    VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamPhoton));
+    std::optional<BsdfSample> bs = bsdf.Sample(
+        wo, rng.Uniform(kDimBsdfChoice), Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),
+        r.lambda, TransportMode::kImportance);
+    if (!bs) return false;
+    SampledSpectrum beta = r.beta * bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        // Through a window pane: not a bounce, so a photon that arrives next at a diffuse surface
+        // is still direct sunlight, which next-event estimation through glass already counts.
+        r.beta = beta;
+        if (r.beta.IsZero()) return false;
+        r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+        r.t_max = kInfinity;
+        return true;
+    }
+    if (last) return false;
+    // Russian roulette on the photon's change of power (pbrt-v4 SPPM photon pass).
+    float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
+    if (rng.Uniform(kDimRoulette) < q) return false;
+    r.beta = beta / (1 - q);
+    if (r.beta.IsZero()) return false;
+    r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.dir = bs->wi;
+    r.t_max = kInfinity;
+    r.depth += 1;
+    return true;
+}
+
+}  // namespace nave::render

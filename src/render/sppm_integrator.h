@@ -1,0 +1,51 @@
+#pragma once
+// Photon mode: stochastic progressive photon mapping (sppm.h) on the ray streams. Each iteration
+// traces a camera pass (PathIntegrator, stopping at the visible points) and then a photon pass
+// (photons from PhotonEmitters, deposited at the visible points), each drained to the last ray
+// before the next starts.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "core/status.h"
+#include "render/brick_source.h"
+#include "render/film.h"
+#include "render/integrator.h"
+#include "render/photon_emission.h"
+#include "render/ray.h"
+#include "render/scene.h"
+#include "render/sppm.h"
+#include "render/stream_scheduler.h"
+
+namespace nave::render {
+
+/// Runs photon mode, and traces its photons: the RayProcessor of the photon pass. ProcessBatch is
+/// thread-safe; Run is called from the render's thread.
+class SppmIntegrator final : public RayProcessor {
+  public:
+    /// Photon mode for `scene` into `film`, rays scheduled by `scheduler` (all must outlive the
+    /// integrator).
+    SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler);
+
+    /// Renders scene.settings.iterations SPPM iterations (fewer if time_limit_s runs out) and adds
+    /// the photon estimate to the film; fills iterations, samples_per_pixel, camera_paths and
+    /// photons of `stats`. Errors: no emitter, portal settings without portals, a brick that cannot
+    /// be pinned.
+    Status Run(RenderStats* stats);
+
+    void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                      std::span<const RayRecord> rays, RayOutbox& out) override;
+
+  private:
+    /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
+    bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
+
+    const RenderScene& scene_;
+    Film* film_;
+    StreamScheduler& scheduler_;
+    std::unique_ptr<VisiblePoints> visible_;
+    uint32_t iteration_ = 0;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,123 @@
+#pragma once
+// The stream scheduler (docs/render.md, "Scheduling"; docs/pager.md): the per-brick queues of rays
+// in flight and the loop that drains them. Drain repeatedly picks a brick (the BrickPicker, or the
+// pager's choice under a memory budget), pins it through the pager or the brick source, takes a
+// batch of its rays and hands the batch to a RayProcessor on all threads; what the processor sends
+// on is flushed, grouped by brick, to the RayExchange, which queues it at the brick's owner. The
+// scheduler knows rays and bricks only: what happens to a ray inside a brick (shading, lights, the
+// film) is the processor's, so paging is tuned here without touching the physics.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "core/status.h"
+#include "render/brick_source.h"
+#include "render/integrator.h"
+#include "render/pager.h"
+#include "render/ray.h"
+#include "render/ray_exchange.h"
+#include "render/ray_queue.h"
+#include "store/brick_tree.h"
+
+namespace nave::render {
+
+/// Work counted by the workers, summed into RenderStats by the scheduler.
+struct RayCounts {
+    /// Ray segments traced inside a brick (closest-hit queries).
+    uint64_t segments = 0;
+    /// Shadow-ray segments traced inside a brick (occlusion queries).
+    uint64_t shadow_segments = 0;
+    /// Rays sent to another brick than the one they were traced or made in.
+    uint64_t moves = 0;
+    /// Rays started: camera, continuation, shadow rays and photons.
+    uint64_t rays = 0;
+};
+
+/// What one task produced: the rays it sends on (spawned, or leaving the brick's cell) and its
+/// counts. One per task, so not thread-safe; StreamScheduler::Flush hands it to the exchange and
+/// empties it.
+struct RayOutbox {
+    /// Holds `r` for brick `next` until the flush. A move when `next` is not `current`, the brick
+    /// the ray was traced or made in (store::kNoBrick for rays made outside a batch, like camera
+    /// rays).
+    void Send(uint32_t next, uint32_t current, const RayRecord& r) {
+        if (next != current) ++counts.moves;
+        rays.emplace_back(next, r);
+    }
+
+    std::vector<std::pair<uint32_t, RayRecord>> rays;  ///< (brick, ray), in the order sent
+    RayCounts counts;
+};
+
+/// The work on the rays of one brick: what Drain does with a batch.
+class RayProcessor {
+  public:
+    virtual ~RayProcessor() = default;
+    /// Traces `rays`, taken from the queue of brick `brick` (pinned as `resident` for the call),
+    /// and sends every ray that goes on in another brick to `out`. Called from many threads at
+    /// once, each with its own part of the batch and its own outbox, which the scheduler flushes
+    /// after the call.
+    virtual void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                              std::span<const RayRecord> rays, RayOutbox& out) = 0;
+};
+
+/// The ray queues of one render and the loop that drains them. EnablePaging, Acquire, Drain and
+/// FillStats are called from the render's thread; Route and Flush from any thread (workers call
+/// them).
+class StreamScheduler {
+  public:
+    /// Schedules rays over the bricks of `source`, which must outlive the scheduler. `picker`
+    /// empty: PickFullestBrick, or with paging the pager's choice. `wave_paths`: camera paths (or
+    /// photons) per wave, the unit of WaveOverlap.
+    StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths);
+    StreamScheduler(const StreamScheduler&) = delete;
+    StreamScheduler& operator=(const StreamScheduler&) = delete;
+
+    /// Pages bricks under `options` from now on (call before the first Drain); refuses an
+    /// impossible budget with the pager's ResourceExhausted error.
+    Status EnablePaging(const PagerOptions& options);
+    /// Pins brick `brick` for a batch or a pass over the bricks, through the pager when paging;
+    /// in-core, the wait for a load counts as stall. Load errors name the brick.
+    StatusOr<BrickHandle> Acquire(uint32_t brick);
+    /// Sets r's segment to the first brick after `from_t` other than `current`; returns it or
+    /// store::kNoBrick (the ray leaves the model, or reaches t_max, first).
+    uint32_t Route(RayRecord& r, float from_t, uint32_t current) const;
+    /// Sends the rays of `out` to the exchange, grouped by brick, adds its counts to the render's
+    /// and empties it.
+    void Flush(RayOutbox& out);
+    /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty), tracing
+    /// every batch with `processor`. Errors: a brick that cannot be pinned.
+    Status Drain(RayProcessor& processor, size_t stop_below = 0);
+    /// Rays left waiting when the next wave is generated: under paging the next wave joins the tail
+    /// of the previous one, whose few scattered rays would otherwise cost a load each
+    /// (docs/pager.md); in-core, waves do not overlap.
+    size_t WaveOverlap() const;
+    /// Fills the scheduling and residency fields of `stats` (segments, shadow segments, rays,
+    /// moves, batches, loads, bytes read, acquires, budget, evictions, reloads, prefetches, stall,
+    /// peak queue bytes). `before`: the source's counters when the render started.
+    void FillStats(const BrickSourceStats& before, RenderStats* stats) const;
+
+    /// The source's brick tree, along which rays are routed.
+    const store::BrickTree& tree() const { return tree_; }
+
+  private:
+    BrickSource& source_;
+    const store::BrickTree& tree_;
+    const bool custom_picker_;
+    const BrickPicker picker_;
+    const uint64_t wave_paths_;
+    BrickQueues<RayRecord> queues_;
+    LocalRayExchange local_exchange_{queues_};
+    RayExchange& exchange_ = local_exchange_;  // every ray leaving a batch goes through here
+    // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
+    std::unique_ptr<Pager> pager_;  // null: in-core
+    double stall_seconds_ = 0;      // in-core
+    uint64_t peak_queue_bytes_ = 0;
+    std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
+};
+
+}  // namespace nave::render

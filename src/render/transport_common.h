@@ -1,0 +1,106 @@
+#pragma once
+// What path tracing, photon tracing, light sampling and photon emission share: the layout of a
+// vertex's random numbers, the MIS weight, one pass over the triangles of chosen materials, and the
+// walk of a path or photon through a brick.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+
+#include "core/status.h"
+#include "render/brick_walk.h"
+#include "render/ray.h"
+#include "render/rng.h"
+#include "render/scene.h"
+#include "render/stream_scheduler.h"
+
+namespace nave::render {
+
+inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+/// Dimensions of a vertex's random numbers (VertexRng::Uniform).
+enum RngDim : uint32_t {
+    // The camera stream only: pixel position, lens, wavelengths.
+    kDimPixelX = 0,
+    kDimPixelY,
+    kDimLens0,
+    kDimLens1,
+    kDimLambda,
+    // Every scattering vertex: BSDF lobe and direction, Russian roulette.
+    kDimBsdfChoice = 8,
+    kDimBsdf0,
+    kDimBsdf1,
+    kDimRoulette,
+    kDimLight0 = 16,  // next-event estimation: two per light, then the sky's
+};
+
+/// The random streams of a ray (RngKey::stream).
+enum RngStream : uint32_t {
+    kStreamPath = 0,
+    kStreamPhoton = 1,
+    kStreamCamera = 2,
+    kStreamEmit = 3,
+    kStreamLambda = 4,
+};
+
+/// The key of ray r's random numbers in `stream`: its path (or photon), its vertex and the SPPM
+/// iteration (0 in path mode) under the render's `seed`.
+inline RngKey RayKey(uint64_t seed, const RayRecord& r, uint32_t iteration, uint32_t stream) {
+    return RngKey{seed, r.pixel, r.sample, r.vertex, iteration, stream};
+}
+
+/// The MIS weight of a sample drawn with pdf `a` against a strategy with pdf `b`.
+inline float PowerHeuristic(float a, float b) {
+    // Veach 1997, eq. 9.13 with beta = 2.
+    if (std::isinf(a)) return 1;
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0;
+}
+
+/// One pass over the bricks (pinned through `scheduler`, so through the pager when paging) calling
+/// `visit(mesh, t, b)` for every triangle t of brick b whose material passes `want`. A triangle
+/// stored in several bricks (it crosses cells) is visited once: in the brick whose cell holds its
+/// centroid. Errors: a brick that cannot be pinned. Call from the render's thread, not during a
+/// Drain.
+Status ForEachOwnedTriangle(
+    const RenderScene& scene, StreamScheduler& scheduler,
+    const std::function<bool(const SurfaceMaterial&)>& want,
+    const std::function<void(const store::BrickMesh&, size_t, uint32_t)>& visit);
+
+/// Traces a path or photon ray `r` inside brick `b` (pinned as `brick`) from its segment there. At
+/// each hit, `shade(r, hit)` scatters the ray in place and returns whether it goes on. A ray that
+/// goes on inside the cell is traced on at once, without queueing; one whose next segment lies in
+/// another brick is sent to `out`; one that leaves the model goes to `escape(r)`.
+template <typename Shade, typename Escape>
+void TraceInBrick(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                  const StreamScheduler& scheduler, RayOutbox& out, Shade&& shade,
+                  Escape&& escape) {
+    for (;;) {
+        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        ++out.counts.segments;
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, r.t_enter, t1, &hit)) {
+            const uint32_t next = scheduler.Route(r, r.t_exit, b);
+            if (next == store::kNoBrick) {
+                escape(r);
+            } else {
+                out.Send(next, b, r);
+            }
+            return;
+        }
+        if (!shade(r, hit)) return;
+        ++out.counts.rays;
+        const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);
+        if (next == store::kNoBrick) {
+            escape(r);
+            return;
+        }
+        if (next == b) continue;  // still in this brick: keep tracing without queueing
+        out.Send(next, b, r);
+        return;
+    }
+}
+
+}  // namespace nave::render
