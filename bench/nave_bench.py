@@ -1,4 +1,4 @@
-"""Helpers for nave's benchmark scripts (bench_pager_budget.py).
+"""Helpers shared by nave's benchmark scripts (bench_pager_budget.py, bench_pager_scale.py).
 
 Running nave under /usr/bin/time -v, telling a refused budget from a failure, reading the "nave:statistics"
 metadata of a rendered EXR, parsing budgets as nave does, writing CSV and Markdown tables, loading pyplot.

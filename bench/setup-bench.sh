@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   python3                  # bench/*.py
   python3-openimageio      # reads the "nave:statistics" metadata of the rendered EXR files
-  python3-matplotlib       # the PNG plots of bench_pager_budget.py and plot_benchmarks.py
+  python3-matplotlib       # the PNG plots of bench_pager_budget.py, bench_pager_scale.py, plot_benchmarks.py
   time                     # /usr/bin/time -v: the peak resident set size of a whole nave process
 )
 
