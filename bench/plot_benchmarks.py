@@ -7,7 +7,7 @@ Usage:
 
 One bar chart per benchmark family (the name before the first '/'), one bar per argument set, showing the
 chosen counter (default: items_per_second, i.e. triangles/s or rays/s as the benchmark reports it) or, when a
-benchmark lacks it, real time. Needs python3-matplotlib (Debian package).
+benchmark lacks it, real time. Needs python3-matplotlib (bash bench/setup-bench.sh installs it).
 """
 import argparse
 import collections
