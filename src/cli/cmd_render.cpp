@@ -8,6 +8,7 @@
 #endif
 
 #include "cli/commands.h"
+#include "core/trace.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "core/progress.h"
@@ -33,6 +34,7 @@ struct RenderOptions {
     std::string resolution;  // "WxH"
     std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
     std::string pager;       // --pager TUNABLES
+    std::string trace;       // --trace FILE.json
     bool no_textures = false;
 };
 
@@ -55,6 +57,12 @@ std::string ModeName(render::RenderSettings::Mode m) {
 }
 
 Status RunRender(const RenderOptions& o) {
+#if defined(__GLIBC__)
+    // One malloc arena for all threads: a brick freed by one thread (an eviction) is then reused by
+    // the next load on any other, where per-thread arenas each kept their own freed bricks (the
+    // abbey at --memory 2G peaked at 2.14 GiB with them, 1.88 GiB with one arena, and ran faster).
+    mallopt(M_ARENA_MAX, 1);
+#endif
     if (o.model.empty() == o.procedural.empty()) {
         return InvalidArgumentError("give either MODEL.nave or --procedural NAME (not both, not neither)");
     }
@@ -80,9 +88,10 @@ Status RunRender(const RenderOptions& o) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
         memory_limit = bytes;
     }
-    if (!o.pager.empty() && !memory_limit) return InvalidArgumentError("--pager {}: tunables need --memory SIZE", o.pager);
 
-    NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create());
+    // Huge pages for Embree's BVHs: a fresh 4 KiB page costs a fault, and on virtual machines faults
+    // took as long as the BVH builds themselves (in-core abbey: 42 s -> 35 s with huge pages).
+    NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create("hugepages=1"));
     std::unique_ptr<render::BrickSource> source;
     if (!o.model.empty()) {
         NAVE_ASSIGN_OR_RETURN(source, render::StoreBrickSource::Open(o.model, device));
@@ -117,22 +126,34 @@ Status RunRender(const RenderOptions& o) {
 
     // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process); the
     // bricks get what is left (docs/pager.md).
-    std::optional<render::PagerOptions> paging;
+    render::PagerOptions options;
+    NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
+    std::unique_ptr<TraceRecorder> trace;
+    if (!o.trace.empty()) {
+        trace = std::make_unique<TraceRecorder>();
+        options.trace = trace.get();
+    }
+    // The brick sizes below depend on how their BVHs are built.
+    NAVE_RETURN_IF_ERROR(source->SetBvhSettings(options.bvh));
     if (memory_limit) {
         const uint64_t memory = *memory_limit;
-        render::PagerOptions options;
-        NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
         // The texture cache's cap comes out of --memory too (docs/pager.md).
         const uint64_t texture_bytes = textures ? textures->max_memory_bytes() : 0;
         const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
-                                                            source->brick_count(), options.wave_overlap) +
+                                                            source->brick_count(), options.wave_overlap,
+                                                            CurrentRssBytes()) +
                                  texture_bytes;
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
-        if (memory < reserve + need.min_bytes) {
+        // The image is written after the bricks are freed, but OpenImageIO must fit then.
+        const uint64_t writer = CurrentRssBytes() + render::kImageWriterBytes +
+                                render::Film::MemoryBytes(config.camera.width, config.camera.height);
+        const uint64_t minimum = std::max(reserve + need.min_bytes, writer);
+        if (memory < minimum) {
             return ResourceExhaustedError(
                 "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
-                "resident{}, and the reserve for the film, ray queues and process is {} ({} bytes){}: at least {} "
-                "({} bytes) is needed (all {} bricks resident at once take {}, {} bytes)",
+                "resident{}, the reserve for the film, ray queues and process is {} ({} bytes){}, and writing the "
+                "image afterwards takes {} ({} bytes, OpenImageIO included): at least {} ({} bytes) is needed (all {} "
+                "bricks resident at once take {}, {} bytes)",
                 o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
                 options.prefetch && need.second_bytes > 0
                     ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
@@ -141,25 +162,26 @@ Status RunRender(const RenderOptions& o) {
                 FormatBytes(reserve), reserve,
                 texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
                                   : std::string(),
-                FormatBytes(reserve + need.min_bytes), reserve + need.min_bytes,
+                FormatBytes(writer), writer, FormatBytes(minimum), minimum,
                 source->brick_count(), FormatBytes(need.total_bytes), need.total_bytes);
         }
         options.brick_budget_bytes = memory - reserve;
+        if (options.in_core()) --options.brick_budget_bytes;
         log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
                   "reserved{}", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
                   FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
                   reserve, texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
                                              : std::string());
-        paging = options;
     }
 
     render::Film film(config.camera.width, config.camera.height, config.output);
     render::RenderStats stats;
-    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, paging ? &*paging : nullptr));
+    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, &options));
+    // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB), so
+    // that the two never add up (glibc keeps freed heap pages otherwise).
+    for (uint32_t b = 0; b < source->brick_count(); ++b) source->Evict(b);
 #if defined(__GLIBC__)
-    // The ray queues are gone: give their pages back before the image writer loads OpenImageIO, so that the
-    // process stays near --memory (glibc keeps freed heap pages otherwise).
-    if (paging) malloc_trim(0);
+    malloc_trim(0);
 #endif
 
     const uint64_t rays = stats.rays;
@@ -190,29 +212,33 @@ Status RunRender(const RenderOptions& o) {
                                                          textures->bytes_read())});
     }
     NAVE_RETURN_IF_ERROR(film.Write(out, metadata));
+    if (trace) NAVE_RETURN_IF_ERROR(trace->Write(o.trace).WithContext("--trace"));
 
     if (log::GetLevel() > log::Level::kInfo) return Status::Ok();  // -q: errors only, no summary
+    // The whole process's peak, image writing included: what --memory bounds.
+    const uint64_t process_peak = PeakRssBytes();
     std::filesystem::path png = out;
     png.replace_extension(".png");
     std::fprintf(stderr,
                  "nave render: wrote %s and %s\n"
                  "  time %s, %s rays/s (%s rays: %s segments traced, %s shadow segments), %s photons/s\n"
-                 "  rays moved between bricks %s, brick visits %s, loads %s, read %s, peak memory %s, "
-                 "peak queues %s\n",
+                 "  rays moved between bricks %s, brick visits %s, loads %s, read %s, peak memory %s (%llu "
+                 "bytes), peak queues %s\n",
                  out.string().c_str(), png.string().c_str(), FormatDuration(stats.wall_seconds).c_str(),
                  FormatCount(double(rays) / secs).c_str(), FormatCount(double(rays)).c_str(),
                  FormatCount(double(stats.segments_traced)).c_str(),
                  FormatCount(double(stats.shadow_segments)).c_str(),
                  FormatCount(double(stats.photons) / secs).c_str(), FormatCount(double(stats.brick_moves)).c_str(),
                  FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),
-                 FormatBytes(stats.bytes_read).c_str(), FormatBytes(stats.peak_rss_bytes).c_str(),
+                 FormatBytes(stats.bytes_read).c_str(), FormatBytes(process_peak).c_str(),
+                 static_cast<unsigned long long>(process_peak),
                  FormatBytes(stats.peak_queue_bytes).c_str());
     std::fprintf(stderr, "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
                  "resident when needed %s of %s, workers stalled on loads %s\n",
-                 paging ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")").c_str()
+                 memory_limit ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")").c_str()
                         : "in-core",
                  FormatBytes(stats.peak_brick_bytes).c_str(),
-                 paging ? fmt::format(" ({:.0f}% of budget)",
+                 memory_limit ? fmt::format(" ({:.0f}% of budget)",
                                       100.0 * double(stats.peak_brick_bytes) / double(stats.brick_budget_bytes))
                               .c_str()
                         : "",
@@ -254,8 +280,12 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                     "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
                     "Default: every brick stays resident once loaded");
     cmd->add_option("--pager", opts->pager,
-                    "Pager tunables with --memory: prefetch=on|off, nearly_empty=RAYS, prefer_resident=FRACTION "
-                    "(comma separated; docs/pager.md)");
+                    "Pager tunables, comma separated (docs/pager.md): prefetch=on|off, loaders=N, "
+                    "nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, overlap=FRACTION, "
+                    "bvh=low|medium|high, bvh_compact=on|off");
+    cmd->add_option("--trace", opts->trace,
+                    "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
+                    "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }

@@ -7,17 +7,21 @@
 #include <limits>
 #include <unordered_map>
 
+#include "core/trace.h"
+
 
 namespace nave::render {
 uint64_t BvhSettings::BytesPerTriangle() const {
     // Embree's own count of its allocations (its memory monitor) after building abbey bricks of
     // 0.1-1 M triangles, rounded up: bench_brick_load's bvh_bytes/triangle (docs/pager.md).
+    // Measured on brick 63 (700 k triangles): low 85.8, low compact 46.9, medium and high 65.9,
+    // medium and high compact 34.2.
     switch (quality) {
-        case Quality::kLow: return compact ? 56 : 72;
-        case Quality::kMedium: return compact ? 56 : 72;
-        case Quality::kHigh: return compact ? 64 : 80;
+        case Quality::kLow: return compact ? 50 : 90;
+        case Quality::kMedium:
+        case Quality::kHigh: return compact ? 38 : 70;
     }
-    return 80;
+    return 90;
 }
 
 // ---------------------------------------------------------------------------------------------- Embree
@@ -257,11 +261,19 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         return slot.error;
     }
     auto start = std::chrono::steady_clock::now();
+    TraceSpan load(trace_, "load", "pager");
+    load.AddArg({"brick", id});
     uint64_t bytes = 0;
+    TraceSpan decode(trace_, "read and decode", "pager");
     StatusOr<store::BrickMesh> mesh = LoadMesh(id, &bytes);
+    decode.End();
+    if (mesh.ok()) load.AddArg({"triangles", mesh->TriangleCount()});
+    load.AddArg({"bytes_read", bytes});
+    TraceSpan build(trace_, "bvh build", "pager");
     StatusOr<std::unique_ptr<ResidentBrick>> built =
         mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(), &alpha_masks_, bvh_)
                   : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
+    build.End();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
         slot.error = built.status().WithContext(fmt::format("loading brick {}", id));
@@ -287,10 +299,15 @@ void BrickSource::SetAlphaMasks(AlphaMasks masks) {
     alpha_masks_ = std::move(masks);
 }
 
-void BrickSource::SetBvhSettings(const BvhSettings& bvh) {
+Status BrickSource::SetBvhSettings(const BvhSettings& bvh) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
-    NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "BVH settings changed while bricks are resident";
+    if (bvh == bvh_) return Status::Ok();
+    if (stats_.resident_bytes != 0) {
+        return InvalidArgumentError("the BVH settings of a brick source cannot change while {} of bricks are resident",
+                                       stats_.resident_bytes);
+    }
     bvh_ = bvh;
+    return Status::Ok();
 }
 
 void BrickSource::Release(uint32_t id) {

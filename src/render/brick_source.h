@@ -19,6 +19,9 @@
 #include "store/brick_tree.h"
 #include "store/material_record.h"
 
+namespace nave {
+class TraceRecorder;
+}
 namespace nave::store {
 class Store;
 }
@@ -41,10 +44,14 @@ using AlphaMasks = std::vector<std::shared_ptr<const AlphaMask>>;
 /// trace speed for memory. Measured on abbey bricks by bench_brick_load (docs/pager.md, "Brick loads").
 struct BvhSettings {
     enum class Quality : uint8_t { kLow, kMedium, kHigh };
-    Quality quality = Quality::kMedium;
-    bool compact = false;
+    // Low quality, compact nodes: on the detail-110 abbey the whole in-core render took 42 s
+    // instead of 56 s with medium (a load is 2-3x cheaper, tracing slightly slower) and 7.6 GiB
+    // instead of 9.1 GiB (docs/pager.md, "Brick loads").
+    Quality quality = Quality::kLow;
+    bool compact = true;
     /// Bytes Embree's BVH takes per triangle with these settings (measured upper bound, for budgets).
     uint64_t BytesPerTriangle() const;
+    bool operator==(const BvhSettings&) const = default;
 };
 
 /// The nearest hit of a ray inside one brick.
@@ -166,10 +173,13 @@ class BrickSource {
     /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is loaded
     /// (checked): a resident brick keeps the masks it was built with.
     void SetAlphaMasks(AlphaMasks masks);
-    /// How bricks built from now on build their BVH (and what EstimatedResidentBytes assumes). Call
-    /// before any brick is loaded (checked).
-    void SetBvhSettings(const BvhSettings& bvh);
+    /// How bricks build their BVH (and what EstimatedResidentBytes assumes). FailedPrecondition if
+    /// bricks built otherwise are resident (they would not match the estimates).
+    Status SetBvhSettings(const BvhSettings& bvh);
     const BvhSettings& bvh_settings() const { return bvh_; }
+    /// Records every load (read and decode, BVH build) as spans on `trace` (null: no tracing). Set
+    /// before loads start; `trace` must outlive them.
+    void SetTrace(TraceRecorder* trace) { trace_ = trace; }
 
   protected:
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
@@ -195,6 +205,7 @@ class BrickSource {
     Bounds3f bounds_;
     AlphaMasks alpha_masks_;
     BvhSettings bvh_;
+    TraceRecorder* trace_ = nullptr;
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;

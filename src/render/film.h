@@ -1,7 +1,8 @@
 #pragma once
-// The film: per-pixel sums of spectral samples converted to CIE XYZ, taking concurrent adds from every
-// worker. Sums are doubles updated atomically, so the order in which bricks and threads add their samples
-// changes a pixel only by double rounding (relative ~1e-15 per add), far below the float of the output.
+// The film: per-pixel sums of spectral samples converted to CIE XYZ, taking concurrent adds from
+// every worker. Sums are doubles updated atomically, so the order in which bricks and threads add
+// their samples changes a pixel only by double rounding (relative ~1e-15 per add), far below the
+// float of the output.
 
 #include <atomic>
 #include <cstdint>
@@ -23,11 +24,18 @@ class Film {
   public:
     Film(int width, int height, const OutputConfig& output);
 
+    /// Bytes a film of width x height holds: 3 doubles of XYZ, 7 floats of AOVs and a counter per
+    /// pixel, plus what Write converts them into (linear RGB and AOVs in float, 8-bit PNG).
+    static uint64_t MemoryBytes(int width, int height) {
+        return uint64_t(width) * uint64_t(height) * ((3 * 8 + 7 * 4 + 4) + (3 + 10) * 4 + 3);
+    }
+
     int width() const { return width_; }
     int height() const { return height_; }
     size_t pixel_count() const { return size_t(width_) * height_; }
 
-    /// Adds radiance `L` carried at `lambda` to pixel `pixel` (y * width + x). Thread-safe, lock-free.
+    /// Adds radiance `L` carried at `lambda` to pixel `pixel` (y * width + x). Thread-safe,
+    /// lock-free.
     void AddSample(uint32_t pixel, const SampledSpectrum& L, const SampledWavelengths& lambda) {
         Vec3d xyz = SampledToXYZ(L, lambda);
         AddXYZ(pixel, xyz);
@@ -44,8 +52,8 @@ class Film {
     /// The estimate of `pixel` in XYZ: sum / spp.
     Vec3d PixelXYZ(uint32_t pixel) const { return SumXYZ(pixel) * (1.0 / spp_); }
 
-    /// Writes linear RGB (plus AOV channels) as EXR with `metadata`, and a tone-mapped sRGB PNG beside it
-    /// (same name, .png). Both through temp name + rename.
+    /// Writes linear RGB (plus AOV channels) as EXR with `metadata`, and a tone-mapped sRGB PNG
+    /// beside it (same name, .png). Both through temp name + rename.
     Status Write(const std::filesystem::path& exr_path,
                  const std::vector<std::pair<std::string, std::string>>& metadata) const;
     /// Linear RGB of the output space (sRGB primaries) after white balance, per pixel.

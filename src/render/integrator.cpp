@@ -52,7 +52,8 @@ Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, B
     Status status;
     arena.execute([&] {
         StreamScheduler scheduler(*scene.source, std::move(picker), scene.settings.wave_paths);
-        status = paging != nullptr ? scheduler.EnablePaging(*paging) : Status::Ok();
+        // In-core too, the pager loads bricks in the background while the workers trace.
+        status = scheduler.EnablePaging(paging != nullptr ? *paging : PagerOptions());
         if (status.ok()) status = Render(scene, film, stats, scheduler);
     });
     return status;

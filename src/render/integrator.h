@@ -62,9 +62,11 @@ using BrickPicker = std::function<uint32_t(const std::vector<size_t>& waiting, c
 uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource& source);
 
 /// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's resolution.
-/// Thread count: scene.settings.threads (0: all cores). `picker` empty: PickFullestBrick, or with paging the
-/// pager's choice. `paging` null: in-core (bricks stay once loaded); else bricks are paged under
-/// paging->brick_budget_bytes (pager.h), and an impossible budget is refused before anything is traced.
+/// Thread count: scene.settings.threads (0: all cores). `picker` empty: the pager's choice (the fullest
+/// resident brick first). `paging` null: in-core with the default tunables (bricks stay once loaded, and
+/// are loaded in the background while the workers trace); else bricks are paged under
+/// paging->brick_budget_bytes (pager.h; kUnlimitedBrickBudget is in-core), and an impossible budget is
+/// refused before anything is traced.
 Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker = {},
                      const PagerOptions* paging = nullptr);
 

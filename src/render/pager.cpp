@@ -8,6 +8,8 @@
 
 #include "core/log.h"
 #include "core/memory.h"
+#include "core/trace.h"
+#include "render/film.h"
 #include "render/ray.h"
 #include "render/scene_config.h"
 
@@ -19,7 +21,7 @@ namespace nave::render {
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
         "prefetch=on|off, loaders=N, nearly_empty=RAYS, prefer_resident=FRACTION, "
-        "evict=lru|traffic, overlap=FRACTION";
+        "evict=lru|traffic, overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -39,6 +41,26 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                 options->prefetch = false;
             } else {
                 return InvalidArgumentError("pager tunable prefetch={}: expected on or off", value);
+            }
+        } else if (key == "bvh") {
+            if (value == "low") {
+                options->bvh.quality = BvhSettings::Quality::kLow;
+            } else if (value == "medium") {
+                options->bvh.quality = BvhSettings::Quality::kMedium;
+            } else if (value == "high") {
+                options->bvh.quality = BvhSettings::Quality::kHigh;
+            } else {
+                return InvalidArgumentError("pager tunable bvh={}: expected low, medium or high",
+                                            value);
+            }
+        } else if (key == "bvh_compact") {
+            if (value == "on") {
+                options->bvh.compact = true;
+            } else if (value == "off") {
+                options->bvh.compact = false;
+            } else {
+                return InvalidArgumentError("pager tunable bvh_compact={}: expected on or off",
+                                            value);
             }
         } else if (key == "evict") {
             if (value == "lru") {
@@ -116,14 +138,11 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
 }
 
 uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
-                            uint32_t brick_count, double wave_overlap) {
+                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
-    // The process without bricks: code, Embree's device, TBB's threads, the store's tables,
-    // allocator slack, and the image writer's OpenImageIO plugin loaded after the render (~40 MiB
-    // resident, measured).
-    const uint64_t kProcess = (56ull << 20) + uint64_t(brick_count) * 256;
-    // Film: 3 doubles of XYZ, 7 floats of AOVs and a counter per pixel (film.h).
-    const uint64_t film = pixels * (3 * 8 + 7 * 4 + 4);
+    // The process without bricks (pager.h), and per brick its queue, slot and statistics.
+    const uint64_t kProcess = process_bytes + kRenderGrowthBytes + uint64_t(brick_count) * 256;
+    const uint64_t film = Film::MemoryBytes(width, height);
     // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken
     // from a queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on
     // the abbey.
@@ -315,6 +334,11 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
     for (const Candidate& c : candidates) {
         if (committed_bytes_ + need <= budget) break;
         if (!source_.Evict(c.id)) continue;  // pinned: the batch being traced
+        if (options_.trace != nullptr) {
+            options_.trace->Instant(
+                "evict", "pager",
+                {{"brick", c.id}, {"waiting", c.waiting}, {"bytes", bytes_[c.id]}});
+        }
         state_[c.id] = State::kAbsent;
         committed_bytes_ -= bytes_[c.id];
         bytes_[c.id] = 0;
@@ -326,9 +350,6 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
 StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     if (id >= state_.size()) return source_.Acquire(id);  // the source's error names the brick
     const auto start = std::chrono::steady_clock::now();
-    auto stalled = [&] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
     std::unique_lock<std::mutex> lock(mutex_);
     last_used_[id] = ++tick_;
     ++stats_.acquires;
@@ -338,7 +359,7 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
         if (state_[id] == State::kResident) {
             // Pinned under the lock: evictions take it too, so the brick cannot go between check
             // and pin.
-            if (waited) stats_.stall_seconds += stalled();
+            if (waited) Stalled(id, start);
             return source_.Acquire(id);
         }
         if (state_[id] == State::kLoading) {
@@ -362,8 +383,14 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
                            state_[l.target] == State::kLoading;
                 });
             if (loader_loading) {
+                // Its brick becomes evictable once loaded. Meanwhile no loader may start another
+                // load: the room it frees is the scheduler's (otherwise loaders that take turns
+                // could starve it at small budgets).
                 waited = true;
-                loaded_cv_.wait(lock);  // its brick becomes evictable once loaded
+                scheduler_needs_room_ = true;
+                loaded_cv_.wait(lock);
+                scheduler_needs_room_ = false;
+                loader_cv_.notify_all();
                 continue;
             }
             return ResourceExhaustedError(
@@ -381,12 +408,12 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
             bytes_[id] = 0;
             state_[id] = State::kAbsent;
             loaded_cv_.notify_all();
-            stats_.stall_seconds += stalled();
+            Stalled(id, start);
             return handle.status();
         }
         Loaded(id, (*handle)->memory_bytes(), false);
         loaded_cv_.notify_all();
-        stats_.stall_seconds += stalled();
+        Stalled(id, start);
         return handle;
     }
 }
@@ -411,6 +438,13 @@ void Pager::BatchDone() {
     loader_cv_.notify_all();
 }
 
+void Pager::Stalled(uint32_t id, std::chrono::steady_clock::time_point start) {
+    const auto end = std::chrono::steady_clock::now();
+    stats_.stall_seconds += std::chrono::duration<double>(end - start).count();
+    if (options_.trace != nullptr)
+        options_.trace->Complete("stall", "pager", start, end, {{"brick", id}});
+}
+
 PagerStats Pager::stats() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return stats_;
@@ -423,6 +457,7 @@ void Pager::LoaderLoop(size_t index) {
     // buffers).
     tbb::task_arena arena(1);
     Loader& self = loaders_[index];
+    if (options_.trace != nullptr) options_.trace->NameThread(fmt::format("loader {}", index + 1));
     uint64_t seen_epoch = 0;
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
@@ -437,7 +472,7 @@ void Pager::LoaderLoop(size_t index) {
         bool reserved = false;
         for (;;) {
             if (stop_ || self.cancel) break;  // given up, or taken over by the scheduler
-            if (MakeRoom(need, target, true)) {
+            if (!scheduler_needs_room_ && MakeRoom(need, target, true)) {
                 Reserve(target, need);
                 reserved = true;
                 break;
@@ -446,8 +481,10 @@ void Pager::LoaderLoop(size_t index) {
             // then), or for a newer view of the queues (which may prefer another brick).
             const uint64_t batch = batch_epoch_;
             const uint64_t request = request_epoch_;
+            const bool yielding = scheduler_needs_room_;
             loader_cv_.wait(lock, [&] {
-                return stop_ || self.cancel || batch_epoch_ != batch || request_epoch_ != request;
+                return stop_ || self.cancel || batch_epoch_ != batch || request_epoch_ != request ||
+                       scheduler_needs_room_ != yielding;
             });
             if (request_epoch_ != request) {
                 seen_epoch = request_epoch_ - 1;  // look again at once, with the newer view

@@ -8,6 +8,7 @@
 // goes through the pager, so its accounting (real ResidentBrick::memory_bytes of resident bricks
 // plus the estimate of the brick being loaded) never exceeds the budget.
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -25,12 +26,22 @@ namespace nave::render {
 
 struct RenderSettings;
 
+/// A brick budget that never evicts: the in-core render (no --memory), which still loads bricks in
+/// the background while the workers trace.
+inline constexpr uint64_t kUnlimitedBrickBudget = ~uint64_t(0);
+
 /// Tunables of the pager; docs/pager.md has the measurements behind the defaults.
 struct PagerOptions {
     /// Bytes the resident bricks may take (sum of ResidentBrick::memory_bytes, plus the estimate of
     /// a brick being loaded). The caller computes it from the user's --memory, minus what it
-    /// reserves for the rest.
-    uint64_t brick_budget_bytes = 0;
+    /// reserves for the rest. kUnlimitedBrickBudget: in-core.
+    uint64_t brick_budget_bytes = kUnlimitedBrickBudget;
+    bool in_core() const { return brick_budget_bytes == kUnlimitedBrickBudget; }
+    /// How loaded bricks build their BVH (applied to the brick source before anything loads).
+    BvhSettings bvh;
+    /// Where loads, evictions, stalls, batches and queue and residency counters are recorded
+    /// (`nave render --trace`); null: nowhere. Must outlive the render.
+    TraceRecorder* trace = nullptr;
     /// Load the next bricks in background threads while the workers trace the current one.
     bool prefetch = true;
     /// Background loader threads (with prefetch): how many bricks may load at once beside the
@@ -73,8 +84,20 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch);
 /// Memory `nave render --memory` sets aside for everything but bricks: the film, the ray queues of
 /// a wave and the process itself (code, Embree and TBB state, the store's tables); see
 /// docs/pager.md. `wave_overlap`: PagerOptions::wave_overlap (more rays in flight).
+/// `process_bytes`: what the process holds already when the render is planned (its resident size
+/// then: code, libraries, the store's tables, the scene), to which the render adds its threads and
+/// allocator slack (kRenderGrowthBytes).
 uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
-                            uint32_t brick_count, double wave_overlap);
+                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes);
+
+/// What a render grows the process by beyond its size when planned, bricks, film and queues aside:
+/// Embree's and TBB's threads and state, allocator slack (an 8x8 render of a one-brick model: 3
+/// MiB).
+inline constexpr uint64_t kRenderGrowthBytes = uint64_t(32) << 20;
+/// What writing the image adds once the render is over and its bricks and queues are freed:
+/// OpenImageIO and the libraries it loads (measured 122 MiB on Debian 12). --memory must hold the
+/// process, the film and this.
+inline constexpr uint64_t kImageWriterBytes = uint64_t(128) << 20;
 
 /// What the pager did during one render.
 struct PagerStats {
@@ -138,6 +161,8 @@ class Pager {
     /// Records a finished load of `id` (real size `bytes`). Holds mutex_.
     void Loaded(uint32_t id, uint64_t bytes, bool prefetched);
     void Reserve(uint32_t id, uint64_t bytes);
+    /// Counts the scheduler's wait for brick `id` since `start` as stall. Holds mutex_.
+    void Stalled(uint32_t id, std::chrono::steady_clock::time_point start);
     /// The fullest brick of the last Prefetch snapshot that nobody loads or claims, or kNoBrick.
     /// Holds mutex_.
     uint32_t NextPrefetchTarget() const;
@@ -172,6 +197,7 @@ class Pager {
     };
     std::vector<Loader> loaders_;
     uint64_t batch_epoch_ = 0;
+    bool scheduler_needs_room_ = false;  // the scheduler waits for room: loaders start no load
     bool stop_ = false;
     PagerStats stats_;
     bool warned_estimate_ = false;

@@ -7,6 +7,7 @@
 #include <chrono>
 
 #include "core/check.h"
+#include "core/trace.h"
 #include "render/brick_walk.h"
 
 namespace nave::render {
@@ -27,6 +28,10 @@ StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64
       queues_(source.brick_count()) {}
 
 Status StreamScheduler::EnablePaging(const PagerOptions& options) {
+    NAVE_RETURN_IF_ERROR(source_.SetBvhSettings(options.bvh));
+    source_.SetTrace(options.trace);
+    trace_ = options.trace;
+    if (trace_ != nullptr) trace_->NameThread("scheduler");
     NAVE_ASSIGN_OR_RETURN(
         pager_, Pager::Create(source_, options, [this](uint32_t b) { return queues_.Waiting(b); }));
     return Status::Ok();
@@ -77,6 +82,11 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         for (uint32_t i = 0; i < queues_.brick_count(); ++i)
             total += waiting[i] = queues_.Waiting(i);
         if (total <= stop_below) break;
+        if (trace_ != nullptr) {
+            trace_->Counter("rays waiting", {{"rays", total}});
+            trace_->Counter("memory", {{"resident_bricks", source_.stats().resident_bytes},
+                                       {"queues", queues_.MemoryBytes()}});
+        }
         const uint32_t b =
             pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, source_);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
@@ -94,6 +104,9 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
                              batch.size());  // loads the next brick while this batch is traced
         }
         const ResidentBrick& brick = *handle;
+        TraceSpan span(trace_, "batch", "scheduler");
+        span.AddArg({"brick", b});
+        span.AddArg({"rays", batch.size()});
         tbb::parallel_for(
             tbb::blocked_range<size_t>(0, batch.size(), kChunk),
             [&](const tbb::blocked_range<size_t>& range) {
@@ -112,7 +125,8 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
 }
 
 size_t StreamScheduler::WaveOverlap() const {
-    return pager_ ? size_t(pager_->options().wave_overlap * double(wave_paths_)) : 0;
+    if (!pager_ || pager_->options().in_core()) return 0;
+    return size_t(pager_->options().wave_overlap * double(wave_paths_));
 }
 
 void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* stats) const {
@@ -128,7 +142,7 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
     stats->brick_acquires = after.acquires - before.acquires;
     if (pager_) {
         const PagerStats p = pager_->stats();
-        stats->brick_budget_bytes = p.brick_budget_bytes;
+        stats->brick_budget_bytes = pager_->options().in_core() ? 0 : p.brick_budget_bytes;
         stats->peak_brick_bytes = p.peak_resident_bytes;
         stats->brick_evictions = p.evictions;
         stats->brick_reloads = p.reloads;

@@ -116,6 +116,7 @@ class StreamScheduler {
     // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
     std::unique_ptr<Pager> pager_;  // null: in-core
     double stall_seconds_ = 0;      // in-core
+    TraceRecorder* trace_ = nullptr;
     uint64_t peak_queue_bytes_ = 0;
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
 };

@@ -439,17 +439,71 @@ TEST(PagerCliTest, MemoryBudgetRendersAndReportsPaging) {
                      ("nave_memory_ok_" + std::to_string(getpid()) + ".exr");
     const test::CommandResult r = test::RunNave(
         "render --procedural clutter:bricks=4 --config " + config +
-        " --resolution 16x12 --spp 1 --memory 64M --pager prefetch=off -o " + out.string());
+        " --resolution 16x12 --spp 1 --memory 256M --pager prefetch=off -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_NE(r.output.find("(--memory 64M)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("(--memory 256M)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("evictions"), std::string::npos) << r.output;
     const test::CommandResult bad =
         test::RunNave("render --procedural clutter:bricks=4 --config " + config +
-                      " --memory 64M --pager speed=11 -o " + out.string());
+                      " --memory 256M --pager speed=11 -o " + out.string());
     EXPECT_NE(bad.exit_code, 0);
     EXPECT_NE(bad.output.find("speed"), std::string::npos) << bad.output;
     std::filesystem::remove(out);
     std::filesystem::remove(std::filesystem::path(out).replace_extension(".png"));
+}
+
+// The whole process, not only its bricks, stays within --memory + 64 MiB (VmHWM as nave reports it
+// at exit, image writing included) at the smallest budget nave accepts, halfway to in-core, and
+// with room for every brick: a store of 6 x 6 dense balls in 72 bricks.
+TEST(PagerCliTest, WholeProcessPeakStaysWithinTheBudget) {
+    const auto dir =
+        std::filesystem::temp_directory_path() / fmt::format("nave_pager_memory_{}", getpid());
+    std::filesystem::create_directories(dir);
+    store::BrickMesh mesh;
+    AppendQuad(&mesh, {0, 0, 0}, {6, 0, 0}, {0, 6, 0}, 12, 0);
+    for (int i = 0; i < 6; ++i) {
+        for (int j = 0; j < 6; ++j) {
+            AppendSphere(&mesh, {-5 + 2.f * float(i), -5 + 2.f * float(j), 0.7f}, 0.6f, 48, 96, 1);
+        }
+    }
+    const auto store_path = dir / "dense.nave";
+    ASSERT_TRUE(WriteStore(store_path, mesh, 6, 6, 2).ok());
+    const auto config = dir / "dense.toml";
+    {
+        std::ofstream f(config);
+        f << fmt::format(fmt::runtime(kBallGrid), "path");
+    }
+    const std::string render = "render " + store_path.string() + " --config " + config.string() +
+                               " --resolution 64x48 --spp 2 -o " + (dir / "out.exr").string();
+    auto bytes_after = [](const std::string& text, const std::string& marker) -> uint64_t {
+        const size_t at = text.find(marker);
+        if (at == std::string::npos) return 0;
+        const size_t open = text.find('(', at + marker.size());
+        return open == std::string::npos ? 0 : std::stoull(text.substr(open + 1));
+    };
+    const test::CommandResult refused = test::RunNave(render + " --memory 1M");
+    ASSERT_NE(refused.exit_code, 0);
+    // "... at least 205.3 MiB (215233376 bytes) is needed (all 132 bricks resident at once take
+    // 190.8 MiB, 200044776 bytes)"
+    const uint64_t minimum = bytes_after(refused.output, "at least");
+    const size_t take = refused.output.find("at once take");
+    const size_t comma = refused.output.find(", ", take);
+    const uint64_t all_bricks = take == std::string::npos || comma == std::string::npos
+                                    ? 0
+                                    : std::stoull(refused.output.substr(comma + 2));
+    ASSERT_GT(minimum, 0u) << refused.output;
+    ASSERT_GT(all_bricks, 0u) << refused.output;
+    for (const uint64_t budget : {minimum, minimum + all_bricks / 2, minimum + all_bricks}) {
+        const test::CommandResult r = test::RunNave(render + " --memory " + std::to_string(budget));
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        const uint64_t peak = bytes_after(r.output, "peak memory");
+        ASSERT_GT(peak, 0u) << r.output;
+        EXPECT_LE(peak, budget + (uint64_t(64) << 20))
+            << "--memory " << budget << " (" << FormatBytes(budget) << "): the process peaked at "
+            << FormatBytes(peak) << "\n"
+            << r.output;
+    }
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
