@@ -40,11 +40,11 @@ double Since(Clock::time_point t) {
 // buffers, the sample, the split buffers per thread, and a margin for the allocator and libraries.
 constexpr uint64_t kFixedBytes = 48ull << 20;
 
-std::string OptionsText(const PreprocessOptions& o, uint64_t budget, double step, int threads,
-                        const std::string& units) {
+std::string OptionsText(const PreprocessOptions& o, uint64_t brick_triangles, uint64_t budget,
+                        double step, int threads, const std::string& units) {
     return fmt::format(
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} units={}",
-        o.brick_triangles, budget, step, threads, o.encode.draco_speed, units);
+        brick_triangles, budget, step, threads, o.encode.draco_speed, units);
 }
 
 /// Removes the texture folder of a run that fails, unless it existed before the run (it may hold textures an
@@ -83,22 +83,31 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
 #endif
     PreprocessStats stats;
     if (options.output.empty()) return InvalidArgumentError("no output file given (-o MODEL.nave)");
-    if (options.brick_triangles < 1000) {
-        return InvalidArgumentError("--brick-triangles {}: expected at least 1000",
-                                    options.brick_triangles);
+    if (options.brick_triangles != 0 && options.brick_triangles < kMinBrickTriangles) {
+        return InvalidArgumentError("--brick-triangles {}: expected at least {}",
+                                    options.brick_triangles, kMinBrickTriangles);
     }
     stats.threads = options.threads > 0 ? options.threads
                                         : int(std::max(1u, std::thread::hardware_concurrency()));
     stats.memory_budget =
         options.memory_bytes > 0 ? options.memory_bytes : PhysicalMemoryBytes() / 4;
 
-    // The budget must hold one brick's work (the largest a leaf may be: 5/4 of the target).
-    const uint64_t leaf_max = options.brick_triangles + options.brick_triangles / 4;
+    // The budget must hold one brick's work (the largest a leaf may be: 5/4 of the target). Without
+    // --brick-triangles, bricks get the default size, or the largest whose work fits the budget.
+    const uint64_t fit = stats.memory_budget > kFixedBytes
+                             ? (stats.memory_budget - kFixedBytes) / kEncodeBytesPerTriangle * 4 / 5
+                             : 0;
+    uint64_t brick_triangles = options.brick_triangles;
+    if (brick_triangles == 0) {
+        brick_triangles = std::clamp<uint64_t>(fit, kMinBrickTriangles, kDefaultBrickTriangles);
+        if (brick_triangles < kDefaultBrickTriangles) {
+            log::Info("preprocess: bricks of {} triangles (the largest whose work fits --memory {})",
+                      brick_triangles, FormatBytes(stats.memory_budget));
+        }
+    }
+    const uint64_t leaf_max = brick_triangles + brick_triangles / 4;
     const uint64_t per_brick = leaf_max * kEncodeBytesPerTriangle;
     if (stats.memory_budget < kFixedBytes + per_brick) {
-        uint64_t fit = stats.memory_budget > kFixedBytes
-                           ? (stats.memory_budget - kFixedBytes) / kEncodeBytesPerTriangle * 4 / 5
-                           : 0;
         return ResourceExhaustedError(
             "--memory {} cannot hold the work for one brick: {} triangles x {} bytes = {} plus {} "
             "fixed; raise "
@@ -126,7 +135,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
 
     // Phase 1: read and bin.
     PartitionConfig config;
-    config.brick_triangles = options.brick_triangles;
+    config.brick_triangles = brick_triangles;
     config.threads = stats.threads;
     // Split buffers: each thread holds up to 64 writers' blocks (two copies each).
     config.block_bytes = std::clamp<uint64_t>(
@@ -239,7 +248,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     if (!options.generate.empty()) provenance.source_files.push_back(options.generate);
     provenance.tool_version = options.tool_version;
     provenance.options =
-        OptionsText(options, stats.memory_budget, stats.grid_step, stats.threads, stats.units);
+        OptionsText(options, brick_triangles, stats.memory_budget, stats.grid_step, stats.threads, stats.units);
     NAVE_ASSIGN_OR_RETURN(auto writer,
                           store::StoreWriter::Create(options.output, grid, provenance));
 

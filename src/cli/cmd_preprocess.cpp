@@ -15,7 +15,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     struct Options {
         std::vector<std::string> inputs;
         std::string generate, output, memory, temp_dir;
-        uint64_t brick_triangles = 1'000'000;
+        uint64_t brick_triangles = 0;
         double precision = 0;
         int threads = 0;
         int draco_speed = store::EncodeOptions{}.draco_speed;
@@ -29,7 +29,8 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--memory", opt->memory,
                     "Memory budget, e.g. 4G (default: a quarter of physical memory)");
     cmd->add_option("--brick-triangles", opt->brick_triangles,
-                    "Target triangles per brick (default 1000000)");
+                    "Target triangles per brick (default 200000, or fewer when --memory cannot "
+                    "hold the encoding work of a brick that size)");
     cmd->add_option(
         "--precision", opt->precision,
         "Grid step in model units (default: bounds diagonal / 2^20; max error step * sqrt(3) / 2)");

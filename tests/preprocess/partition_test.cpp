@@ -167,6 +167,25 @@ class PartitionedSphere : public ::testing::Test {
     static inline std::filesystem::path dir_;
 };
 
+// Without --brick-triangles, a budget too small for million-triangle bricks gets smaller bricks instead of a
+// refusal: here about 5 000 triangles (48 MiB fixed + 5 000 x 5/4 x 600 bytes of encoding work).
+TEST_F(PartitionedSphere, SmallBudgetWithoutBrickSizeChoosesSmallerBricks) {
+    const auto out = dir_ / "auto.nave";
+    PreprocessOptions o;
+    o.inputs = {dir_ / "sphere.obj"};
+    o.output = out;
+    o.memory_bytes = (48ull << 20) + 5000 * 5 / 4 * 600;
+    auto stats = RunPreprocess(o);
+    ASSERT_TRUE(stats.ok()) << stats.status().ToString();
+    auto st = store::Store::Open(out);
+    ASSERT_TRUE(st.ok()) << st.status().ToString();
+    EXPECT_GE((*st)->bricks().size(), 3u) << "20 480 triangles in bricks of about 5 000";
+    for (const store::BrickInfo& b : (*st)->bricks()) {
+        EXPECT_LE(b.triangle_count, 5000u * 5 / 4 + 500) << "brick " << b.id;
+    }
+    std::filesystem::remove(out);
+}
+
 std::set<QTri, QTriLess> StoreTriangles(const store::Store& s, uint64_t* references) {
     std::set<QTri, QTriLess> all;
     *references = 0;
@@ -336,6 +355,7 @@ TEST(PreprocessErrors, BudgetTooSmallSaysWhichOptionToChange) {
     o.inputs = {testing::Fixture("ascii.stl")};
     o.output = std::filesystem::temp_directory_path() / "never.nave";
     o.memory_bytes = 100ull << 20;
+    o.brick_triangles = kDefaultBrickTriangles;  // asked for: not lowered behind the user's back
     auto stats = RunPreprocess(o);
     ASSERT_FALSE(stats.ok());
     EXPECT_EQ(stats.status().code(), StatusCode::kResourceExhausted);
