@@ -11,8 +11,8 @@
 #   NAVE_DETAIL=1         abbey detail (1: ~1.5 M triangles; 9: ~8 M; 110: ~96 M; see docs/abbey.md)
 #   NAVE_MEMORY=2G        preprocess memory budget
 #   NAVE_BRICK_TRIANGLES=100000   target triangles per brick (detail 1 gives 16 bricks)
-#   NAVE_RENDER_MEMORY=640M       render memory budget (at 960x640: ~35 MiB of it for bricks, a sixth of the
-#                                 200 MiB all bricks take; the rest is the film, ray queues, textures, process)
+#   NAVE_RENDER_MEMORY=620M       render memory budget (at 960x640: 35 MiB of it for bricks, a quarter of the
+#                                 132 MiB all bricks take; the rest is the film, ray queues, textures, process)
 #   NAVE_RESOLUTION=960x640, NAVE_SPP=16, NAVE_MODE=path (or photon)   render settings (configs/abbey.toml has the rest)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,7 @@ out=${NAVE_OUT:-out}
 detail=${NAVE_DETAIL:-1}
 memory=${NAVE_MEMORY:-2G}
 brick_triangles=${NAVE_BRICK_TRIANGLES:-100000}
-render_memory=${NAVE_RENDER_MEMORY:-640M}
+render_memory=${NAVE_RENDER_MEMORY:-620M}
 resolution=${NAVE_RESOLUTION:-960x640}
 spp=${NAVE_SPP:-16}
 mode=${NAVE_MODE:-path}

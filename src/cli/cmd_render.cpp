@@ -144,8 +144,9 @@ Status RunRender(const RenderOptions& o) {
                                                             CurrentRssBytes()) +
                                  texture_bytes;
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
-        // The image is written after the bricks are freed, but OpenImageIO must fit then.
-        const uint64_t writer = CurrentRssBytes() + render::kImageWriterBytes +
+        // The image is written after the bricks are freed, but OpenImageIO must fit then (unless the
+        // texture cache loaded it already: the process's size counts it then).
+        const uint64_t writer = CurrentRssBytes() + (textures ? 0 : render::kImageWriterBytes) +
                                 render::Film::MemoryBytes(config.camera.width, config.camera.height);
         const uint64_t minimum = std::max(reserve + need.min_bytes, writer);
         if (memory < minimum) {

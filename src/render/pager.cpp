@@ -144,8 +144,7 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
     const uint64_t kProcess = process_bytes + kRenderGrowthBytes + uint64_t(brick_count) * 256;
     const uint64_t film = Film::MemoryBytes(width, height);
     // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken
-    // from a queue (at most one record per ray in flight), measured at 2.0-2.4 records per path on
-    // the abbey.
+    // from a queue (at most one record per ray in flight).
     const uint64_t per_pass =
         settings.mode == RenderSettings::Mode::kPath ? uint64_t(std::max(1, settings.spp)) : 1;
     uint64_t in_flight = std::min<uint64_t>(settings.wave_paths, pixels * per_pass);
@@ -156,7 +155,10 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
     // Under paging the next wave is generated while wave_overlap of a wave is still waiting.
     in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) *
                           std::clamp(wave_overlap, 0.0, 1.0));
-    const uint64_t queues = 3 * in_flight * sizeof(RayRecord);
+    // Two records per path in flight: measured peaks are 0.85 (the demo in-core, 84 MiB for waves of
+    // 1 M paths) to 1.1 (the detail-110 abbey paged at 2G, 124 MiB for 1.09 M paths) records per
+    // path, with the queues' partly filled blocks.
+    const uint64_t queues = 2 * in_flight * sizeof(RayRecord);
     // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and
     // references to the points in the brick grids.
     const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton ? pixels * 256 : 0;
