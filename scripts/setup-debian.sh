@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages nave needs to build, test and run, only those missing: `apt-get update` runs
-# once and only when something must be installed, so a machine that has everything is left untouched.
+# Installs the Debian 12 packages nave needs to build, test and run (or the packages given as arguments), only
+# those missing: `apt-get update` runs once and only when something must be installed, so a machine that has
+# everything is left untouched.
 set -euo pipefail
 
 packages=(
@@ -21,6 +22,9 @@ packages=(
   libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS...)
 )
 
+# Other scripts pass their own list (bench/setup-bench.sh): install those instead.
+if (($# > 0)); then packages=("$@"); fi
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -32,6 +36,8 @@ echo "nave setup: installing ${#missing[@]} missing Debian packages: ${missing[*
 as_root=()
 if [[ $(id -u) -ne 0 ]]; then as_root=(sudo); fi
 export DEBIAN_FRONTEND=noninteractive
-"${as_root[@]}" apt-get update -qq
-"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# Waits for another install on the same machine rather than failing on its dpkg lock.
+lock_wait=(-o DPkg::Lock::Timeout=600)
+"${as_root[@]}" apt-get "${lock_wait[@]}" update -qq
+"${as_root[@]}" apt-get "${lock_wait[@]}" install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 echo "nave setup: done" >&2
