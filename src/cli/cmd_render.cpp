@@ -35,6 +35,7 @@ struct RenderOptions {
     std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
     std::string pager;       // --pager TUNABLES
     std::string trace;       // --trace FILE.json
+    std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     bool no_textures = false;
 };
 
@@ -54,6 +55,14 @@ Status ParseResolution(const std::string& text, int* width, int* height) {
 
 std::string ModeName(render::RenderSettings::Mode m) {
     return m == render::RenderSettings::Mode::kPath ? "path" : "photon";
+}
+
+/// The most any one brick's load needs beside the brick while it decodes (one decode at a time
+/// under --memory).
+uint64_t MaxLoadScratchBytes(const render::BrickSource& source) {
+    uint64_t most = 0;
+    for (uint32_t b = 0; b < source.brick_count(); ++b) most = std::max(most, source.LoadScratchBytes(b));
+    return most;
 }
 
 Status RunRender(const RenderOptions& o) {
@@ -79,7 +88,10 @@ Status RunRender(const RenderOptions& o) {
     if (o.threads) config.render.threads = *o.threads;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
-    if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
+    if (o.wave_paths) {
+        config.render.wave_paths = uint32_t(*o.wave_paths);
+        config.render.wave_paths_given = true;
+    }
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
@@ -133,16 +145,25 @@ Status RunRender(const RenderOptions& o) {
         trace = std::make_unique<TraceRecorder>();
         options.trace = trace.get();
     }
+    options.spill_dir = !o.temp_dir.empty() ? std::filesystem::path(o.temp_dir) : out.parent_path();
     // The brick sizes below depend on how their BVHs are built.
     NAVE_RETURN_IF_ERROR(source->SetBvhSettings(options.bvh));
     if (memory_limit) {
         const uint64_t memory = *memory_limit;
         // The texture cache's cap comes out of --memory too (docs/pager.md).
         const uint64_t texture_bytes = textures ? textures->max_memory_bytes() : 0;
+        // Queues beyond a small share of the budget spill to disk, so a wave can be the whole image.
+        if (options.queue_memory_bytes == render::PagerOptions::kAutoQueueMemory) {
+            options.queue_memory_bytes = render::QueueMemoryBytes(memory);
+        }
+        if (!config.render.wave_paths_given && options.queue_memory_bytes > 0) {
+            config.render.wave_paths = render::AutoWavePaths(config.render, config.camera.width, config.camera.height);
+            scene.settings.wave_paths = config.render.wave_paths;
+        }
         const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
                                                             source->brick_count(), options.wave_overlap,
-                                                            CurrentRssBytes()) +
-                                 texture_bytes;
+                                                            CurrentRssBytes(), options.queue_memory_bytes) +
+                                 texture_bytes + MaxLoadScratchBytes(*source);
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
         // The image is written after the bricks are freed, but OpenImageIO must fit then (unless the
         // texture cache loaded it already: the process's size counts it then).
@@ -194,12 +215,13 @@ Status RunRender(const RenderOptions& o) {
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
         "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} brick_reloads={} "
-        "prefetch_loads={} prefetch_hits={} stall={:.3f}s",
+        "prefetch_loads={} prefetch_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
+        "spilled_rays={} spill_bytes_written={}",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
         stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
         stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes) : std::string("in-core"),
         stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads, stats.prefetch_hits,
-        stats.stall_seconds);
+        stats.stall_seconds, stats.cache_reads, stats.cache_disk_bytes, stats.spilled_rays, stats.spill_bytes_written);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -246,6 +268,17 @@ Status RunRender(const RenderOptions& o) {
                  FormatCount(double(stats.brick_evictions)).c_str(), FormatCount(double(stats.brick_reloads)).c_str(),
                  FormatCount(double(stats.prefetch_loads)).c_str(), FormatCount(double(stats.prefetch_hits)).c_str(),
                  FormatCount(double(stats.brick_acquires)).c_str(), FormatDuration(stats.stall_seconds).c_str());
+    if (stats.spilled_rays > 0) {
+        std::fprintf(stderr, "  ray queues: %s rays spilled to disk (%s written, at most %s on disk at once)\n",
+                     FormatCount(double(stats.spilled_rays)).c_str(), FormatBytes(stats.spill_bytes_written).c_str(),
+                     FormatBytes(stats.spill_peak_disk_bytes).c_str());
+    }
+    if (stats.cache_bricks_written > 0) {
+        std::fprintf(stderr, "  brick cache: %s bricks decoded once, %s reloads read back, %s on disk (%s decoded)\n",
+                     FormatCount(double(stats.cache_bricks_written)).c_str(),
+                     FormatCount(double(stats.cache_reads)).c_str(), FormatBytes(stats.cache_disk_bytes).c_str(),
+                     FormatBytes(stats.cache_mesh_bytes).c_str());
+    }
     if (textures) {
         std::fprintf(stderr, "  textures: read %s through a %s tile cache (%s held at the end)\n",
                      FormatBytes(textures->bytes_read()).c_str(), FormatBytes(textures->max_memory_bytes()).c_str(),
@@ -283,7 +316,10 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--pager", opts->pager,
                     "Pager tunables, comma separated (docs/pager.md): prefetch=on|off, loaders=N, "
                     "nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, overlap=FRACTION, "
-                    "bvh=low|medium|high, bvh_compact=on|off");
+                    "bvh=low|medium|high, bvh_compact=on|off, cache=on|off, cache_limit=SIZE, queue_memory=SIZE");
+    cmd->add_option("--temp-dir", opts->temp_dir,
+                    "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "
+                    "and vanish when nave exits. Default: beside the output");
     cmd->add_option("--trace", opts->trace,
                     "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
                     "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");

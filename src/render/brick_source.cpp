@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "core/trace.h"
+#include "render/brick_mesh_cache.h"
 
 
 namespace nave::render {
@@ -264,9 +265,31 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     TraceSpan load(trace_, "load", "pager");
     load.AddArg({"brick", id});
     uint64_t bytes = 0;
-    TraceSpan decode(trace_, "read and decode", "pager");
-    StatusOr<store::BrickMesh> mesh = LoadMesh(id, &bytes);
+    const bool cached = mesh_cache_ != nullptr && mesh_cache_->Has(id);
+    TraceSpan decode(trace_, cached ? "read from the brick cache" : "read and decode", "pager");
+    StatusOr<store::BrickMesh> mesh = store::BrickMesh();
+    if (cached) {
+        mesh = mesh_cache_->Get(id);
+    } else {
+        if (decode_limit_ > 0) {
+            std::unique_lock<std::mutex> decode_lock(decode_mutex_);
+            decode_cv_.wait(decode_lock, [&] { return decodes_ < decode_limit_; });
+            ++decodes_;
+        }
+        mesh = LoadMesh(id, &bytes);
+        if (decode_limit_ > 0) {
+            {
+                std::lock_guard<std::mutex> decode_lock(decode_mutex_);
+                --decodes_;
+            }
+            decode_cv_.notify_one();
+        }
+    }
     decode.End();
+    if (mesh.ok() && mesh_cache_ != nullptr && !cached) {
+        TraceSpan put(trace_, "write to the brick cache", "pager");
+        mesh_cache_->Put(id, *mesh);
+    }
     if (mesh.ok()) load.AddArg({"triangles", mesh->TriangleCount()});
     load.AddArg({"bytes_read", bytes});
     TraceSpan build(trace_, "bvh build", "pager");

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -107,6 +108,7 @@ class ResidentBrick {
 };
 
 class BrickSource;
+class BrickMeshCache;
 
 /// A pin on a resident brick: while a handle lives, its brick stays in memory. Move-only; releasing (or
 /// destroying) the handle unpins it.
@@ -180,6 +182,19 @@ class BrickSource {
     /// Records every load (read and decode, BVH build) as spans on `trace` (null: no tracing). Set
     /// before loads start; `trace` must outlive them.
     void SetTrace(TraceRecorder* trace) { trace_ = trace; }
+    /// Loads read decoded meshes back from `cache` when it has them, and put there those they
+    /// decode (null: every load decodes from the store). Set before loads start; `cache` must
+    /// outlive them.
+    void SetMeshCache(BrickMeshCache* cache) { mesh_cache_ = cache; }
+    /// At most `limit` loads decode at once (0: no limit); under a budget one decode's scratch
+    /// memory is reserved, not one per loader. Set before loads start.
+    void SetDecodeLimit(int limit) { decode_limit_ = limit; }
+    /// Memory a load of brick `id` needs beside the brick itself while it decodes (0 for sources
+    /// that do not decode).
+    virtual uint64_t LoadScratchBytes(uint32_t id) const {
+        (void)id;
+        return 0;
+    }
 
   protected:
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
@@ -206,6 +221,11 @@ class BrickSource {
     AlphaMasks alpha_masks_;
     BvhSettings bvh_;
     TraceRecorder* trace_ = nullptr;
+    BrickMeshCache* mesh_cache_ = nullptr;
+    int decode_limit_ = 0;
+    std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
+    std::condition_variable decode_cv_;
+    int decodes_ = 0;
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;
@@ -220,6 +240,7 @@ class StoreBrickSource final : public BrickSource {
     ~StoreBrickSource() override;
     const store::Store& store() const { return *store_; }
     uint64_t EstimatedResidentBytes(uint32_t id) const override;
+    uint64_t LoadScratchBytes(uint32_t id) const override;
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;

@@ -48,6 +48,17 @@ struct RenderStats {
     double stall_seconds = 0;          ///< time the workers idled while the scheduler waited for a load
     uint64_t peak_rss_bytes = 0;
     uint64_t peak_queue_bytes = 0;
+    // The brick cache under a budget (BrickMeshCache): meshes written, loads it served, its size
+    // on disk and decoded.
+    uint64_t cache_bricks_written = 0;
+    uint64_t cache_reads = 0;
+    uint64_t cache_disk_bytes = 0;
+    uint64_t cache_mesh_bytes = 0;
+    // Ray queues spilled to disk under a budget: rays written, bytes written (compressed) and the
+    // most the spill file held at once.
+    uint64_t spilled_rays = 0;
+    uint64_t spill_bytes_written = 0;
+    uint64_t spill_peak_disk_bytes = 0;
     int samples_per_pixel = 0;     ///< path mode: passes completed
     int iterations = 0;            ///< photon mode: SPPM iterations completed
 };

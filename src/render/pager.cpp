@@ -21,7 +21,8 @@ namespace nave::render {
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
         "prefetch=on|off, loaders=N, nearly_empty=RAYS, prefer_resident=FRACTION, "
-        "evict=lru|traffic, overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off";
+        "evict=lru|traffic, overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off, "
+        "cache=on|off, cache_limit=SIZE, queue_memory=SIZE";
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -53,6 +54,28 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                 return InvalidArgumentError("pager tunable bvh={}: expected low, medium or high",
                                             value);
             }
+        } else if (key == "cache") {
+            if (value == "on") {
+                options->brick_cache = true;
+            } else if (value == "off") {
+                options->brick_cache = false;
+            } else {
+                return InvalidArgumentError("pager tunable cache={}: expected on or off", value);
+            }
+        } else if (key == "cache_limit") {
+            StatusOr<uint64_t> bytes = ParseByteSize(value);
+            if (!bytes.ok()) {
+                return InvalidArgumentError(
+                    "pager tunable cache_limit={}: expected a size (8G, 500M)", value);
+            }
+            options->brick_cache_limit_bytes = *bytes;
+        } else if (key == "queue_memory") {
+            StatusOr<uint64_t> bytes = ParseByteSize(value);
+            if (!bytes.ok()) {
+                return InvalidArgumentError(
+                    "pager tunable queue_memory={}: expected a size (64M; 0: no spilling)", value);
+            }
+            options->queue_memory_bytes = *bytes;
         } else if (key == "bvh_compact") {
             if (value == "on") {
                 options->bvh.compact = true;
@@ -137,8 +160,30 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
     return m;
 }
 
+uint32_t AutoWavePaths(const RenderSettings& settings, int width, int height) {
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    const uint64_t paths = settings.mode == RenderSettings::Mode::kPath
+                               ? pixels * uint64_t(std::max(1, settings.spp))
+                               : settings.photons_per_iteration;
+    return uint32_t(std::clamp<uint64_t>(paths, uint64_t(1) << 20, uint64_t(1) << 24));
+}
+
+uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes) {
+    return std::max<uint64_t>(uint64_t(32) << 20, brick_budget_bytes / 32);
+}
+
+size_t MaxBatchRays(uint64_t queue_memory_bytes) {
+    constexpr size_t kMaxBatch = size_t(1) << 18;
+    if (queue_memory_bytes == 0) return kMaxBatch;
+    // The batch itself, and up to two records sent on per ray (a continuation and a shadow ray)
+    // pushed before the next spill.
+    return std::clamp<size_t>(size_t(queue_memory_bytes / (3 * sizeof(RayRecord))), 4096,
+                              kMaxBatch);
+}
+
 uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
-                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes) {
+                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes,
+                            uint64_t queue_memory_bytes) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
     // The process without bricks (pager.h), and per brick its queue, slot and statistics.
     const uint64_t kProcess = process_bytes + kRenderGrowthBytes + uint64_t(brick_count) * 256;
@@ -155,10 +200,16 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
     // Under paging the next wave is generated while wave_overlap of a wave is still waiting.
     in_flight += uint64_t(double(std::min<uint64_t>(settings.wave_paths, in_flight)) *
                           std::clamp(wave_overlap, 0.0, 1.0));
-    // Two records per path in flight: measured peaks are 0.85 (the demo in-core, 84 MiB for waves of
-    // 1 M paths) to 1.1 (the detail-110 abbey paged at 2G, 124 MiB for 1.09 M paths) records per
+    // Two records per path in flight: measured peaks are 0.85 (the demo in-core, 84 MiB for waves
+    // of 1 M paths) to 1.1 (the detail-110 abbey paged at 2G, 124 MiB for 1.09 M paths) records per
     // path, with the queues' partly filled blocks.
-    const uint64_t queues = 2 * in_flight * sizeof(RayRecord);
+    uint64_t queues = 2 * in_flight * sizeof(RayRecord);
+    // Spilling keeps the queues under their cap between batches; a batch adds itself and what its
+    // rays send on.
+    if (queue_memory_bytes > 0) {
+        queues = std::min(
+            queues, queue_memory_bytes + 3 * MaxBatchRays(queue_memory_bytes) * sizeof(RayRecord));
+    }
     // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and
     // references to the points in the brick grids.
     const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton ? pixels * 256 : 0;

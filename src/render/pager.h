@@ -11,6 +11,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -62,7 +63,33 @@ struct PagerOptions {
     /// wave's paths are still waiting, so that its rays join the previous wave's tail (0: waves do
     /// not overlap).
     double wave_overlap = 0.5;
+    /// Under a budget, keep each decoded brick on disk after its first load, so that reloads skip
+    /// the Draco decode (BrickMeshCache, docs/pager.md "Reloads").
+    bool brick_cache = true;
+    /// Bytes the brick cache may take on disk; 0: half the free space of spill_dir when the render
+    /// starts.
+    uint64_t brick_cache_limit_bytes = 0;
+    /// Bytes of ray queues kept in memory under a budget: beyond, the full blocks of the queues of
+    /// bricks that are not resident are spilled to disk (LZ4) until half of it is left, and read
+    /// back when their brick is processed (docs/pager.md, "Spilling"). 0: queues stay in memory;
+    /// kAutoQueueMemory: QueueMemoryBytes of the brick budget.
+    static constexpr uint64_t kAutoQueueMemory = ~uint64_t(0);
+    uint64_t queue_memory_bytes = kAutoQueueMemory;
+    /// Where spill files go (the brick cache, the ray queues). Empty: the current directory.
+    std::filesystem::path spill_dir;
 };
+
+/// Camera paths (or photons) per wave when the user chose none and queues spill under a budget:
+/// every path of a pass sequence at once (pixels x spp in path mode, an iteration's photons in
+/// photon mode), so that each brick is loaded for as many rays as the image has, from 1 M up to
+/// 16 M (the spill file then holds at most about 1.5 GB).
+uint32_t AutoWavePaths(const RenderSettings& settings, int width, int height);
+/// The queue memory (PagerOptions::queue_memory_bytes) for a brick budget: 1/32 of it, at least
+/// 32 MiB.
+uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes);
+/// Rays taken from a queue per batch: at most 256 k, and under a queue memory cap (0: none) few
+/// enough that the batch and the two rays each of its rays may send on stay within the cap.
+size_t MaxBatchRays(uint64_t queue_memory_bytes);
 
 /// Parses "prefetch=off,nearly_empty=4096,prefer_resident=0.25" (any subset, comma separated) into
 /// `options`. Errors name the key or value and list the accepted keys.
@@ -87,8 +114,11 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch);
 /// `process_bytes`: what the process holds already when the render is planned (its resident size
 /// then: code, libraries, the store's tables, the scene), to which the render adds its threads and
 /// allocator slack (kRenderGrowthBytes).
+/// `queue_memory_bytes`: PagerOptions::queue_memory_bytes (0: no spilling, the queues of a wave
+/// are all in memory).
 uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int height,
-                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes);
+                            uint32_t brick_count, double wave_overlap, uint64_t process_bytes,
+                            uint64_t queue_memory_bytes = 0);
 
 /// What a render grows the process by beyond its size when planned, bricks, film and queues aside:
 /// Embree's and TBB's threads and state, allocator slack (an 8x8 render of a one-brick model: 3

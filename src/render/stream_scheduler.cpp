@@ -13,8 +13,7 @@
 namespace nave::render {
 namespace {
 
-/// Rays taken from a queue per scheduler step, and rays per task within it.
-constexpr size_t kMaxBatch = 1u << 18;
+/// Rays per task within a batch.
 constexpr size_t kChunk = 256;
 
 }  // namespace
@@ -25,11 +24,44 @@ StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64
       custom_picker_(bool(picker)),
       picker_(picker ? std::move(picker) : BrickPicker(PickFullestBrick)),
       wave_paths_(wave_paths),
-      queues_(source.brick_count()) {}
+      queues_(source.brick_count()),
+      max_batch_(MaxBatchRays(0)) {}
+
+StreamScheduler::~StreamScheduler() {
+    pager_.reset();  // joins the loaders before the cache they use goes
+    if (mesh_cache_) source_.SetMeshCache(nullptr);
+    source_.SetDecodeLimit(0);
+}
 
 Status StreamScheduler::EnablePaging(const PagerOptions& options) {
     NAVE_RETURN_IF_ERROR(source_.SetBvhSettings(options.bvh));
     source_.SetTrace(options.trace);
+    // Under a budget one decode runs at a time: its scratch memory is reserved once
+    // (RenderReserveBytes's caller adds LoadScratchBytes), and with the brick cache only first
+    // loads decode.
+    if (!options.in_core()) source_.SetDecodeLimit(1);
+    if (!options.in_core() && options.brick_cache) {
+        NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::SpillFile> file,
+                              store::SpillFile::Create(options.spill_dir, "the brick cache"));
+        uint64_t limit = options.brick_cache_limit_bytes;
+        if (limit == 0) {
+            std::error_code ec;
+            const std::filesystem::space_info space = std::filesystem::space(file->dir(), ec);
+            limit = ec ? 0 : space.available / 2;
+        }
+        mesh_cache_ =
+            std::make_unique<BrickMeshCache>(std::move(file), source_.brick_count(), limit);
+        source_.SetMeshCache(mesh_cache_.get());
+    }
+    const uint64_t queue_memory = options.queue_memory_bytes == PagerOptions::kAutoQueueMemory
+                                      ? QueueMemoryBytes(options.brick_budget_bytes)
+                                      : options.queue_memory_bytes;
+    if (!options.in_core() && queue_memory > 0) {
+        NAVE_ASSIGN_OR_RETURN(queue_spill_,
+                              store::SpillFile::Create(options.spill_dir, "the ray queues"));
+        queue_memory_ = queue_memory;
+        max_batch_ = MaxBatchRays(queue_memory_);
+    }
     trace_ = options.trace;
     if (trace_ != nullptr) trace_->NameThread("scheduler");
     NAVE_ASSIGN_OR_RETURN(
@@ -87,6 +119,9 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
             trace_->Counter("memory", {{"resident_bricks", source_.stats().resident_bytes},
                                        {"queues", queues_.MemoryBytes()}});
         }
+        if (queue_spill_ && queues_.MemoryBytes() > queue_memory_) {
+            NAVE_RETURN_IF_ERROR(SpillQueues(waiting));
+        }
         const uint32_t b =
             pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, source_);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
@@ -96,7 +131,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         // while the workers would idle anyway.
         if (pager_ && !source_.IsResident(b)) pager_->Prefetch(waiting, b, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(b));
-        queues_.Take(b, kMaxBatch, &batch);
+        NAVE_RETURN_IF_ERROR(queues_.Take(b, max_batch_, &batch, queue_spill_.get()).status());
         batches_.fetch_add(1, std::memory_order_relaxed);
         if (pager_) {
             waiting[b] -= batch.size();
@@ -120,6 +155,33 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
             handle.Reset();
             pager_->BatchDone();
         }
+    }
+    return Status::Ok();
+}
+
+Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
+    // The bricks with the most rays load next: their queues stay. Of the others, the largest
+    // queues in memory go first (fewest writes for the bytes freed).
+    std::vector<uint32_t> order(waiting.size());
+    for (uint32_t b = 0; b < order.size(); ++b) order[b] = b;
+    std::sort(order.begin(), order.end(),
+              [&](uint32_t a, uint32_t b) { return waiting[a] > waiting[b]; });
+    const size_t keep = pager_ ? size_t(std::max(1, pager_->options().loaders)) + 1 : 1;
+    std::vector<uint32_t> victims;
+    for (size_t i = keep; i < order.size() && waiting[order[i]] > 0; ++i) {
+        if (!source_.IsResident(order[i])) victims.push_back(order[i]);
+    }
+    std::sort(victims.begin(), victims.end(),
+              [&](uint32_t a, uint32_t b) { return queues_.InMemory(a) > queues_.InMemory(b); });
+    TraceSpan span(trace_, "spill queues", "scheduler");
+    for (uint32_t b : victims) {
+        if (queues_.MemoryBytes() <= queue_memory_ / 2) break;
+        StatusOr<size_t> n = queues_.Spill(b, *queue_spill_);
+        if (!n.ok()) {
+            return n.status().WithContext(
+                "spilling ray queues beyond the memory budget (--temp-dir chooses where)");
+        }
+        spilled_rays_ += *n;
     }
     return Status::Ok();
 }
@@ -150,6 +212,19 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
         stats->prefetch_hits = p.prefetch_hits;
         stats->brick_acquires = p.acquires;
         stats->stall_seconds = p.stall_seconds;
+        if (queue_spill_) {
+            const store::SpillStats q = queue_spill_->stats();
+            stats->spilled_rays = spilled_rays_;
+            stats->spill_bytes_written = q.stored_bytes_written;
+            stats->spill_peak_disk_bytes = q.peak_stored_bytes;
+        }
+        if (mesh_cache_) {
+            const BrickMeshCacheStats c = mesh_cache_->stats();
+            stats->cache_bricks_written = c.bricks_written;
+            stats->cache_reads = c.reads;
+            stats->cache_disk_bytes = c.disk_bytes;
+            stats->cache_mesh_bytes = c.mesh_bytes;
+        }
     } else {
         stats->peak_brick_bytes = after.peak_resident_bytes;
         stats->brick_evictions = after.evictions - before.evictions;

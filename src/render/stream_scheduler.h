@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "render/brick_mesh_cache.h"
 #include "render/brick_source.h"
 #include "render/integrator.h"
 #include "render/pager.h"
@@ -74,6 +75,7 @@ class StreamScheduler {
     /// empty: PickFullestBrick, or with paging the pager's choice. `wave_paths`: camera paths (or
     /// photons) per wave, the unit of WaveOverlap.
     StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths);
+    ~StreamScheduler();
     StreamScheduler(const StreamScheduler&) = delete;
     StreamScheduler& operator=(const StreamScheduler&) = delete;
 
@@ -113,6 +115,17 @@ class StreamScheduler {
     BrickQueues<RayRecord> queues_;
     LocalRayExchange local_exchange_{queues_};
     RayExchange& exchange_ = local_exchange_;  // every ray leaving a batch goes through here
+    /// Spills queues of bricks that are not resident until their memory is below half the cap.
+    Status SpillQueues(const std::vector<size_t>& waiting);
+
+    // Under a budget: queue blocks spilled to disk beyond queue_memory_ (null: none).
+    std::unique_ptr<store::SpillFile> queue_spill_;
+    uint64_t queue_memory_ = 0;
+    uint64_t spilled_rays_ = 0;
+    size_t max_batch_;  // rays taken from a queue per batch
+    // Under a budget: decoded meshes of loaded bricks, for their reloads (null: none). Outlives
+    // the pager, whose loaders read and write it.
+    std::unique_ptr<BrickMeshCache> mesh_cache_;
     // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
     std::unique_ptr<Pager> pager_;  // null: in-core
     double stall_seconds_ = 0;      // in-core

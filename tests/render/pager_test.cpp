@@ -6,8 +6,10 @@
 #include "render/pager.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -112,6 +114,7 @@ PagerOptions SmallBudget(const BrickSource& source, bool prefetch = true) {
     PagerOptions o;
     o.prefetch = prefetch;
     o.brick_budget_bytes = std::max(m.min_bytes, m.total_bytes * 15 / 100);
+    o.spill_dir = std::filesystem::temp_directory_path();
     return o;
 }
 
@@ -121,11 +124,14 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     const BrickBudgetMinimum m = MinimumBrickBudget(*in_core.source, true);
     EXPECT_GE(in_core.source->brick_count(), 30u);
     // Prefetching on and off; then small waves (the in-core render has one), which under paging
-    // overlap.
-    for (int variant = 0; variant < 3; ++variant) {
+    // overlap; then without the brick cache (every reload decodes the brick again); then with
+    // queues spilled to disk beyond 64 KiB.
+    for (int variant = 0; variant < 5; ++variant) {
         const bool prefetch = variant != 1;
         const uint32_t wave_paths = variant == 2 ? 500 : 0;
         PagerOptions options = SmallBudget(*in_core.source, prefetch);
+        options.brick_cache = variant != 3;
+        if (variant == 4) options.queue_memory_bytes = 64 << 10;
         EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4)
             << "the test scene should allow a small budget";
         Rendered paged = RenderBallGrid(mode, &options, 2, wave_paths);
@@ -143,6 +149,17 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
         EXPECT_GT(paged.stats.brick_loads, in_core.stats.brick_loads);
         EXPECT_EQ(paged.stats.prefetch_loads > 0, prefetch);
         EXPECT_EQ(paged.stats.brick_budget_bytes, options.brick_budget_bytes);
+        EXPECT_EQ(paged.stats.spilled_rays > 0, variant == 4) << variant;
+        // With the cache, every brick is decoded once and every reload read back from it.
+        if (options.brick_cache) {
+            EXPECT_EQ(paged.stats.cache_reads, paged.stats.brick_reloads) << variant;
+            EXPECT_EQ(paged.stats.cache_bricks_written + paged.stats.brick_reloads,
+                      paged.stats.brick_loads)
+                << variant;
+        } else {
+            EXPECT_EQ(paged.stats.cache_reads, 0u);
+            EXPECT_EQ(paged.stats.cache_bricks_written, 0u);
+        }
     }
 }
 
@@ -313,8 +330,12 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    for (const char* bad : {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11",
-                            "prefetch", "evict=random", "overlap=2"}) {
+    ASSERT_TRUE(ParsePagerTunables("cache=off,cache_limit=3G", &o).ok());
+    EXPECT_FALSE(o.brick_cache);
+    EXPECT_EQ(o.brick_cache_limit_bytes, uint64_t(3) << 30);
+    for (const char* bad :
+         {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11", "prefetch",
+          "evict=random", "overlap=2", "cache=yes", "cache_limit=lots"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
@@ -433,6 +454,34 @@ TEST(PagerCliTest, TooSmallMemoryIsRefusedNamingTheBrickAndTheMinimum) {
     EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(PagerCliTest, AFullDiskWhileSpillingNamesTheSpillDirectoryAndWritesNoImage) {
+    const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("nave_spill_full_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    const auto out = dir / "clutter.exr";
+    // Queues over 4 KiB spill; a file size limit of 8 KiB (inherited by nave) fails the spill as a
+    // full disk would.
+    struct rlimit old {};
+    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+    auto previous = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = old;
+    small.rlim_cur = 8 << 10;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    const test::CommandResult r = test::RunNave(
+        "render --procedural clutter:bricks=4 --config " + config +
+        " --resolution 64x48 --spp 2 --memory 256M --pager queue_memory=4K --temp-dir " +
+        dir.string() + " -o " + out.string());
+    ::setrlimit(RLIMIT_FSIZE, &old);
+    std::signal(SIGXFSZ, previous);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("ray queues to " + dir.string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--temp-dir"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_TRUE(std::filesystem::is_empty(dir));  // no partial image, no spill file left
+    std::filesystem::remove_all(dir);
+}
+
 TEST(PagerCliTest, MemoryBudgetRendersAndReportsPaging) {
     const std::string config = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_clutter.toml";
     const auto out = std::filesystem::temp_directory_path() /
@@ -496,8 +545,8 @@ TEST(PagerCliTest, WholeProcessPeakStaysWithinTheBudget) {
                                     : std::stoull(refused.output.substr(comma + 2));
     ASSERT_GT(minimum, 0u) << refused.output;
     ASSERT_GT(all_bricks, 0u) << refused.output;
-    // The minimum counts the process's size when the render is planned, which differs by a few pages
-    // from one run to the next: start 4 MiB above it.
+    // The minimum counts the process's size when the render is planned, which differs by a few
+    // pages from one run to the next: start 4 MiB above it.
     const uint64_t smallest = minimum + (uint64_t(4) << 20);
     for (const uint64_t budget : {smallest, smallest + all_bricks / 2, smallest + all_bricks}) {
         const test::CommandResult r = test::RunNave(render + " --memory " + std::to_string(budget));

@@ -1,0 +1,116 @@
+#include "render/brick_mesh_cache.h"
+
+#include "core/log.h"
+#include "core/memory.h"
+
+namespace nave::render {
+namespace {
+
+template <typename T>
+StatusOr<store::SpillExtent> WriteVector(store::SpillFile& file, const std::vector<T>& v) {
+    return file.Write(v.data(), v.size() * sizeof(T));
+}
+
+/// Reads `extent` into a vector of `n` elements. `spare` more elements are reserved (positions
+/// keep room for Embree's 16-byte loads past the last vertex, so building the brick does not copy
+/// them).
+template <typename T>
+Status ReadVector(const store::SpillFile& file, const store::SpillExtent& extent, size_t n,
+                  size_t spare, std::vector<T>* v) {
+    v->reserve(n + spare);
+    v->resize(n);
+    return file.Read(extent, v->data());
+}
+
+}  // namespace
+
+BrickMeshCache::BrickMeshCache(std::unique_ptr<store::SpillFile> file, uint32_t brick_count,
+                               uint64_t limit_bytes)
+    : file_(std::move(file)), limit_bytes_(limit_bytes) {
+    entries_.reserve(brick_count);
+    for (uint32_t b = 0; b < brick_count; ++b) entries_.push_back(std::make_unique<Entry>());
+}
+
+BrickMeshCache::~BrickMeshCache() = default;
+
+bool BrickMeshCache::Has(uint32_t id) const {
+    return id < entries_.size() && entries_[id]->ready.load(std::memory_order_acquire);
+}
+
+void BrickMeshCache::Put(uint32_t id, const store::BrickMesh& mesh) {
+    if (id >= entries_.size() || Has(id)) return;
+    const uint64_t mesh_bytes = mesh.positions.size() * sizeof(Vec3f) +
+                                mesh.normals.size() * sizeof(Vec3f) +
+                                mesh.uvs.size() * sizeof(mesh.uvs[0]) + mesh.indices.size() * 4 +
+                                mesh.material_ids.size() * 4;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        // The decoded size bounds what it takes on disk (LZ4 never stores more than that here).
+        if (failed_ || stats_.disk_bytes + mesh_bytes > limit_bytes_) {
+            ++stats_.skipped;
+            return;
+        }
+        stats_.disk_bytes += mesh_bytes;  // held until the real size is known
+    }
+    Entry& e = *entries_[id];
+    std::vector<store::SpillExtent*> written;
+    Status status = Status::Ok();
+    auto write = [&](store::SpillExtent* extent, StatusOr<store::SpillExtent> result) {
+        if (!status.ok()) return;
+        if (!result.ok()) {
+            status = result.status();
+            return;
+        }
+        *extent = std::move(result).value();
+        written.push_back(extent);
+    };
+    write(&e.positions, WriteVector(*file_, mesh.positions));
+    write(&e.normal_data, WriteVector(*file_, mesh.normals));
+    write(&e.uv_data, WriteVector(*file_, mesh.uvs));
+    write(&e.indices, WriteVector(*file_, mesh.indices));
+    write(&e.materials, WriteVector(*file_, mesh.material_ids));
+    uint64_t stored = 0;
+    for (store::SpillExtent* x : written) stored += x->stored_bytes;
+    std::lock_guard<std::mutex> lock(mutex_);
+    stats_.disk_bytes -= mesh_bytes;
+    if (!status.ok()) {
+        for (store::SpillExtent* x : written) file_->Release(*x);
+        ++stats_.skipped;
+        if (!failed_) {
+            failed_ = true;
+            log::Warning("brick cache: {}; later loads decode from the store", status.message());
+        }
+        return;
+    }
+    e.positions_n = mesh.positions.size();
+    e.normals_n = mesh.normals.size();
+    e.uvs_n = mesh.uvs.size();
+    e.indices_n = mesh.indices.size();
+    e.materials_n = mesh.material_ids.size();
+    stats_.disk_bytes += stored;
+    stats_.mesh_bytes += mesh_bytes;
+    ++stats_.bricks_written;
+    e.ready.store(true, std::memory_order_release);
+}
+
+StatusOr<store::BrickMesh> BrickMeshCache::Get(uint32_t id) const {
+    if (!Has(id)) return InternalError("brick {} is not in the brick cache", id);
+    const Entry& e = *entries_[id];
+    store::BrickMesh mesh;
+    Status s = ReadVector(*file_, e.positions, e.positions_n, 1, &mesh.positions);
+    if (s.ok()) s = ReadVector(*file_, e.normal_data, e.normals_n, 0, &mesh.normals);
+    if (s.ok()) s = ReadVector(*file_, e.uv_data, e.uvs_n, 0, &mesh.uvs);
+    if (s.ok()) s = ReadVector(*file_, e.indices, e.indices_n, 0, &mesh.indices);
+    if (s.ok()) s = ReadVector(*file_, e.materials, e.materials_n, 0, &mesh.material_ids);
+    if (!s.ok()) return s.WithContext(fmt::format("reading brick {} from the brick cache", id));
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.reads;
+    return mesh;
+}
+
+BrickMeshCacheStats BrickMeshCache::stats() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stats_;
+}
+
+}  // namespace nave::render
