@@ -88,10 +88,7 @@ Status RunRender(const RenderOptions& o) {
     if (o.threads) config.render.threads = *o.threads;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
-    if (o.wave_paths) {
-        config.render.wave_paths = uint32_t(*o.wave_paths);
-        config.render.wave_paths_given = true;
-    }
+    if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
@@ -152,13 +149,9 @@ Status RunRender(const RenderOptions& o) {
         const uint64_t memory = *memory_limit;
         // The texture cache's cap comes out of --memory too (docs/pager.md).
         const uint64_t texture_bytes = textures ? textures->max_memory_bytes() : 0;
-        // Queues beyond a small share of the budget spill to disk, so a wave can be the whole image.
+        // Queues beyond a small share of the budget spill to disk.
         if (options.queue_memory_bytes == render::PagerOptions::kAutoQueueMemory) {
             options.queue_memory_bytes = render::QueueMemoryBytes(memory);
-        }
-        if (!config.render.wave_paths_given && options.queue_memory_bytes > 0) {
-            config.render.wave_paths = render::AutoWavePaths(config.render, config.camera.width, config.camera.height);
-            scene.settings.wave_paths = config.render.wave_paths;
         }
         const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
                                                             source->brick_count(), options.wave_overlap,

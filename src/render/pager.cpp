@@ -160,14 +160,6 @@ BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) 
     return m;
 }
 
-uint32_t AutoWavePaths(const RenderSettings& settings, int width, int height) {
-    const uint64_t pixels = uint64_t(width) * uint64_t(height);
-    const uint64_t paths = settings.mode == RenderSettings::Mode::kPath
-                               ? pixels * uint64_t(std::max(1, settings.spp))
-                               : settings.photons_per_iteration;
-    return uint32_t(std::clamp<uint64_t>(paths, uint64_t(1) << 20, uint64_t(1) << 24));
-}
-
 uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes) {
     return std::max<uint64_t>(uint64_t(32) << 20, brick_budget_bytes / 32);
 }

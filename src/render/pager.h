@@ -79,11 +79,6 @@ struct PagerOptions {
     std::filesystem::path spill_dir;
 };
 
-/// Camera paths (or photons) per wave when the user chose none and queues spill under a budget:
-/// every path of a pass sequence at once (pixels x spp in path mode, an iteration's photons in
-/// photon mode), so that each brick is loaded for as many rays as the image has, from 1 M up to
-/// 16 M (the spill file then holds at most about 1.5 GB).
-uint32_t AutoWavePaths(const RenderSettings& settings, int width, int height);
 /// The queue memory (PagerOptions::queue_memory_bytes) for a brick budget: 1/32 of it, at least
 /// 32 MiB.
 uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes);

@@ -112,9 +112,6 @@ struct RenderSettings {
     uint64_t seed = 1;
     int threads = 0;                 ///< 0: all cores
     uint32_t wave_paths = 1u << 20;  ///< camera paths in flight at once
-    /// Whether wave_paths was chosen (config key or --wave-paths); if not, a render under --memory
-    /// makes the whole image one wave (AutoWavePaths), its queues spilling to disk.
-    bool wave_paths_given = false;
     /// Where photons from the sun and directional lights are aimed: the model's bounds projected onto the
     /// light's direction, or the triangles of materials marked `portal` (windows) only.
     enum class PhotonTarget { kBounds, kPortals };

@@ -167,12 +167,17 @@ Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
     std::sort(order.begin(), order.end(),
               [&](uint32_t a, uint32_t b) { return waiting[a] > waiting[b]; });
     const size_t keep = pager_ ? size_t(std::max(1, pager_->options().loaders)) + 1 : 1;
+    // Resident bricks' queues too, after the others: when every brick fits (a small model under a
+    // large wave) only they hold rays, and the cap must hold all the same.
     std::vector<uint32_t> victims;
-    for (size_t i = keep; i < order.size() && waiting[order[i]] > 0; ++i) {
-        if (!source_.IsResident(order[i])) victims.push_back(order[i]);
-    }
-    std::sort(victims.begin(), victims.end(),
-              [&](uint32_t a, uint32_t b) { return queues_.InMemory(a) > queues_.InMemory(b); });
+    for (size_t i = keep; i < order.size() && waiting[order[i]] > 0; ++i)
+        victims.push_back(order[i]);
+    std::vector<uint8_t> resident(waiting.size(), 0);
+    for (uint32_t b : victims) resident[b] = source_.IsResident(b) ? 1 : 0;
+    std::sort(victims.begin(), victims.end(), [&](uint32_t a, uint32_t b) {
+        if (resident[a] != resident[b]) return resident[a] < resident[b];
+        return queues_.InMemory(a) > queues_.InMemory(b);
+    });
     TraceSpan span(trace_, "spill queues", "scheduler");
     for (uint32_t b : victims) {
         if (queues_.MemoryBytes() <= queue_memory_ / 2) break;
