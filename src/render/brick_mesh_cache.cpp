@@ -39,10 +39,7 @@ bool BrickMeshCache::Has(uint32_t id) const {
 
 void BrickMeshCache::Put(uint32_t id, const store::BrickMesh& mesh) {
     if (id >= entries_.size() || Has(id)) return;
-    const uint64_t mesh_bytes = mesh.positions.size() * sizeof(Vec3f) +
-                                mesh.normals.size() * sizeof(Vec3f) +
-                                mesh.uvs.size() * sizeof(mesh.uvs[0]) + mesh.indices.size() * 4 +
-                                mesh.material_ids.size() * 4;
+    const uint64_t mesh_bytes = mesh.MemoryBytes();
     {
         std::lock_guard<std::mutex> lock(mutex_);
         // The decoded size bounds what it takes on disk (LZ4 never stores more than that here).

@@ -18,6 +18,19 @@ namespace nave::render {
 // ----------------------------------------------------------------------------------------------
 // options
 
+namespace {
+
+/// A pager tunable's on|off value; the error names the key.
+Status ParseOnOff(std::string_view key, std::string_view value, bool* out) {
+    if (value == "on" || value == "off") {
+        *out = value == "on";
+        return Status::Ok();
+    }
+    return InvalidArgumentError("pager tunable {}={}: expected on or off", key, value);
+}
+
+}  // namespace
+
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     constexpr const char* kKeys =
         "prefetch=on|off, loaders=N, nearly_empty=RAYS, prefer_resident=FRACTION, "
@@ -36,13 +49,7 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
         }
         std::string_view key = item.substr(0, eq), value = item.substr(eq + 1);
         if (key == "prefetch") {
-            if (value == "on") {
-                options->prefetch = true;
-            } else if (value == "off") {
-                options->prefetch = false;
-            } else {
-                return InvalidArgumentError("pager tunable prefetch={}: expected on or off", value);
-            }
+            NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->prefetch));
         } else if (key == "bvh") {
             if (value == "low") {
                 options->bvh.quality = BvhSettings::Quality::kLow;
@@ -55,13 +62,7 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                                             value);
             }
         } else if (key == "cache") {
-            if (value == "on") {
-                options->brick_cache = true;
-            } else if (value == "off") {
-                options->brick_cache = false;
-            } else {
-                return InvalidArgumentError("pager tunable cache={}: expected on or off", value);
-            }
+            NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->brick_cache));
         } else if (key == "cache_limit") {
             StatusOr<uint64_t> bytes = ParseByteSize(value);
             if (!bytes.ok()) {
@@ -77,14 +78,7 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             }
             options->queue_memory_bytes = *bytes;
         } else if (key == "bvh_compact") {
-            if (value == "on") {
-                options->bvh.compact = true;
-            } else if (value == "off") {
-                options->bvh.compact = false;
-            } else {
-                return InvalidArgumentError("pager tunable bvh_compact={}: expected on or off",
-                                            value);
-            }
+            NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->bvh.compact));
         } else if (key == "evict") {
             if (value == "lru") {
                 options->evict_least_traffic = false;

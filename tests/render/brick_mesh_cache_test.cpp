@@ -1,10 +1,10 @@
 #include "render/brick_mesh_cache.h"
 
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
-#include <csignal>
 #include <filesystem>
+
+#include "common/file_size_limit.h"
 
 namespace nave::render {
 namespace {
@@ -67,15 +67,11 @@ TEST(BrickMeshCache, AWriteErrorStopsTheCachingAndKeepsWhatWasCached) {
     cache.Put(0, TwoTriangles(true, true));
     ASSERT_TRUE(cache.Has(0));
     // A file size limit makes the next writes fail as a full disk would.
-    struct rlimit old {};
-    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
-    auto previous = std::signal(SIGXFSZ, SIG_IGN);
-    struct rlimit tiny = old;
-    tiny.rlim_cur = 1;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &tiny), 0);
-    cache.Put(1, TwoTriangles(true, true));
-    ::setrlimit(RLIMIT_FSIZE, &old);
-    std::signal(SIGXFSZ, previous);
+    {
+        test::ScopedFileSizeLimit limit(1);
+        ASSERT_TRUE(limit.ok());
+        cache.Put(1, TwoTriangles(true, true));
+    }
     EXPECT_FALSE(cache.Has(1));
     cache.Put(2, TwoTriangles(false, false));  // no more caching after a failure
     EXPECT_FALSE(cache.Has(2));

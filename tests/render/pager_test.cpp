@@ -6,13 +6,12 @@
 #include "render/pager.h"
 
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
-#include <csignal>
 #include <filesystem>
 #include <fstream>
 
+#include "common/file_size_limit.h"
 #include "common/run_nave.h"
 #include "core/memory.h"
 #include "core/progress.h"
@@ -462,18 +461,15 @@ TEST(PagerCliTest, AFullDiskWhileSpillingNamesTheSpillDirectoryAndWritesNoImage)
     const auto out = dir / "clutter.exr";
     // Queues over 4 KiB spill; a file size limit of 8 KiB (inherited by nave) fails the spill as a
     // full disk would.
-    struct rlimit old {};
-    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
-    auto previous = std::signal(SIGXFSZ, SIG_IGN);
-    struct rlimit small = old;
-    small.rlim_cur = 8 << 10;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
-    const test::CommandResult r = test::RunNave(
-        "render --procedural clutter:bricks=4 --config " + config +
-        " --resolution 64x48 --spp 2 --memory 256M --pager queue_memory=4K --temp-dir " +
-        dir.string() + " -o " + out.string());
-    ::setrlimit(RLIMIT_FSIZE, &old);
-    std::signal(SIGXFSZ, previous);
+    test::CommandResult r;
+    {
+        test::ScopedFileSizeLimit limit(8 << 10);
+        ASSERT_TRUE(limit.ok());
+        r = test::RunNave("render --procedural clutter:bricks=4 --config " + config +
+                          " --resolution 64x48 --spp 2 --memory 256M --pager queue_memory=4K "
+                          "--temp-dir " +
+                          dir.string() + " -o " + out.string());
+    }
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("ray queues to " + dir.string()), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("--temp-dir"), std::string::npos) << r.output;

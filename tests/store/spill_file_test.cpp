@@ -1,13 +1,13 @@
 #include "store/spill_file.h"
 
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <random>
 #include <vector>
+
+#include "common/file_size_limit.h"
 
 namespace nave::store {
 namespace {
@@ -107,16 +107,13 @@ TEST(SpillFile, AFullDiskIsAnErrorNamingTheDirectoryAndWhatWasSpilled) {
     // A file size limit makes writes past it fail as a full disk would (EFBIG instead of ENOSPC).
     auto file = SpillFile::Create(TestDir(), "ray queues");
     ASSERT_TRUE(file.ok());
-    struct rlimit old {};
-    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
-    auto previous = std::signal(SIGXFSZ, SIG_IGN);
-    struct rlimit small = old;
-    small.rlim_cur = 64 << 10;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
     const std::vector<char> noise = Noise(256 << 10, 5);
-    auto extent = (*file)->Write(noise.data(), noise.size());
-    ::setrlimit(RLIMIT_FSIZE, &old);
-    std::signal(SIGXFSZ, previous);
+    StatusOr<SpillExtent> extent = SpillExtent();
+    {
+        test::ScopedFileSizeLimit limit(64 << 10);
+        ASSERT_TRUE(limit.ok());
+        extent = (*file)->Write(noise.data(), noise.size());
+    }
     ASSERT_FALSE(extent.ok());
     EXPECT_EQ(extent.status().code(), StatusCode::kIoError);
     EXPECT_NE(extent.status().message().find("ray queues"), std::string::npos)
