@@ -88,7 +88,10 @@ Status RunRender(const RenderOptions& o) {
     if (o.threads) config.render.threads = *o.threads;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
-    if (o.wave_paths) config.render.wave_paths = uint32_t(*o.wave_paths);
+    if (o.wave_paths) {
+        config.render.wave_paths = uint32_t(*o.wave_paths);
+        config.render.wave_paths_chosen = true;
+    }
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
@@ -153,11 +156,26 @@ Status RunRender(const RenderOptions& o) {
         if (options.queue_memory_bytes == render::PagerOptions::kAutoQueueMemory) {
             options.queue_memory_bytes = render::QueueMemoryBytes(memory);
         }
-        const uint64_t reserve = render::RenderReserveBytes(config.render, config.camera.width, config.camera.height,
-                                                            source->brick_count(), options.wave_overlap,
-                                                            CurrentRssBytes(), options.queue_memory_bytes) +
-                                 texture_bytes + MaxLoadScratchBytes(*source);
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        auto reserve_for = [&](const render::RenderSettings& settings) {
+            return render::RenderReserveBytes(settings, config.camera.width, config.camera.height,
+                                              source->brick_count(), options.wave_overlap, CurrentRssBytes(),
+                                              options.queue_memory_bytes) +
+                   texture_bytes + MaxLoadScratchBytes(*source);
+        };
+        uint64_t reserve = reserve_for(scene.settings);
+        // When the bricks will not all fit, one wave for the whole image unless the user chose
+        // (WavePathsUnderPaging): its camera rays spill to disk as they are generated.
+        if (options.queue_memory_bytes > 0 && memory < reserve + need.total_bytes) {
+            const uint32_t wave =
+                render::WavePathsUnderPaging(scene.settings, config.camera.width, config.camera.height);
+            if (wave != scene.settings.wave_paths) {
+                scene.settings.wave_paths = wave;
+                reserve = reserve_for(scene.settings);
+                log::Info("render: waves of {} camera paths (--wave-paths); their rays beyond {} of queues spill "
+                          "to disk", wave, FormatBytes(options.queue_memory_bytes));
+            }
+        }
         // The image is written after the bricks are freed, but OpenImageIO must fit then (unless the
         // texture cache loaded it already: the process's size counts it then).
         const uint64_t writer = CurrentRssBytes() + (textures ? 0 : render::kImageWriterBytes) +
@@ -300,8 +318,9 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
     cmd->add_option("--wave-paths", opts->wave_paths,
-                    "Camera paths (or photons) in flight at once (default 1048576): more rays per brick visit, so "
-                    "fewer loads under --memory, for more ray-queue memory")
+                    "Camera paths (or photons) in flight at once (default 1048576; under --memory, when the bricks do "
+                    "not all fit, the whole image in path mode): more rays per brick visit, so fewer loads, for "
+                    "more ray-queue memory or spilling")
         ->check(CLI::Range(uint64_t(1024), uint64_t(1) << 31));
     cmd->add_option("--memory", opts->memory,
                     "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "

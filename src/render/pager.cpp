@@ -158,6 +158,14 @@ uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes) {
     return std::max<uint64_t>(uint64_t(32) << 20, brick_budget_bytes / 32);
 }
 
+uint32_t WavePathsUnderPaging(const RenderSettings& settings, int width, int height) {
+    if (settings.wave_paths_chosen || settings.mode != RenderSettings::Mode::kPath) {
+        return settings.wave_paths;
+    }
+    const uint64_t paths = uint64_t(width) * uint64_t(height) * uint64_t(std::max(1, settings.spp));
+    return uint32_t(std::max<uint64_t>(settings.wave_paths, std::min(paths, kMaxPagedWavePaths)));
+}
+
 size_t MaxBatchRays(uint64_t queue_memory_bytes) {
     constexpr size_t kMaxBatch = size_t(1) << 18;
     if (queue_memory_bytes == 0) return kMaxBatch;

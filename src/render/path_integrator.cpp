@@ -44,7 +44,8 @@ Status PathIntegrator::Run(RenderStats* stats) {
         const int s_end = std::min(spp, s + passes_per_wave);
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
-            for (int k = s; k < s_end; ++k) GenerateCameraRays(first, last, uint32_t(k), nullptr);
+            for (int k = s; k < s_end; ++k)
+                NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k), nullptr));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
             progress.Add((last - first) * uint64_t(s_end - s));
         }
@@ -61,8 +62,20 @@ Status PathIntegrator::Run(RenderStats* stats) {
     return Status::Ok();
 }
 
-void PathIntegrator::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
-                                        const SampledWavelengths* lambda) {
+Status PathIntegrator::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
+                                          const SampledWavelengths* lambda) {
+    // In chunks, with the queues spilled beyond their cap between two: a wave may be larger than
+    // the queues' memory (under a budget the whole image is one wave, docs/pager.md).
+    const uint64_t chunk = scheduler_.generate_chunk();
+    for (uint64_t begin = first; begin < last; begin += chunk) {
+        GenerateCameraChunk(begin, std::min(last, begin + chunk), sample, lambda);
+        NAVE_RETURN_IF_ERROR(scheduler_.SpillIfOverCap());
+    }
+    return Status::Ok();
+}
+
+void PathIntegrator::GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sample,
+                                         const SampledWavelengths* lambda) {
     const Camera& camera = *scene_.camera;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
         RayOutbox out;

@@ -35,9 +35,10 @@ class PathIntegrator final : public RayProcessor {
     /// wave_paths, and fills samples_per_pixel and camera_paths of `stats`.
     Status Run(RenderStats* stats);
     /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or
-    /// the iteration's when `lambda` is given).
-    void GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
-                            const SampledWavelengths* lambda);
+    /// the iteration's when `lambda` is given), spilling queues beyond their cap as it goes.
+    /// Errors: a failed spill.
+    Status GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
+                              const SampledWavelengths* lambda);
     /// Keys the random numbers of the paths generated and traced from now on to SPPM iteration
     /// `iteration` (path mode: 0).
     void set_iteration(uint32_t iteration) { iteration_ = iteration; }
@@ -46,6 +47,8 @@ class PathIntegrator final : public RayProcessor {
                       std::span<const RayRecord> rays, RayOutbox& out) override;
 
   private:
+    void GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sample,
+                             const SampledWavelengths* lambda);
     void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, RayOutbox& out);
     /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if
     /// the path ends.

@@ -55,8 +55,7 @@ class BrickQueues {
             q.count += n;
             q.in_memory += n;
         }
-        q.size.store(q.count, std::memory_order_relaxed);
-        q.memory_size.store(q.in_memory, std::memory_order_relaxed);
+        Publish(q);
     }
     /// Moves up to `max_count` records of `brick` into `out` (cleared first): the most recent ones
     /// in memory, in the order they were pushed, so that emptied blocks are freed at once, then
@@ -105,8 +104,7 @@ class BrickQueues {
             }
         }
         q.count -= n;
-        q.size.store(q.count, std::memory_order_relaxed);
-        q.memory_size.store(q.in_memory, std::memory_order_relaxed);
+        Publish(q);
         return n;
     }
     /// Writes the full blocks of `brick`'s queue to `file` and frees them (the last, partly filled
@@ -128,7 +126,7 @@ class BrickQueues {
                 file.Write(block.data(), block.size() * sizeof(R));
             if (!extent.ok()) {
                 q.blocks.erase(q.blocks.begin(), q.blocks.begin() + std::ptrdiff_t(i));
-                q.memory_size.store(q.in_memory, std::memory_order_relaxed);
+                Publish(q);
                 return extent.status();
             }
             q.spilled.push_back({std::move(extent).value(), block.size()});
@@ -136,7 +134,7 @@ class BrickQueues {
             spilled += block.size();
         }
         q.blocks.erase(q.blocks.begin(), q.blocks.begin() + std::ptrdiff_t(full));
-        q.memory_size.store(q.in_memory, std::memory_order_relaxed);
+        Publish(q);
         return spilled;
     }
     /// Records of `brick` held in memory (not spilled; a snapshot).
@@ -154,11 +152,10 @@ class BrickQueues {
     }
     /// Bytes the queues hold in memory (for statistics and budgets); spilled records are not
     /// counted.
-    size_t MemoryBytes() const {
-        size_t n = 0;
-        for (const auto& q : queues_)
-            n += q->memory_size.load(std::memory_order_relaxed) * sizeof(R);
-        return n;
+    size_t MemoryBytes() const { return in_memory_.load(std::memory_order_relaxed) * sizeof(R); }
+    /// The most MemoryBytes has been, at any moment.
+    size_t PeakMemoryBytes() const {
+        return peak_in_memory_.load(std::memory_order_relaxed) * sizeof(R);
     }
 
   private:
@@ -178,6 +175,25 @@ class BrickQueues {
         std::atomic<size_t> memory_size{0};  // in_memory, for other threads
     };
     std::vector<std::unique_ptr<Queue>> queues_;
+    std::atomic<size_t> in_memory_{0};       // records in memory over all queues
+    std::atomic<size_t> peak_in_memory_{0};  // the most in_memory_ has been
+
+    /// Publishes q's counts to other threads (under q.mutex) and keeps the totals over all queues.
+    void Publish(Queue& q) {
+        q.size.store(q.count, std::memory_order_relaxed);
+        const size_t before = q.memory_size.exchange(q.in_memory, std::memory_order_relaxed);
+        if (q.in_memory >= before) {
+            const size_t now =
+                in_memory_.fetch_add(q.in_memory - before, std::memory_order_relaxed) +
+                (q.in_memory - before);
+            size_t peak = peak_in_memory_.load(std::memory_order_relaxed);
+            while (now > peak &&
+                   !peak_in_memory_.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
+            }
+        } else {
+            in_memory_.fetch_sub(before - q.in_memory, std::memory_order_relaxed);
+        }
+    }
 };
 
 }  // namespace nave::render

@@ -489,6 +489,7 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Int("max_depth", &s->max_depth, 1, 1000));
     NAVE_RETURN_IF_ERROR(r.Int("seed", &s->seed, 0, INT64_MAX));
     NAVE_RETURN_IF_ERROR(r.Int("threads", &s->threads, 0, 4096));
+    s->wave_paths_chosen = r.Has("wave_paths");
     NAVE_RETURN_IF_ERROR(r.Int("wave_paths", &s->wave_paths, 1024, int64_t(1) << 30));
     NAVE_RETURN_IF_ERROR(r.Choice("photon_target", {{"bounds", RenderSettings::PhotonTarget::kBounds},
                                                     {"portals", RenderSettings::PhotonTarget::kPortals}},

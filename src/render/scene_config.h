@@ -112,6 +112,9 @@ struct RenderSettings {
     uint64_t seed = 1;
     int threads = 0;                 ///< 0: all cores
     uint32_t wave_paths = 1u << 20;  ///< camera paths in flight at once
+    /// Whether the config or the command line set wave_paths; if not, `nave render --memory` may
+    /// choose it (WavePathsUnderPaging, pager.h).
+    bool wave_paths_chosen = false;
     /// Where photons from the sun and directional lights are aimed: the model's bounds projected onto the
     /// light's direction, or the triangles of materials marked `portal` (windows) only.
     enum class PhotonTarget { kBounds, kPortals };

@@ -44,7 +44,8 @@ Status SppmIntegrator::Run(RenderStats* stats) {
         // only. So the queues hold camera paths and their shadow rays, then photons, never both,
         // and each pass is drained by its own processor.
         for (uint64_t first = 0; first < pixels; first += wave) {
-            camera_paths.GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda);
+            NAVE_RETURN_IF_ERROR(
+                camera_paths.GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(
                 camera_paths, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
         }

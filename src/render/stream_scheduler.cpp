@@ -126,7 +126,6 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
             pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, source_);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
             << "the brick picker chose brick " << b << " which has no rays waiting";
-        peak_queue_bytes_ = std::max<uint64_t>(peak_queue_bytes_, queues_.MemoryBytes());
         // If b must be loaded now, the loader loads the next brick meanwhile: two loads at once
         // while the workers would idle anyway.
         if (pager_ && !source_.IsResident(b)) pager_->Prefetch(waiting, b, 0);
@@ -157,6 +156,13 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         }
     }
     return Status::Ok();
+}
+
+Status StreamScheduler::SpillIfOverCap() {
+    if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
+    std::vector<size_t> waiting(queues_.brick_count());
+    for (uint32_t i = 0; i < queues_.brick_count(); ++i) waiting[i] = queues_.Waiting(i);
+    return SpillQueues(waiting);
 }
 
 Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
@@ -203,7 +209,8 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
     stats->brick_moves = moves_.load();
     stats->rays = rays_.load();
     stats->batches = batches_.load();
-    stats->peak_queue_bytes = std::max(stats->peak_queue_bytes, peak_queue_bytes_);
+    stats->peak_queue_bytes =
+        std::max<uint64_t>(stats->peak_queue_bytes, queues_.PeakMemoryBytes());
     stats->brick_loads = after.loads - before.loads;
     stats->bytes_read = after.bytes_read - before.bytes_read;
     stats->brick_acquires = after.acquires - before.acquires;

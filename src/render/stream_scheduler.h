@@ -94,6 +94,14 @@ class StreamScheduler {
     /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty), tracing
     /// every batch with `processor`. Errors: a brick that cannot be pinned.
     Status Drain(RayProcessor& processor, size_t stop_below = 0);
+    /// Spills queues to disk if they hold more than the queue memory cap (a no-op without paging).
+    /// For the integrators between chunks of a wave's new rays, so that a wave larger than the cap
+    /// is spilled as it is generated rather than queued whole first. Not concurrent with Drain or
+    /// Flush.
+    Status SpillIfOverCap();
+    /// New rays (camera paths, photons) to generate between two SpillIfOverCap calls: as many as a
+    /// batch takes, for which the queue reserve has room (RenderReserveBytes).
+    size_t generate_chunk() const { return max_batch_; }
     /// Rays left waiting when the next wave is generated: under paging the next wave joins the tail
     /// of the previous one, whose few scattered rays would otherwise cost a load each
     /// (docs/pager.md); in-core, waves do not overlap.
@@ -130,7 +138,6 @@ class StreamScheduler {
     std::unique_ptr<Pager> pager_;  // null: in-core
     double stall_seconds_ = 0;      // in-core
     TraceRecorder* trace_ = nullptr;
-    uint64_t peak_queue_bytes_ = 0;
     std::atomic<uint64_t> segments_{0}, shadow_segments_{0}, moves_{0}, batches_{0}, rays_{0};
 };
 

@@ -16,6 +16,7 @@
 #include "core/memory.h"
 #include "core/progress.h"
 #include "render/procedural_meshes.h"
+#include "render/ray.h"
 #include "render_test_util.h"
 #include "store/store_reader.h"
 #include "store/store_writer.h"
@@ -93,13 +94,14 @@ struct Rendered {
 };
 
 Rendered RenderBallGrid(const std::string& mode, const PagerOptions* paging, int threads = 2,
-                        uint32_t wave_paths = 0) {
+                        uint32_t wave_paths = 0, int spp = 0) {
     Rendered r;
     r.source = BallGridSource();
     auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), mode), "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     config->render.threads = threads;
     if (wave_paths > 0) config->render.wave_paths = wave_paths;
+    if (spp > 0) config->render.spp = spp;
     auto scene = BuildRenderScene(*config, *r.source);
     EXPECT_TRUE(scene.ok()) << scene.status().ToString();
     r.film = std::make_unique<Film>(config->camera.width, config->camera.height, config->output);
@@ -160,6 +162,24 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
             EXPECT_EQ(paged.stats.cache_bricks_written, 0u);
         }
     }
+}
+
+TEST_F(PagerTest, AWaveLargerThanTheQueueMemorySpillsAsItIsGenerated) {
+    // 32x24 pixels at 64 spp in one wave: 49 152 camera paths, 5.3 MiB of records, where the queues
+    // may hold 64 KiB and what the reserve allows beyond (RenderReserveBytes).
+    Rendered in_core = RenderBallGrid("path", nullptr, 2, 1 << 20, 64);
+    ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
+    PagerOptions options = SmallBudget(*in_core.source);
+    options.queue_memory_bytes = 64 << 10;
+    Rendered paged = RenderBallGrid("path", &options, 2, 1 << 20, 64);
+    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
+    const uint64_t bound = options.queue_memory_bytes +
+                           3 * MaxBatchRays(options.queue_memory_bytes) * sizeof(RayRecord);
+    ASSERT_GT(paged.stats.camera_paths * sizeof(RayRecord), 2 * bound)
+        << "the wave should exceed the bound";
+    EXPECT_LE(paged.stats.peak_queue_bytes, bound);
+    EXPECT_GT(paged.stats.spilled_rays, paged.stats.camera_paths / 2);
+    EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
@@ -555,6 +575,25 @@ TEST(PagerCliTest, WholeProcessPeakStaysWithinTheBudget) {
             << r.output;
     }
     std::filesystem::remove_all(dir);
+}
+
+TEST(PagerWaves, UnderPagingAPathRenderIsOneWaveUnlessTheUserChose) {
+    RenderSettings s;
+    s.mode = RenderSettings::Mode::kPath;
+    s.spp = 4;
+    // 640x427 at 4 spp: one wave of every path.
+    EXPECT_EQ(WavePathsUnderPaging(s, 640, 427), 640u * 427u * 4u);
+    // Never below the default wave, never above the cap.
+    EXPECT_EQ(WavePathsUnderPaging(s, 16, 16), s.wave_paths);
+    s.spp = 1024;
+    EXPECT_EQ(WavePathsUnderPaging(s, 1920, 1080), kMaxPagedWavePaths);
+    // The user's choice (config or --wave-paths) stands, and photon mode keeps its waves.
+    s.wave_paths_chosen = true;
+    s.wave_paths = 5000;
+    EXPECT_EQ(WavePathsUnderPaging(s, 640, 427), 5000u);
+    s.wave_paths_chosen = false;
+    s.mode = RenderSettings::Mode::kPhoton;
+    EXPECT_EQ(WavePathsUnderPaging(s, 640, 427), 5000u);
 }
 
 }  // namespace
