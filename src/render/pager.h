@@ -85,8 +85,7 @@ uint64_t QueueMemoryBytes(uint64_t brick_budget_bytes);
 /// The camera paths per wave when paging with spilled queues and the user chose none: the whole
 /// image (all its passes) in one wave, at most kMaxPagedWavePaths. One wave has one tail, the few
 /// deep bounces scattered over every brick that cost a load each; the camera rays of a wave beyond
-/// the queue memory spill as they are generated. On the detail-110 abbey at 2G: 58.7 s with waves
-/// of 1 M paths, 48.2 s with one wave of 1.09 M (docs/pager.md). Path mode only: photon mode's
+/// the queue memory spill as they are generated (docs/pager.md). Path mode only: photon mode's
 /// camera and photon passes are drained separately each iteration anyway.
 inline constexpr uint64_t kMaxPagedWavePaths = uint64_t(16) << 20;
 uint32_t WavePathsUnderPaging(const RenderSettings& settings, int width, int height);
