@@ -14,9 +14,11 @@
 namespace nave::preprocess {
 
 /// Triangles per brick when none is asked for and the budget allows. Measured on the detail-110
-/// abbey under --memory 2G: 200 k-triangle bricks rendered in 90 s, 700 k-triangle ones in 108 s
-/// (in-core 47 s and 39 s: smaller bricks page better, cost more visits; docs/pager.md).
-inline constexpr uint64_t kDefaultBrickTriangles = 200'000;
+/// abbey (docs/pager.md, "At scale"): with 700 k-triangle bricks the render stays within --memory
+/// (2G: 59.0 s, 1G: 69.1 s, in-core 31.9 s); with 200 k ones it pages in about the same time (53.1
+/// s, 67.0 s) but in-core takes 40.7 s and the process goes up to 307 MiB over --memory (Embree's
+/// BVHs of many sizes fragment the heap). Preprocessing takes the same time (1 min 30 s).
+inline constexpr uint64_t kDefaultBrickTriangles = 700'000;
 /// The smallest brick size preprocess accepts.
 inline constexpr uint64_t kMinBrickTriangles = 1000;
 
