@@ -119,7 +119,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
 
     std::unique_ptr<TriangleSource> source;
     if (!options.generate.empty()) {
-        NAVE_ASSIGN_OR_RETURN(source, OpenGenerator(options.generate));
+        NAVE_ASSIGN_OR_RETURN(source, OpenGenerator(options.generate, stats.threads));
     } else {
         NAVE_ASSIGN_OR_RETURN(source, OpenModels(options.inputs));
     }

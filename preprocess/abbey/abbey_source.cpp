@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/glass_textures.h"
@@ -17,13 +19,18 @@ namespace nave::preprocess {
 namespace {
 
 constexpr size_t kBatchTriangles = 1 << 14;
-constexpr size_t kQueueBatches = 4;  // bounded: at most ~4 x 16 K triangles waiting
+constexpr size_t kQueueBatches = 4;  // per part in flight: at most ~4 x 16 K triangles waiting
 
 class AbbeySource final : public TriangleSource {
   public:
-    explicit AbbeySource(double detail) : detail_(detail), materials_(abbey::AbbeyMaterials()) {
-        parts_total_ = abbey::AbbeyParts(abbey::Detail(detail_)).size();
-        producer_ = std::thread([this] { Produce(); });
+    AbbeySource(double detail, int threads)
+        : detail_(detail),
+          materials_(abbey::AbbeyMaterials()),
+          parts_(abbey::AbbeyParts(abbey::Detail(detail))),
+          channels_(parts_.size()) {
+        if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+        threads = int(std::min<size_t>(size_t(threads), std::max<size_t>(1, parts_.size())));
+        for (int t = 0; t < threads; ++t) producers_.emplace_back([this] { Produce(); });
     }
 
     ~AbbeySource() override {
@@ -32,7 +39,7 @@ class AbbeySource final : public TriangleSource {
             stop_ = true;
         }
         changed_.notify_all();
-        producer_.join();
+        for (std::thread& t : producers_) t.join();
     }
 
     StatusOr<bool> Next(std::vector<Triangle>& batch, size_t max_triangles) override {
@@ -42,10 +49,21 @@ class AbbeySource final : public TriangleSource {
                 pending_.clear();
                 pending_pos_ = 0;
                 std::unique_lock<std::mutex> lock(mutex_);
-                changed_.wait(lock, [&] { return !queue_.empty() || done_; });
-                if (queue_.empty()) break;
-                pending_ = std::move(queue_.front());
-                queue_.pop_front();
+                // The parts in order: the current one until its producer is done with it.
+                for (;;) {
+                    if (current_ == parts_.size()) break;
+                    Channel& c = channels_[current_];
+                    if (!c.batches.empty()) break;
+                    if (c.done) {
+                        ++current_;
+                        parts_done_.fetch_add(1);
+                        continue;
+                    }
+                    changed_.wait(lock);
+                }
+                if (current_ == parts_.size()) break;
+                pending_ = std::move(channels_[current_].batches.front());
+                channels_[current_].batches.pop_front();
                 changed_.notify_all();
             }
             size_t n = std::min(max_triangles - batch.size(), pending_.size() - pending_pos_);
@@ -63,61 +81,78 @@ class AbbeySource final : public TriangleSource {
         return abbey::WriteGlassTextures(dir);
     }
     uint64_t progress_done() const override { return parts_done_.load(); }
-    uint64_t progress_total() const override { return parts_total_; }
+    uint64_t progress_total() const override { return parts_.size(); }
     uint64_t memory_bytes() const override {
-        return (kQueueBatches + 3) * kBatchTriangles * sizeof(Triangle);
+        return (producers_.size() * (kQueueBatches + 1) + 2) * kBatchTriangles * sizeof(Triangle);
     }
     const ImportWarnings& warnings() const override { return warnings_; }
 
   private:
     struct Stopped {};
+    /// The batches of one part, from its producer to Next.
+    struct Channel {
+        std::deque<std::vector<Triangle>> batches;
+        bool done = false;
+    };
 
+    /// Takes the next part nobody has taken, generates it into its channel; until none is left.
+    /// A producer waits while its part's channel is full; the part being handed on always drains,
+    /// and every part before it is done, so some producer can always go on.
     void Produce() {
         try {
-            abbey::Emitter em(
-                [this](std::vector<Triangle>& batch) {
-                    std::unique_lock<std::mutex> lock(mutex_);
-                    changed_.wait(lock, [&] { return queue_.size() < kQueueBatches || stop_; });
-                    if (stop_) throw Stopped{};
-                    queue_.push_back(std::move(batch));
-                    batch = std::vector<Triangle>();
-                    batch.reserve(kBatchTriangles);
-                    changed_.notify_all();
-                },
-                kBatchTriangles);
-            for (const abbey::AbbeyPart& part : abbey::AbbeyParts(abbey::Detail(detail_))) {
-                part.emit(em);
-                parts_done_.fetch_add(1);
+            for (;;) {
+                size_t part;
+                {
+                    std::lock_guard<std::mutex> lock(mutex_);
+                    if (stop_ || next_part_ == parts_.size()) return;
+                    part = next_part_++;
+                }
+                abbey::Emitter em(
+                    [this, part](std::vector<Triangle>& batch) {
+                        std::unique_lock<std::mutex> lock(mutex_);
+                        changed_.wait(lock, [&] {
+                            return channels_[part].batches.size() < kQueueBatches || stop_;
+                        });
+                        if (stop_) throw Stopped{};
+                        channels_[part].batches.push_back(std::move(batch));
+                        batch = std::vector<Triangle>();
+                        batch.reserve(kBatchTriangles);
+                        changed_.notify_all();
+                    },
+                    kBatchTriangles);
+                parts_[part].emit(em);
+                em.Flush();
+                std::lock_guard<std::mutex> lock(mutex_);
+                channels_[part].done = true;
+                changed_.notify_all();
             }
-            em.Flush();
         } catch (const Stopped&) {
         }
-        std::lock_guard<std::mutex> lock(mutex_);
-        done_ = true;
-        changed_.notify_all();
     }
 
     double detail_;
     std::vector<store::MaterialRecord> materials_;
     ImportWarnings warnings_;
-    uint64_t parts_total_ = 0;
+    const std::vector<abbey::AbbeyPart> parts_;
     std::atomic<uint64_t> parts_done_{0};
     std::mutex mutex_;
     std::condition_variable changed_;
-    std::deque<std::vector<Triangle>> queue_;
-    bool stop_ = false, done_ = false;
+    std::vector<Channel> channels_;  // by part
+    size_t next_part_ = 0;           // the next part a producer takes
+    size_t current_ = 0;             // the part Next hands on
+    bool stop_ = false;
     std::vector<Triangle> pending_;
     size_t pending_pos_ = 0;
-    std::thread producer_;
+    std::vector<std::thread> producers_;
 };
 
 }  // namespace
 
-std::unique_ptr<TriangleSource> MakeAbbeySource(double detail) {
-    return std::make_unique<AbbeySource>(detail);
+std::unique_ptr<TriangleSource> MakeAbbeySource(double detail, int threads) {
+    return std::make_unique<AbbeySource>(detail, threads);
 }
 
-StatusOr<std::unique_ptr<TriangleSource>> OpenGenerator(const std::string& spec) {
+StatusOr<std::unique_ptr<TriangleSource>> OpenGenerator(const std::string& spec, int threads) {
     std::string_view text = spec;
     auto colon = text.find(':');
     std::string_view name = text.substr(0, colon);
@@ -140,7 +175,7 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGenerator(const std::string& spec)
         }
         detail = value;
     }
-    return MakeAbbeySource(detail);
+    return MakeAbbeySource(detail, threads);
 }
 
 }  // namespace nave::preprocess
