@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# The billion-triangle abbey end to end under one memory budget: generate and preprocess it, then
+# render it, each under --memory, and print each phase's time, the store's size, the temporary disk
+# and the whole process's peak RSS (/usr/bin/time -v) as a Markdown table.
+#
+#     bash bench/bench_billion.sh                      # detail 1250 (1.02 G triangles), 4G, 1920x1080
+#     bash bench/bench_billion.sh --detail 1 --resolution 160x107 --spp 1 --memory 1G   # the script in a minute
+#
+# Defaults: detail 1250, --memory 4G for both phases, configs/abbey.toml, path mode, 1920x1080, 4 spp.
+# Everything goes under --dir (default /tmp/nave-billion): the store of detail 1250 takes about 2.2 GB
+# (2.11 bytes per triangle), the preprocess's temporary files about 17 GB at their peak (1.44 GiB at
+# detail 110), the render's spill files a few GB. On a RAM file system they would count against memory.
+# An existing store of the same detail is reused (--fresh: generate it again).
+set -euo pipefail
+
+detail=1250
+memory=4G
+resolution=1920x1080
+spp=4
+mode=path
+config=configs/abbey.toml
+dir=/tmp/nave-billion
+fresh=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --detail) detail=$2; shift 2 ;;
+    --memory) memory=$2; shift 2 ;;
+    --resolution) resolution=$2; shift 2 ;;
+    --spp) spp=$2; shift 2 ;;
+    --mode) mode=$2; shift 2 ;;
+    --config) config=$2; shift 2 ;;
+    --dir) dir=$2; shift 2 ;;
+    --fresh) fresh=1; shift ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bench_billion.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+cd "$(dirname "$0")/.."
+nave=build/release/src/cli/nave
+if [ ! -x "$nave" ]; then
+  cmake --preset release >/dev/null && cmake --build --preset release -j"$(nproc)" --target nave
+fi
+if [ ! -x /usr/bin/time ]; then
+  echo "bench_billion.sh: needs GNU time (/usr/bin/time): run bash bench/setup-bench.sh" >&2
+  exit 1
+fi
+mkdir -p "$dir"
+store="$dir/abbey$detail.nave"
+
+# field LOG LABEL: the value after "LABEL:" in /usr/bin/time -v's report.
+field() { grep -F "$2:" "$1" | tail -1 | sed 's/.*: //'; }
+kib_to_gib() { awk -v k="$1" 'BEGIN { printf "%.2f GiB", k / 1048576 }'; }
+
+rows=()
+if [ "$fresh" = 1 ] || [ ! -f "$store" ]; then
+  echo "== preprocess: abbey detail $detail -> $store (--memory $memory)" >&2
+  log="$dir/preprocess.log"
+  /usr/bin/time -v "$nave" preprocess --generate "abbey:detail=$detail" --memory "$memory" -o "$store" 2>"$log"
+  disk=$(grep -F "on disk:" "$log" | tail -1 | sed 's/^ *on disk: *//')
+  rate=$(grep -F "time:" "$log" | tail -1 | sed 's/^ *time: *//')
+  rows+=("| preprocess | $(field "$log" "Elapsed (wall clock) time (h:mm:ss or m:ss)") | $(kib_to_gib "$(field "$log" "Maximum resident set size (kbytes)")") | $rate; $disk |")
+else
+  echo "== reusing $store (--fresh to generate it again)" >&2
+fi
+
+echo "== render: $mode, $spp spp, $resolution, --memory $memory" >&2
+log="$dir/render.log"
+/usr/bin/time -v "$nave" render "$store" --config "$config" --mode "$mode" --spp "$spp" \
+  --resolution "$resolution" --memory "$memory" --temp-dir "$dir" -o "$dir/abbey$detail.exr" 2>"$log"
+summary=$(grep -E "^  (time|rays moved|bricks:|ray queues:|brick cache:)" "$log" | sed 's/^ *//' | paste -sd ';' - | sed 's/;/; /g')
+rows+=("| render | $(field "$log" "Elapsed (wall clock) time (h:mm:ss or m:ss)") | $(kib_to_gib "$(field "$log" "Maximum resident set size (kbytes)")") | $summary |")
+
+echo
+echo "abbey detail $detail ($(du -h "$store" | cut -f1) store), --memory $memory; render $mode, $spp spp, $resolution, $config"
+echo
+echo "| phase | wall time | peak RSS | details |"
+echo "|---|---|---|---|"
+printf '%s\n' "${rows[@]}"
+echo
+echo "logs: $dir/preprocess.log, $dir/render.log; image: $dir/abbey$detail.png"
