@@ -34,7 +34,13 @@ Status PathIntegrator::Run(RenderStats* stats) {
     const uint64_t pixels = uint64_t(camera.width()) * camera.height();
     const int spp = scene_.settings.spp;
     const uint64_t wave = scene_.settings.wave_paths;
+    // Advanced by every path as it ends, on the workers: a wave can be the whole image.
     ProgressBar progress("render", pixels * uint64_t(spp), "paths");
+    progress_ = &progress;
+    struct Unset {
+        ProgressBar*& bar;
+        ~Unset() { bar = nullptr; }
+    } unset{progress_};  // before `progress` goes, whichever way Run returns
     auto start = std::chrono::steady_clock::now();
     int passes = 0;
     // Small images put several passes in one wave, so that the streams stay long enough to keep
@@ -47,7 +53,6 @@ Status PathIntegrator::Run(RenderStats* stats) {
             for (int k = s; k < s_end; ++k)
                 NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k), nullptr));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
-            progress.Add((last - first) * uint64_t(s_end - s));
         }
         passes = s_end;
         double elapsed =
@@ -119,11 +124,16 @@ void PathIntegrator::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& br
     }
     TraceInBrick(
         r, b, brick, scheduler_, out,
-        [&](RayRecord& path, const BrickHit& hit) { return ShadePath(path, b, brick, hit, out); },
+        [&](RayRecord& path, const BrickHit& hit) {
+            const bool goes_on = ShadePath(path, b, brick, hit, out);
+            if (!goes_on && progress_ != nullptr) progress_->Add(1);
+            return goes_on;
+        },
         [&](const RayRecord& path) { Escape(path); });
 }
 
 void PathIntegrator::Escape(const RayRecord& r) {
+    if (progress_ != nullptr) progress_->Add(1);  // the path ends here
     SampledSpectrum L;
     if (scene_.sky) {
         // The sky is also next-event estimated: weight the BSDF-sampled escape against it, at the

@@ -15,6 +15,10 @@
 #include "render/light_sampling.h"
 #include "render/ray.h"
 #include "render/scene.h"
+
+namespace nave {
+class ProgressBar;
+}
 #include "render/stream_scheduler.h"
 
 namespace nave::render {
@@ -73,6 +77,7 @@ class PathIntegrator final : public RayProcessor {
     VisiblePoints* visible_points_;  // photon mode
     uint32_t iteration_ = 0;
     const bool has_thin_glass_;
+    ProgressBar* progress_ = nullptr;  // during Run: counts the paths that end
 };
 
 }  // namespace nave::render
