@@ -15,11 +15,11 @@
 #include "render/light_sampling.h"
 #include "render/ray.h"
 #include "render/scene.h"
+#include "render/stream_scheduler.h"
 
 namespace nave {
 class ProgressBar;
 }
-#include "render/stream_scheduler.h"
 
 namespace nave::render {
 

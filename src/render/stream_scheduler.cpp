@@ -119,9 +119,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
             trace_->Counter("memory", {{"resident_bricks", source_.stats().resident_bytes},
                                        {"queues", queues_.MemoryBytes()}});
         }
-        if (queue_spill_ && queues_.MemoryBytes() > queue_memory_) {
-            NAVE_RETURN_IF_ERROR(SpillQueues(waiting));
-        }
+        NAVE_RETURN_IF_ERROR(SpillIfOverCap(waiting));
         const uint32_t b =
             pager_ && !custom_picker_ ? pager_->Pick(waiting) : picker_(waiting, source_);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
@@ -162,6 +160,11 @@ Status StreamScheduler::SpillIfOverCap() {
     if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
     std::vector<size_t> waiting(queues_.brick_count());
     for (uint32_t i = 0; i < queues_.brick_count(); ++i) waiting[i] = queues_.Waiting(i);
+    return SpillIfOverCap(waiting);
+}
+
+Status StreamScheduler::SpillIfOverCap(const std::vector<size_t>& waiting) {
+    if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
     return SpillQueues(waiting);
 }
 

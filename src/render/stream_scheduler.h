@@ -99,8 +99,8 @@ class StreamScheduler {
     /// is spilled as it is generated rather than queued whole first. Not concurrent with Drain or
     /// Flush.
     Status SpillIfOverCap();
-    /// New rays (camera paths, photons) to generate between two SpillIfOverCap calls: as many as a
-    /// batch takes, for which the queue reserve has room (RenderReserveBytes).
+    /// Camera paths to generate between two SpillIfOverCap calls: as many as a batch takes, for
+    /// which the queue reserve has room (RenderReserveBytes).
     size_t generate_chunk() const { return max_batch_; }
     /// Rays left waiting when the next wave is generated: under paging the next wave joins the tail
     /// of the previous one, whose few scattered rays would otherwise cost a load each
@@ -123,6 +123,8 @@ class StreamScheduler {
     BrickQueues<RayRecord> queues_;
     LocalRayExchange local_exchange_{queues_};
     RayExchange& exchange_ = local_exchange_;  // every ray leaving a batch goes through here
+    /// SpillIfOverCap with the rays waiting per brick already counted.
+    Status SpillIfOverCap(const std::vector<size_t>& waiting);
     /// Spills queues of bricks that are not resident until their memory is below half the cap.
     Status SpillQueues(const std::vector<size_t>& waiting);
 
