@@ -37,8 +37,8 @@ while [ $# -gt 0 ]; do
 done
 
 cd "$(dirname "$0")/.."
-nave=build/release/src/cli/nave
-if [ ! -x "$nave" ]; then
+nave=${NAVE:-build/release/src/cli/nave}  # NAVE=path: a copy, so that rebuilding does not touch the run
+if [ ! -x "$nave" ] && [ -z "${NAVE:-}" ]; then
   cmake --preset release >/dev/null && cmake --build --preset release -j"$(nproc)" --target nave
 fi
 if [ ! -x /usr/bin/time ]; then

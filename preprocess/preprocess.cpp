@@ -43,8 +43,10 @@ constexpr uint64_t kFixedBytes = 48ull << 20;
 std::string OptionsText(const PreprocessOptions& o, uint64_t brick_triangles, uint64_t budget,
                         double step, int threads, const std::string& units) {
     return fmt::format(
-        "brick-triangles={} memory={} precision={} threads={} draco-speed={} units={}",
-        brick_triangles, budget, step, threads, o.encode.draco_speed, units);
+        "brick-triangles={} memory={} precision={} threads={} draco-speed={} "
+        "derived-normal-error={} verify-every={} units={}",
+        brick_triangles, budget, step, threads, o.encode.draco_speed,
+        o.encode.derived_normal_error_deg, o.verify_every, units);
 }
 
 /// Removes the texture folder of a run that fails, unless it existed before the run (it may hold textures an
@@ -303,11 +305,15 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 std::filesystem::remove(leaf->file, ec);
                 const BuiltBrick& built = builder.Build(triangles, grid);
                 std::optional<store::EncodedBrick> encoded;
+                store::EncodeOptions encode = options.encode;
+                encode.verify = options.verify_every > 0 && index % options.verify_every == 0;
                 if (!built.mesh.indices.empty()) {
-                    NAVE_ASSIGN_OR_RETURN(encoded, store::EncodeBrick(built.mesh, leaf->cell, grid, options.encode));
+                    NAVE_ASSIGN_OR_RETURN(encoded,
+                                          store::EncodeBrick(built.mesh, leaf->cell, grid, encode));
                 }
                 std::lock_guard<std::mutex> lock(mutex);
                 stats.collapsed_triangles += built.collapsed_triangles;
+                stats.verified_bricks += encoded.has_value() && encode.verify;
                 finished.emplace(index, std::move(encoded));
                 return append_ready();
             }();
@@ -355,14 +361,14 @@ std::string FormatSummary(const PreprocessStats& s) {
     std::string out = fmt::format(
         "input:       {} ({} triangles, units: {})\n"
         "bricks:      {} (+{} empty cells), {} stored triangles, {} duplicated across cells "
-        "({:.2f} %)\n"
+        "({:.2f} %); {} decoded again to check them\n"
         "grid:        step {:.6g}, max error {:.6g} (model units)\n"
         "on disk:     {} ({:.2f} bytes per input triangle); temporary files peaked at {}\n"
         "time:        {} (read {}, split {}, encode {}), {} triangles/s on {} threads\n"
         "memory:      peak {} of a {} budget (importer held {})",
         s.source_name, FormatCount(double(s.source_triangles)), s.units, s.bricks, s.empty_cells,
         FormatCount(double(s.stored_triangles)), FormatCount(double(s.duplicated_triangles)), dup,
-        s.grid_step, s.max_error, FormatBytes(s.output_bytes),
+        s.verified_bricks, s.grid_step, s.max_error, FormatBytes(s.output_bytes),
         s.source_triangles ? double(s.output_bytes) / double(s.source_triangles) : 0.0,
         FormatBytes(s.peak_temp_bytes), FormatDuration(s.seconds), FormatDuration(s.read_seconds),
         FormatDuration(s.split_seconds), FormatDuration(s.encode_seconds),

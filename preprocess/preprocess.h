@@ -34,6 +34,9 @@ struct PreprocessOptions {
     int threads = 0;                 ///< 0: all hardware threads
     std::filesystem::path temp_dir;  ///< parent of the temporary directory; empty: beside output
     store::EncodeOptions encode;
+    /// Decode every n-th brick (and the first) after encoding to check it (EncodeOptions::verify);
+    /// 1 checks them all, 0 none. `nave verify` checks a whole store later.
+    uint32_t verify_every = 1;
     /// Convert the textures the materials name (texture_convert.h); false drops every texture slot.
     bool convert_textures = true;
     std::string tool_version = "nave";
@@ -46,6 +49,7 @@ struct PreprocessStats {
     uint64_t duplicated_triangles = 0;  ///< references beyond the first of triangles crossing cells
     uint64_t collapsed_triangles = 0;   ///< dropped because the grid snapped two corners together
     uint64_t bricks = 0, empty_cells = 0, oversized_bricks = 0;
+    uint64_t verified_bricks = 0;  ///< decoded and compared after encoding (verify_every)
     uint64_t output_bytes = 0, peak_temp_bytes = 0;
     double grid_step = 0, max_error = 0;
     uint64_t memory_budget = 0, peak_rss = 0, source_memory = 0;

@@ -15,6 +15,9 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/key_table.h"
+#include "store/face_shading.h"
+
 namespace nave::store::codec {
 namespace {
 
@@ -29,10 +32,6 @@ constexpr draco::GeometryAttribute::Type kUvType = draco::GeometryAttribute::TEX
 // reordering, so a face's material is the value at any of its corners (Draco splits a vertex shared
 // by two materials).
 constexpr draco::GeometryAttribute::Type kMaterialType = draco::GeometryAttribute::GENERIC;
-// A face is flat when every corner normal is within 0.8 degrees of its geometric normal (cos >=
-// 0.9999): ten-bit octahedral normals, what smooth faces keep, already err by up to ~0.2 degrees.
-constexpr double kFlatCosine = 0.9999;
-
 Vec3f Normalized(const Vec3f& n) {
     const double len = std::sqrt(double(n.x) * n.x + double(n.y) * n.y + double(n.z) * n.z);
     return {float(n.x / len), float(n.y / len), float(n.z / len)};
@@ -89,6 +88,59 @@ Status CopyFloatValues(const draco::PointAttribute& att, uint32_t point_count,
     return Status::Ok();
 }
 
+/// Sets the normals of a decoded brick's derived faces (face_shading.h): per point, the
+/// angle-weighted normals of its faces that count (stored or derived), then added up per (grid
+/// point, material, smoothing group) as the encoder did (ChooseFaceShading), not per Draco point,
+/// since Draco splits a point at a non-manifold vertex; normalised into the derived faces' points.
+Status DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
+                     const PlainAttribute& values, std::vector<Vec3f>* normals) {
+    enum : uint8_t { kNotCounted = 0, kCounted = 1, kDerived = 2 };
+    const uint32_t point_count = dm.num_points();
+    std::vector<uint8_t> role(point_count, kNotCounted);
+    std::vector<Vec3f> point_sum(point_count, Vec3f(0, 0, 0));
+    auto grid_point = [&](uint32_t p) {
+        const int32_t* v = positions.Value<int32_t>(p);
+        return Vec3i(v[0], v[1], v[2]);
+    };
+    for (uint32_t f = 0; f < dm.num_faces(); ++f) {
+        const draco::Mesh::Face& face = dm.face(draco::FaceIndex(f));
+        const int shading = *values.Value<int32_t>(face[0].value()) & 3;
+        if (shading != kShadingDerived && shading != kShadingStored) continue;
+        const uint32_t p[3] = {face[0].value(), face[1].value(), face[2].value()};
+        const auto w = AngleWeightedNormals(grid_point(p[0]), grid_point(p[1]), grid_point(p[2]));
+        for (int c = 0; c < 3; ++c) {
+            point_sum[p[c]] += Vec3f(w[c]);
+            role[p[c]] = shading == kShadingDerived ? kDerived : kCounted;
+        }
+    }
+    struct SiteKey {
+        int32_t x, y, z, material_and_group;
+    };
+    KeyTable<SiteKey> sites;
+    sites.Reset(point_count);
+    std::vector<uint32_t> site_of_point(point_count);
+    std::vector<Vec3f> site_sum;
+    for (uint32_t p = 0; p < point_count; ++p) {
+        if (role[p] == kNotCounted) continue;
+        const Vec3i g = grid_point(p);
+        bool inserted = false;
+        const uint32_t site =
+            sites.Insert({g.x, g.y, g.z, *values.Value<int32_t>(p) >> 2}, &inserted);
+        if (inserted) site_sum.emplace_back(0, 0, 0);
+        site_sum[site] += point_sum[p];
+        site_of_point[p] = site;
+    }
+    for (uint32_t p = 0; p < point_count; ++p) {
+        if (role[p] != kDerived) continue;
+        const Vec3f& n = site_sum[site_of_point[p]];
+        const float length = Length(n);
+        // Zero only if the faces cancel, which the encoder rules out: fall back to the geometric
+        // normal rather than divide by zero.
+        (*normals)[p] = length > 0 ? n / length : Vec3f(0, 0, 0);
+    }
+    return Status::Ok();
+}
+
 }  // namespace
 
 uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
@@ -99,7 +151,8 @@ uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_n
 }
 
 StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
-                                        const EncodeOptions& options) {
+                                        const EncodeOptions& options,
+                                        const Bounds3f& complete_within) {
     if (!(grid.step > 0) || !std::isfinite(grid.step) || !IsFinite(grid.origin)) {
         return InvalidArgumentError(
             "invalid grid: origin {}, step {} (the step must be finite and > 0)",
@@ -107,6 +160,10 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     }
     if (options.draco_speed < 0 || options.draco_speed > 10) {
         return InvalidArgumentError("draco speed {} out of range [0, 10]", options.draco_speed);
+    }
+    if (!(options.derived_normal_error_deg >= 0 && options.derived_normal_error_deg <= 10)) {
+        return InvalidArgumentError("derived normal error {} degrees out of range [0, 10]",
+                                    options.derived_normal_error_deg);
     }
     if (options.normal_bits < 2 || options.normal_bits > 30 || options.uv_bits < 1 ||
         options.uv_bits > 30) {
@@ -179,112 +236,92 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
                                     out.max_material_id, kMaxMaterialId);
     }
 
-    // 4. Flat faces: a face whose corner normals all lie along its geometric normal (within
-    // kFlatCosine) needs no normals, since the renderer falls back to the geometric normal. Its
-    // corners are then joined by grid point (and texture coordinates) rather than by input vertex,
-    // so the faces of faceted stones, whose inputs split every corner by normal, share their
-    // vertices again: fewer points to decode, store and keep resident (docs/store-format.md).
-    std::vector<uint8_t> flat(kept.size(), 1);
-    size_t flat_count = kept.size();
-    if (mesh.HasNormals()) {
-        flat_count = 0;
-        for (size_t k = 0; k < kept.size(); ++k) {
-            const uint32_t* corner = &mesh.indices[3 * size_t(kept[k])];
-            const Vec3i &q0 = q[corner[0]], &q1 = q[corner[1]], &q2 = q[corner[2]];
-            const double e1[3] = {double(q1.x) - q0.x, double(q1.y) - q0.y, double(q1.z) - q0.z};
-            const double e2[3] = {double(q2.x) - q0.x, double(q2.y) - q0.y, double(q2.z) - q0.z};
-            const double ng[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                                  e1[0] * e2[1] - e1[1] * e2[0]};
-            const double ng_len = std::sqrt(ng[0] * ng[0] + ng[1] * ng[1] + ng[2] * ng[2]);
-            bool is_flat = ng_len > 0;
-            for (int c = 0; c < 3 && is_flat; ++c) {
-                const Vec3f& n = mesh.normals[corner[c]];
-                const double n_len =
-                    std::sqrt(double(n.x) * n.x + double(n.y) * n.y + double(n.z) * n.z);
-                const double cosine = (ng[0] * n.x + ng[1] * n.y + ng[2] * n.z) / (ng_len * n_len);
-                is_flat = std::fabs(cosine) >= kFlatCosine;  // the renderer orients by winding
-            }
-            flat[k] = uint8_t(is_flat);
-            flat_count += flat[k];
-        }
+    // 4. Shading (docs/store-format.md, "Shading"; face_shading.h): faces whose normals are their
+    // geometric normal (flat) or can be recomputed from the positions (derived) store none, and
+    // their corners are joined by (grid point, material value, uv) rather than by input vertex, so
+    // surfaces whose inputs split every corner by normal share their vertices again: fewer points
+    // to decode, store and keep resident.
+    // In grid steps, shrunk by two: a vertex's snapped position may lie half a step outside the
+    // box its unsnapped one was tested against, and the box's float bounds round too.
+    Bounds3i complete_cell;
+    for (int a = 0; a < 3; ++a) {
+        auto to_grid = [&](float x, double toward) {
+            const double t =
+                std::clamp((double(x) - grid.origin[a]) / grid.step, -kLimit + 4, kLimit - 4);
+            return int32_t(std::lround(t + toward));
+        };
+        complete_cell.min[a] = to_grid(complete_within.min[a], 2.0);
+        complete_cell.max[a] = to_grid(complete_within.max[a], -2.0);
     }
-    out.has_normals = mesh.HasNormals() && flat_count < kept.size();
-    // Flat faces are marked in the material attribute only when some faces keep normals.
-    const bool mark_flat = out.has_normals && flat_count > 0;
+    const FaceShading shading = ChooseFaceShading(mesh, kept, q, position_value, complete_cell,
+                                                  options.derived_normal_error_deg);
+    const size_t stored_count = shading.stored_count;
+    // The decoded mesh has normals when some face is not flat; the material attribute then holds
+    // each face's shading and smoothing group.
+    out.has_normals = mesh.HasNormals() && shading.flat_count < kept.size();
+    auto material_value = [&](size_t k) {
+        const uint32_t material = mesh.material_ids[kept[k]];
+        return out.has_normals
+                   ? material << 4 | uint32_t(shading.group[k]) << 2 | shading.shading[k]
+                   : material;
+    };
 
-    // 5. Points: a smooth face's corner is one point per (input vertex, material) pair (its normal
-    // and uv are the vertex's); a flat face's corner is one point per (grid point, material, uv).
-    // A point is never shared by a flat and a smooth face (their material values differ when
-    // marked), so decoding can clear the normals of flat faces' points.
+    // 5. Points: a stored face's corner is one point per (input vertex, material value) pair (its
+    // normal and uv are the vertex's); a flat or derived face's corner is one point per (grid
+    // point, material value, uv). A point is never shared by faces of two shadings (their material
+    // values differ), so decoding knows each point's normal.
     constexpr uint32_t kUnset = 0xffffffffu;
-    std::vector<uint32_t> point_of_vertex(vertex_count, kUnset);
-    std::vector<uint32_t> material_of_vertex(vertex_count, 0);
+    std::vector<uint32_t> point_of_vertex(stored_count > 0 ? vertex_count : 0, kUnset);
+    std::vector<uint32_t> value_of_vertex(stored_count > 0 ? vertex_count : 0, 0);
     std::unordered_map<uint64_t, uint32_t> extra_points;
-    // Flat corners' points by (grid point, material, uv): open addressing with linear probing
-    // (std::unordered_map allocated a node per point). At most 3 points per flat face, so a table of
-    // 4 slots per flat face is at most three quarters full.
-    struct FlatKey {
-        uint32_t position, material;
-        uint64_t uv_bits;
-        bool operator==(const FlatKey& o) const {
-            return position == o.position && material == o.material && uv_bits == o.uv_bits;
-        }
+    struct CornerKey {
+        uint32_t position, value, uv[2];
     };
-    struct FlatEntry {
-        FlatKey key;
-        uint32_t point;
-    };
-    std::vector<FlatEntry> flat_entries;
-    size_t flat_slots = 16;
-    while (flat_slots < 4 * flat_count + 16) flat_slots <<= 1;
-    std::vector<uint32_t> flat_table(flat_count > 0 ? flat_slots : 0, kUnset);  // index into flat_entries
-    std::vector<uint32_t> point_vertex, point_material;
-    std::vector<uint8_t> point_flat;
+    KeyTable<CornerKey> corner_keys;
+    corner_keys.Reset(3 * (kept.size() - stored_count));
+    std::vector<uint32_t> point_of_key;
+    std::vector<uint32_t> point_vertex, point_value;
+    std::vector<uint8_t> point_shading;
     std::vector<uint32_t> faces(3 * kept.size());
     Vec3i lo{std::numeric_limits<int32_t>::max(), std::numeric_limits<int32_t>::max(),
              std::numeric_limits<int32_t>::max()};
     Vec3i hi{std::numeric_limits<int32_t>::min(), std::numeric_limits<int32_t>::min(),
              std::numeric_limits<int32_t>::min()};
-    auto new_point = [&](uint32_t v, uint32_t material, bool is_flat) {
+    auto new_point = [&](uint32_t v, uint32_t value, uint8_t face_shading) {
         point_vertex.push_back(v);
-        point_material.push_back(material);
-        point_flat.push_back(uint8_t(is_flat));
+        point_value.push_back(value);
+        point_shading.push_back(face_shading);
         lo = Min(lo, q[v]);
         hi = Max(hi, q[v]);
         return uint32_t(point_vertex.size() - 1);
     };
     for (size_t k = 0; k < kept.size(); ++k) {
         const uint32_t t = kept[k];
-        const uint32_t material = mesh.material_ids[t];
+        const uint32_t value = material_value(k);
+        const uint8_t face_shading = shading.shading[k];
+        const bool stored = face_shading == kShadingStored || face_shading == kShadingStoredApart;
         for (int c = 0; c < 3; ++c) {
             const uint32_t v = mesh.indices[3 * size_t(t) + c];
             uint32_t point;
-            if (flat[k]) {
-                uint64_t uv_bits = 0;
-                if (out.has_uvs) std::memcpy(&uv_bits, mesh.uvs[v].data(), sizeof(uv_bits));
-                const FlatKey key{position_value[v], material, uv_bits};
-                uint64_t h = (uint64_t(key.position) << 32 | key.material) * 0x9e3779b97f4a7c15ull;
-                h ^= (key.uv_bits + 0x7f4a7c159e3779b9ull + (h << 6) + (h >> 2)) * 0xbf58476d1ce4e5b9ull;
-                size_t slot = size_t(h ^ (h >> 31)) & (flat_slots - 1);
-                while (flat_table[slot] != kUnset && !(flat_entries[flat_table[slot]].key == key))
-                    slot = (slot + 1) & (flat_slots - 1);
-                if (flat_table[slot] == kUnset) {
-                    flat_table[slot] = uint32_t(flat_entries.size());
-                    flat_entries.push_back({key, new_point(v, material, true)});
-                }
-                point = flat_entries[flat_table[slot]].point;
+            if (!stored) {
+                CornerKey key{position_value[v], value, {0, 0}};
+                if (out.has_uvs) std::memcpy(key.uv, mesh.uvs[v].data(), sizeof(key.uv));
+                bool inserted = false;
+                const uint32_t id = corner_keys.Insert(key, &inserted);
+                if (inserted) point_of_key.push_back(new_point(v, value, face_shading));
+                point = point_of_key[id];
             } else if (point_of_vertex[v] == kUnset) {
-                point = point_of_vertex[v] = new_point(v, material, false);
-                material_of_vertex[v] = material;
-            } else if (material_of_vertex[v] == material) {
+                point = point_of_vertex[v] = new_point(v, value, face_shading);
+                value_of_vertex[v] = value;
+            } else if (value_of_vertex[v] == value) {
                 point = point_of_vertex[v];
             } else {
-                const uint64_t key = (uint64_t(v) << 32) | material;
+                const uint64_t key = (uint64_t(v) << 32) | value;
                 auto it = extra_points.find(key);
-                point =
-                    it != extra_points.end()
-                        ? it->second
-                        : extra_points.emplace(key, new_point(v, material, false)).first->second;
+                point = it != extra_points.end()
+                            ? it->second
+                            : extra_points.emplace(key, new_point(v, value, face_shading))
+                                  .first->second;
             }
             faces[3 * k + c] = point;
         }
@@ -304,9 +341,10 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     }
     out.bytes.resize(kMeshPrefixBytes);
     const int32_t prefix[4] = {base.x, base.y, base.z,
-                               int32_t(mark_flat ? kMeshFlagFlatFaces : 0u)};
+                               int32_t(out.has_normals ? kMeshFlagShading : 0u)};
     std::memcpy(out.bytes.data(), prefix, kMeshPrefixBytes);
 
+    size_t encoded_points = 0;  // Draco's count, after its own splits: what decoding gives
     if (!kept.empty()) {
         draco::Mesh dm;
         dm.set_num_points(uint32_t(point_count));
@@ -324,12 +362,15 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         }
         const int pos_id = dm.AddAttribute(std::move(pos));
         int normal_id = -1, uv_id = -1;
-        if (out.has_normals) {
+        if (stored_count > 0) {
             auto att = NewAttribute(kNormalType, 3, draco::DT_FLOAT32, point_count);
             for (size_t p = 0; p < point_count; ++p) {
-                // Flat faces' points carry one constant (cheap to code); decoding clears them.
+                // Flat and derived faces' points carry one constant (cheap to code); decoding
+                // replaces it.
                 const Vec3f n =
-                    point_flat[p] ? Vec3f(0, 0, 1) : Normalized(mesh.normals[point_vertex[p]]);
+                    point_shading[p] != kShadingStored && point_shading[p] != kShadingStoredApart
+                        ? Vec3f(0, 0, 1)
+                        : Normalized(mesh.normals[point_vertex[p]]);
                 const float value[3] = {n.x, n.y, n.z};
                 att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), value);
             }
@@ -346,8 +387,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         {
             auto att = NewAttribute(kMaterialType, 1, draco::DT_INT32, point_count);
             for (size_t p = 0; p < point_count; ++p) {
-                const int32_t m = mark_flat ? int32_t(point_material[p] << 1 | point_flat[p])
-                                            : int32_t(point_material[p]);
+                const int32_t m = int32_t(point_value[p]);
                 att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), &m);
             }
             dm.AddAttribute(std::move(att));
@@ -358,6 +398,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         }
 
         draco::ExpertEncoder encoder(dm);
+        encoder.SetTrackEncodedProperties(true);
         encoder.SetSpeedOptions(options.draco_speed, options.draco_speed);
         if (options.sequential) encoder.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
         if (normal_id >= 0) encoder.SetAttributeQuantization(normal_id, options.normal_bits);
@@ -371,17 +412,26 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
                 point_count, status.error_msg_string());
         }
         out.bytes.append(buffer.data(), buffer.size());
+        encoded_points = encoder.num_encoded_points();
     }
+    out.triangle_count = kept.size();
+    out.vertex_count = encoded_points;
+    out.decoded_bytes =
+        DecodedBytes(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
+    // Dequantizing is monotonic per axis: the box of the decoded positions is that of the extremes.
+    if (point_count > 0) out.geometry_bounds = Bounds3f(grid.Dequantize(lo), grid.Dequantize(hi));
+    if (!options.verify) return out;
 
-    // 7. Decode once: the store must never hold a brick that does not decode to what was given, and
-    // the decoded vertex count (Draco splits vertices at attribute seams and non-manifold edges) is
-    // only known after decoding.
+    // 7. Decode once (EncodeOptions::verify): the store must never hold a brick that does not
+    // decode to what was given.
     NAVE_ASSIGN_OR_RETURN(
         BrickMesh decoded,
         DecodeMeshSection(out.bytes, grid, uint64_t(out.max_material_id) + 1, "encoded brick"));
-    if (decoded.TriangleCount() != kept.size()) {
-        return InternalError("Draco round trip lost triangles: encoded {}, decoded {}", kept.size(),
-                             decoded.TriangleCount());
+    if (decoded.TriangleCount() != kept.size() || decoded.VertexCount() != encoded_points) {
+        return InternalError(
+            "Draco round trip changed the counts: encoded {} triangles and {} points, decoded {} "
+            "and {}",
+            kept.size(), encoded_points, decoded.TriangleCount(), decoded.VertexCount());
     }
     std::vector<uint32_t> materials_in(kept.size());
     for (size_t k = 0; k < kept.size(); ++k) materials_in[k] = mesh.material_ids[kept[k]];
@@ -392,11 +442,12 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         return InternalError("Draco round trip changed the triangles' material ids ({} triangles)",
                              kept.size());
     }
-    out.triangle_count = decoded.TriangleCount();
-    out.vertex_count = decoded.VertexCount();
-    out.decoded_bytes =
-        DecodedBytes(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
-    for (const Vec3f& p : decoded.positions) out.geometry_bounds.Extend(p);
+    Bounds3f decoded_bounds;
+    for (const Vec3f& p : decoded.positions) decoded_bounds.Extend(p);
+    if (!(decoded_bounds == out.geometry_bounds)) {
+        return InternalError("Draco round trip moved the brick's bounds: encoded {}, decoded {}",
+                             fmt::streamed(out.geometry_bounds), fmt::streamed(decoded_bounds));
+    }
     return out;
 }
 
@@ -410,12 +461,19 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     std::memcpy(prefix, bytes.data(), kMeshPrefixBytes);
     const Vec3i base{prefix[0], prefix[1], prefix[2]};
     const uint32_t flags = uint32_t(prefix[3]);
-    if ((flags & ~kMeshFlagFlatFaces) != 0) {
+    constexpr uint32_t kKnownFlags = kMeshFlagFlatFaces | kMeshFlagShading;
+    if ((flags & ~kKnownFlags) != 0) {
         return DataLossError(
             "{}: mesh section flags 0x{:x} hold bits this nave does not know (0x{:x})", what, flags,
-            flags & ~kMeshFlagFlatFaces);
+            flags & ~kKnownFlags);
+    }
+    if (flags == kKnownFlags) {
+        return DataLossError(
+            "{}: mesh section flags 0x{:x} mark flat faces in both the 2.0 and the 3.0 way", what,
+            flags);
     }
     const bool flat_marked = (flags & kMeshFlagFlatFaces) != 0;
+    const bool shading_marked = (flags & kMeshFlagShading) != 0;
     BrickMesh out;
     if (bytes.size() == kMeshPrefixBytes)
         return out;  // a brick whose triangles all collapsed on the grid
@@ -453,7 +511,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     const uint32_t face_count = dm->num_faces();
     // Exact sizes, so that MemoryBytes() equals DecodedBytes() and the directory's decoded_bytes.
     out.positions.resize(point_count);
-    if (normal != nullptr) out.normals.resize(point_count);
+    if (normal != nullptr || shading_marked) out.normals.resize(point_count);
     if (uv != nullptr) out.uvs.resize(point_count);
     out.indices.resize(3 * size_t(face_count));
     out.material_ids.resize(face_count);
@@ -474,6 +532,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
                                                 reinterpret_cast<float*>(out.uvs.data())));
     }
     const PlainAttribute materials(*material);
+    bool any_derived = false;
     for (uint32_t f = 0; f < face_count; ++f) {
         const draco::Mesh::Face& face = dm->face(draco::FaceIndex(f));
         for (int c = 0; c < 3; ++c) {
@@ -495,17 +554,27 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         }
         std::rotate(tri, tri + first, tri + 3);
         const int32_t value = *materials.Value<int32_t>(face[0].value());
-        const int32_t m = flat_marked ? value >> 1 : value;
+        const int32_t m = shading_marked ? value >> 4 : flat_marked ? value >> 1 : value;
         if (m < 0 || uint64_t(m) >= material_count) {
             return DataLossError("{}: triangle {} has material {} but the store has {} materials",
                                  what, f, m, material_count);
         }
         out.material_ids[f] = uint32_t(m);
-        if (flat_marked && (value & 1) != 0 && normal != nullptr) {
-            // A flat face: zero normals tell the renderer to shade with the geometric normal.
-            for (int c = 0; c < 3; ++c) out.normals[face[c].value()] = Vec3f(0, 0, 0);
+        const int shading = shading_marked ? value & 3
+                            : flat_marked  ? ((value & 1) != 0 ? kShadingFlat : kShadingStored)
+                                           : kShadingStored;
+        const bool stored = shading == kShadingStored || shading == kShadingStoredApart;
+        if (stored && shading_marked && normal == nullptr) {
+            return DataLossError(
+                "{}: triangle {} keeps its normals, but the mesh section stores none", what, f);
         }
+        if (shading == kShadingFlat && !out.normals.empty()) {
+            // A flat face: zero normals tell the renderer to shade with the geometric normal.
+            for (int c = 0; c < 3; ++c) out.normals[tri[c]] = Vec3f(0, 0, 0);
+        }
+        any_derived |= shading == kShadingDerived;
     }
+    if (any_derived) NAVE_RETURN_IF_ERROR(DeriveNormals(*dm, positions, materials, &out.normals));
     return out;
 }
 

@@ -4,6 +4,7 @@
 // section is LZ4. Byte layouts: docs/store-format.md. No Draco or LZ4 type leaves brick_codec.cpp.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -14,14 +15,21 @@
 
 namespace nave::store::codec {
 
+inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
 /// Bytes of the mesh section's prefix (int32 base x, y, z; uint32 flags).
 inline constexpr size_t kMeshPrefixBytes = 16;
-/// Mesh section flag (prefix word 3, format 2.0): the material attribute holds material * 2 + 1
-/// on flat faces (shaded with their geometric normal; their decoded normals are zero) and
-/// material * 2 on smooth ones. Unset: the attribute is the material.
+/// Mesh section flag (prefix word 3, format 2.0, no longer written): the material attribute holds
+/// material * 2 + 1 on flat faces (shaded with their geometric normal; their decoded normals are
+/// zero) and material * 2 on smooth ones. Unset: the attribute is the material.
 inline constexpr uint32_t kMeshFlagFlatFaces = 1u;
-/// Largest material id a brick can store (the flat-face bit takes one bit of the int32 value).
-inline constexpr uint32_t kMaxMaterialId = (1u << 30) - 1;
+/// Mesh section flag (format 3.0): the material attribute holds material * 16 + smoothing group
+/// * 4 + shading (face_shading.h). Unset (and kMeshFlagFlatFaces unset): the attribute is the
+/// material, and the brick has no normals or every face keeps its own.
+inline constexpr uint32_t kMeshFlagShading = 2u;
+/// Largest material id a brick can store (shading and smoothing group take four bits of the int32
+/// value).
+inline constexpr uint32_t kMaxMaterialId = (1u << 27) - 1;
 /// Largest span of a brick's positions along one axis, in grid steps. Keeps Draco's integer
 /// prediction (a + b - c, in int32) far from overflow.
 inline constexpr int64_t kMaxBrickSpanSteps = int64_t(1) << 29;
@@ -42,9 +50,13 @@ struct EncodedMesh {
 };
 
 /// Snaps, encodes, then decodes the result once to check it and to learn the decoded counts.
-/// Thread-safe.
-StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
-                                        const EncodeOptions& options);
+/// `complete_within` is the box inside which the mesh holds every face around each vertex (a
+/// brick's cell: bricks hold every triangle that overlaps it); only there may normals be derived
+/// (face_shading.h). Thread-safe.
+StatusOr<EncodedMesh> EncodeMeshSection(
+    const BrickMesh& mesh, const GlobalGrid& grid, const EncodeOptions& options,
+    const Bounds3f& complete_within = Bounds3f(Vec3f(-kInfinity, -kInfinity, -kInfinity),
+                                               Vec3f(kInfinity, kInfinity, kInfinity)));
 
 /// Decodes a mesh section. `material_count` bounds the material ids; `what` prefixes every error
 /// ("abbey.nave brick 12 @0x1a2b"). Thread-safe.

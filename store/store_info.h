@@ -10,10 +10,11 @@
 
 namespace nave::store {
 
-/// Current format version. Readers refuse another major version; a newer minor version only adds fields.
-/// The version this nave writes. 2.0: flat faces marked in the mesh section (no normals, shared
-/// corners). 1.1: material alpha_cutoff.
-inline constexpr uint16_t kFormatMajor = 2;
+/// Current format version. Readers refuse another major version; a newer minor version only adds
+/// fields. The version this nave writes. 3.0: each face's shading (stored, flat or derived normals)
+/// in the mesh section, so that smooth surfaces too may store no normals. 2.0: flat faces marked in
+/// the mesh section (no normals, shared corners). 1.1: material alpha_cutoff.
+inline constexpr uint16_t kFormatMajor = 3;
 inline constexpr uint16_t kFormatMinor = 0;
 /// The oldest major version this nave still reads (1.x stores decode as before).
 inline constexpr uint16_t kOldestReadableMajor = 1;

@@ -84,7 +84,7 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     // table).
     NAVE_RETURN_IF_ERROR(ValidateBrickMesh(mesh, size_t(0x7fffffff) + 1));
     NAVE_ASSIGN_OR_RETURN(codec::EncodedMesh encoded,
-                          codec::EncodeMeshSection(mesh, grid, options));
+                          codec::EncodeMeshSection(mesh, grid, options, cell));
     EncodedBrick brick;
     brick.mesh_bytes = std::move(encoded.bytes);
     brick.cell = cell;

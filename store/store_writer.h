@@ -25,6 +25,14 @@ struct EncodeOptions {
     /// Draco's sequential connectivity coding instead of edgebreaker: larger, but decodes faster
     /// on meshes of many small parts with split vertices (bench_brick_load).
     bool sequential = false;
+    /// Largest angle, in degrees, between a derived normal (recomputed from the positions when a
+    /// brick is decoded) and the given one for a face to store no normals (face_shading.h); 0
+    /// stores the normals of every face that is not flat. Why 3: docs/store-format.md, "Shading".
+    double derived_normal_error_deg = 3.0;
+    /// Decode every brick once after encoding and compare its counts, materials and bounds with
+    /// what was encoded. Off, encoding is about a third faster and the counts come from Draco's
+    /// encoder (docs/preprocess.md, "Verification").
+    bool verify = true;
 };
 
 /// A brick ready to be appended: encoded bytes and the directory fields known before writing.

@@ -1,6 +1,7 @@
 #include "preprocess/abbey/primitives.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace nave::preprocess::abbey {
 
@@ -97,6 +98,52 @@ void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& 
     }
 }
 
+namespace {
+
+/// A profile edge's normal at its two ends, in the profile's plane.
+struct EdgeEndNormals {
+    Vec2 start, end;
+};
+
+/// Smooths a profile's normals: `edge_normal[k]` is the unit normal of edge k (points k to k + 1),
+/// zero for an edge of no length. Where two consecutive edges turn by less than 30 degrees the
+/// profile samples a curve (a torus, a bell, a circle) and both ends take the edges' mean, so the
+/// surface shades smooth; a sharper turn is a corner drawn on purpose (a plinth, a joint, a
+/// chamfer) and each edge keeps its own normal there: a crease. (30 degrees is the usual
+/// auto-smooth angle of modelling tools.)
+std::vector<EdgeEndNormals> SmoothProfileNormals(const std::vector<Vec2>& edge_normal,
+                                                 bool closed) {
+    const double kSmoothTurnCos = 0.8660254037844387;  // cos 30 degrees
+    const size_t n = edge_normal.size();
+    std::vector<EdgeEndNormals> out(n);
+    for (size_t k = 0; k < n; ++k) out[k] = {edge_normal[k], edge_normal[k]};
+    auto valid = [&](size_t k) { return edge_normal[k].x != 0 || edge_normal[k].y != 0; };
+    for (size_t k = 0; k < n; ++k) {
+        if (!valid(k)) continue;
+        // The next edge of some length after k (wrapping round a closed profile).
+        size_t next = k;
+        for (size_t step = 1; step < n; ++step) {
+            const size_t j = k + step;
+            if (j >= n && !closed) break;
+            if (valid(j % n)) {
+                next = j % n;
+                break;
+            }
+        }
+        if (next == k) continue;
+        const Vec2 &a = edge_normal[k], &b = edge_normal[next];
+        if (a.x * b.x + a.y * b.y < kSmoothTurnCos) continue;
+        Vec2 mean{a.x + b.x, a.y + b.y};
+        const double len = std::hypot(mean.x, mean.y);
+        mean = {mean.x / len, mean.y / len};
+        out[k].end = mean;
+        out[next].start = mean;
+    }
+    return out;
+}
+
+}  // namespace
+
 void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, int segments,
              uint32_t m, int sides, double phase) {
     const double kTwoPi = 6.283185307179586;
@@ -112,26 +159,33 @@ void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, i
         }
         return Vec3d(std::cos(a), std::sin(a), 0);
     };
-    for (size_t k = 0; k + 1 < profile.size(); ++k) {
-        Vec2 p0 = profile[k], p1 = profile[k + 1];
-        double dr = p1.x - p0.x, dz = p1.y - p0.y;
-        double len = std::hypot(dr, dz);
-        if (len == 0) continue;
-        double nr = dz / len,
-               nz = -dr / len;  // the profile's right-hand normal: outward for an upward profile
+    // Each edge's right-hand normal (r, z): outward for an upward profile.
+    std::vector<Vec2> edge_normal(profile.size() > 1 ? profile.size() - 1 : 0);
+    for (size_t k = 0; k < edge_normal.size(); ++k) {
+        const double dr = profile[k + 1].x - profile[k].x, dz = profile[k + 1].y - profile[k].y;
+        const double len = std::hypot(dr, dz);
+        if (len > 0) edge_normal[k] = {dz / len, -dr / len};
+    }
+    const std::vector<EdgeEndNormals> normals = SmoothProfileNormals(edge_normal, false);
+    for (size_t k = 0; k < edge_normal.size(); ++k) {
+        if (edge_normal[k].x == 0 && edge_normal[k].y == 0) continue;
+        const Vec2 p0 = profile[k], p1 = profile[k + 1];
+        const Vec2 m0 = normals[k].start, m1 = normals[k].end;
         for (int i = 0; i < segments; ++i) {
             Vec3d d0 = dir(i), d1 = dir(i + 1);
             Vec3d a = base + d0 * p0.x + Vec3d(0, 0, p0.y),
                   b = base + d1 * p0.x + Vec3d(0, 0, p0.y);
             Vec3d c = base + d1 * p1.x + Vec3d(0, 0, p1.y),
                   d = base + d0 * p1.x + Vec3d(0, 0, p1.y);
-            Vec3d n0 = Normalize(Vec3d(d0.x, d0.y, 0)) * nr + Vec3d(0, 0, nz);
-            Vec3d n1 = Normalize(Vec3d(d1.x, d1.y, 0)) * nr + Vec3d(0, 0, nz);
-            Vec3d out = (n0 + n1) * 0.5;
+            const Vec3d r0 = Normalize(Vec3d(d0.x, d0.y, 0)), r1 = Normalize(Vec3d(d1.x, d1.y, 0));
+            const Vec3d na = r0 * m0.x + Vec3d(0, 0, m0.y), nb = r1 * m0.x + Vec3d(0, 0, m0.y);
+            const Vec3d nc = r1 * m1.x + Vec3d(0, 0, m1.y), nd = r0 * m1.x + Vec3d(0, 0, m1.y);
+            const Vec3d out =
+                r0 * (edge_normal[k].x) + r1 * edge_normal[k].x + Vec3d(0, 0, 2 * edge_normal[k].y);
             if (sides > 0) {
                 em.Quad(a, b, c, d, out, m);
             } else {
-                em.QuadN(a, b, c, d, n0, n1, n1, n0, out, m);
+                em.QuadN(a, b, c, d, na, nb, nc, nd, out, m);
             }
         }
     }
@@ -153,18 +207,39 @@ void Sweep(Emitter& em, const std::vector<Vec3d>& raw_path, const Vec3d& side,
         Vec3d n = Normalize(Cross(side, t));
         for (size_t q = 0; q < nq; ++q) out[q] = path[i] + side * profile[q].x + n * profile[q].y;
     };
+    // The profile's normals in its (b, n) plane: (dy, -dx) is outward on a counter-clockwise
+    // profile; smooth where it samples a curve, creased at its corners.
+    std::vector<Vec2> edge_normal(nq);
+    for (size_t q = 0; q < nq; ++q) {
+        const Vec2 &a = profile[q], &b = profile[(q + 1) % nq];
+        const double len = std::hypot(b.x - a.x, b.y - a.y);
+        if (len > 0) edge_normal[q] = {(b.y - a.y) / len, -(b.x - a.x) / len};
+    }
+    const std::vector<EdgeEndNormals> normals = SmoothProfileNormals(edge_normal, true);
+    // The ring's in-plane normal axis at path point i.
+    auto ring_axis = [&](size_t i) {
+        Vec3d t = path[std::min(i + 1, np - 1)] - path[i > 0 ? i - 1 : 0];
+        return Normalize(Cross(side, t));
+    };
     make_ring(0, ring_prev);
+    Vec3d axis_prev = ring_axis(0);
     for (size_t i = 1; i < np; ++i) {
         make_ring(i, ring);
+        const Vec3d axis = ring_axis(i);
         for (size_t q = 0; q < nq; ++q) {
+            if (edge_normal[q].x == 0 && edge_normal[q].y == 0) continue;
             size_t r = (q + 1) % nq;
-            Vec3d mid = (path[i - 1] + path[i]) * 0.5;
-            Vec3d out = (ring_prev[q] + ring_prev[r] + ring[q] + ring[r]) * 0.25 - mid;
-            Vec3d n0 = ring_prev[q] - path[i - 1], n1 = ring_prev[r] - path[i - 1];
-            Vec3d n2 = ring[r] - path[i], n3 = ring[q] - path[i];
+            auto normal = [&](const Vec2& v, const Vec3d& n_axis) {
+                return side * v.x + n_axis * v.y;
+            };
+            const Vec3d n0 = normal(normals[q].start, axis_prev),
+                        n1 = normal(normals[q].end, axis_prev);
+            const Vec3d n2 = normal(normals[q].end, axis), n3 = normal(normals[q].start, axis);
+            const Vec3d out = normal(edge_normal[q], axis_prev) + normal(edge_normal[q], axis);
             em.QuadN(ring_prev[q], ring_prev[r], ring[r], ring[q], n0, n1, n2, n3, out, m);
         }
         std::swap(ring_prev, ring);
+        axis_prev = axis;
     }
     if (caps) {
         std::vector<Vec3d> first(nq), last(nq);

@@ -5,27 +5,6 @@
 #include <cstring>
 
 namespace nave::preprocess {
-namespace {
-
-template <typename Key>
-bool SameKey(const Key& a, const Key& b) {
-    return std::memcmp(&a, &b, sizeof(Key)) == 0;
-}
-
-template <typename Key>
-uint64_t HashKey(const Key& k) {
-    uint32_t words[sizeof(Key) / 4];
-    std::memcpy(words, &k, sizeof(Key));
-    uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (uint32_t v : words) {
-        h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
-        h *= 0xBF58476D1CE4E5B9ull;
-    }
-    return h ^ (h >> 29);
-}
-
-}  // namespace
-
 BuiltBrick BuildBrickMesh(const std::vector<Triangle>& triangles, const store::GlobalGrid& grid) {
     BrickBuilder builder;
     return builder.Build(triangles, grid);
@@ -47,37 +26,13 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
     mesh.uvs.clear();
     mesh.indices.clear();
     mesh.material_ids.clear();
-    keys_.clear();
-    keys_.reserve(triangles.size());
     mesh.positions.reserve(triangles.size());
     if (normals) mesh.normals.reserve(triangles.size());
     if (uvs) mesh.uvs.reserve(triangles.size());
     mesh.indices.reserve(triangles.size() * 3);
     mesh.material_ids.reserve(triangles.size());
-    // Open addressing with linear probing; slots hold vertex index + 1 (0: empty). At most three
-    // vertices per triangle, so the table is at most half full.
-    size_t cap = 16;
-    while (cap < 6 * triangles.size() + 32) cap <<= 1;
-    slots_.assign(cap, 0);
-    const size_t mask = cap - 1;
-    auto find = [&](const VertexKey& key, bool* inserted) -> uint32_t {
-        size_t i = HashKey(key) & mask;
-        while (true) {
-            uint32_t s = slots_[i];
-            if (s == 0) {
-                uint32_t next = uint32_t(keys_.size());
-                slots_[i] = next + 1;
-                keys_.push_back(key);
-                *inserted = true;
-                return next;
-            }
-            if (SameKey(keys_[s - 1], key)) {
-                *inserted = false;
-                return s - 1;
-            }
-            i = (i + 1) & mask;
-        }
-    };
+    // At most three vertices per triangle.
+    vertices_.Reset(3 * triangles.size());
     for (const Triangle& t : triangles) {
         Vec3f face_normal(0, 0, 1);
         if (normals) {
@@ -107,7 +62,7 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
                 k.uv[1] = std::bit_cast<uint32_t>(uv[1]);
             }
             bool inserted = false;
-            idx[j] = find(k, &inserted);
+            idx[j] = vertices_.Insert(k, &inserted);
             if (inserted) {
                 Vec3f p = grid.Dequantize(k.q);
                 mesh.positions.push_back(p);
@@ -116,7 +71,8 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
                 if (uvs) mesh.uvs.push_back(uv);
             }
         }
-        const Vec3i &a = keys_[idx[0]].q, &b = keys_[idx[1]].q, &c = keys_[idx[2]].q;
+        const Vec3i &a = vertices_.key(idx[0]).q, &b = vertices_.key(idx[1]).q,
+                    &c = vertices_.key(idx[2]).q;
         if (a == b || b == c || a == c) {
             ++out.collapsed_triangles;
             continue;

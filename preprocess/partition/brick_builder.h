@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "core/key_table.h"
 #include "preprocess/triangle_source.h"
 #include "store/brick_mesh.h"
 #include "store/grid.h"
@@ -32,8 +33,7 @@ class BrickBuilder {
         uint32_t uv[2];
     };
     BuiltBrick out_;
-    std::vector<VertexKey> keys_;
-    std::vector<uint32_t> slots_;
+    KeyTable<VertexKey> vertices_;
 };
 
 /// One-off convenience over BrickBuilder.

@@ -19,6 +19,8 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
         double precision = 0;
         int threads = 0;
         int draco_speed = store::EncodeOptions{}.draco_speed;
+        double derived_normal_error = store::EncodeOptions{}.derived_normal_error_deg;
+        uint32_t verify_every = 8;
         bool no_textures = false;
     };
     auto opt = std::make_shared<Options>();
@@ -29,7 +31,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--memory", opt->memory,
                     "Memory budget, e.g. 4G (default: a quarter of physical memory)");
     cmd->add_option("--brick-triangles", opt->brick_triangles,
-                    "Target triangles per brick (default 200000, or fewer when --memory cannot "
+                    "Target triangles per brick (default 700000, or fewer when --memory cannot "
                     "hold the encoding work of a brick that size)");
     cmd->add_option(
         "--precision", opt->precision,
@@ -40,6 +42,16 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--draco-speed", opt->draco_speed,
                     "Draco encoder speed 0 (smallest) .. 10 (fastest)")
         ->check(CLI::Range(0, 10));
+    cmd->add_option(
+           "--derived-normal-error", opt->derived_normal_error,
+           "Degrees: smooth faces whose normals the renderer can recompute from the positions "
+           "within this angle store none (default 3; 0 stores them all, for mirror-like "
+           "materials)")
+        ->check(CLI::Range(0.0, 10.0));
+    cmd->add_option("--verify-every", opt->verify_every,
+                    "Decode every N-th brick (and the first) again after encoding to check it; 1 "
+                    "checks all (a third slower), 0 none (default 8; `nave verify` checks a store "
+                    "whole)");
     cmd->add_flag("--no-textures", opt->no_textures,
                   "Do not convert textures (the store's materials keep their flat colours; OpenImageIO, "
                   "~160 MB, is then never loaded)");
@@ -64,6 +76,8 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             o.threads = opt->threads;
             o.temp_dir = opt->temp_dir;
             o.encode.draco_speed = opt->draco_speed;
+            o.encode.derived_normal_error_deg = opt->derived_normal_error;
+            o.verify_every = opt->verify_every;
             o.convert_textures = !opt->no_textures;
             o.tool_version = std::string("nave ") + NAVE_VERSION;
             NAVE_ASSIGN_OR_RETURN(auto stats, preprocess::RunPreprocess(o));

@@ -99,7 +99,7 @@ TEST(FlatFaces, MixedMeshMarksFlatFacesAndKeepsSmoothNormals) {
     ASSERT_TRUE(out->HasNormals());
     uint32_t flags = 0;
     std::memcpy(&flags, e.bytes.data() + 12, 4);
-    EXPECT_EQ(flags, codec::kMeshFlagFlatFaces);
+    EXPECT_EQ(flags, codec::kMeshFlagShading);
     ASSERT_EQ(out->TriangleCount(), in.TriangleCount());
     size_t flat = 0, smooth = 0;
     for (size_t t = 0; t < out->TriangleCount(); ++t) {
