@@ -49,8 +49,8 @@ std::string OptionsText(const PreprocessOptions& o, uint64_t brick_triangles, ui
         o.encode.derived_normal_error_deg, o.verify_every, units);
 }
 
-/// Removes the texture folder of a run that fails, unless it existed before the run (it may hold textures an
-/// earlier store still uses).
+/// Removes the texture folder of a run that fails, unless it existed before the run (it may hold
+/// textures an earlier store still uses).
 class TextureFolderGuard {
   public:
     explicit TextureFolderGuard(std::filesystem::path folder) : folder_(std::move(folder)) {
@@ -103,8 +103,9 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     if (brick_triangles == 0) {
         brick_triangles = std::clamp<uint64_t>(fit, kMinBrickTriangles, kDefaultBrickTriangles);
         if (brick_triangles < kDefaultBrickTriangles) {
-            log::Info("preprocess: bricks of {} triangles (the largest whose work fits --memory {})",
-                      brick_triangles, FormatBytes(stats.memory_budget));
+            log::Info(
+                "preprocess: bricks of {} triangles (the largest whose work fits --memory {})",
+                brick_triangles, FormatBytes(stats.memory_budget));
         }
     }
     const uint64_t leaf_max = brick_triangles + brick_triangles / 4;
@@ -158,33 +159,41 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         stats.warnings.push_back(w);
     }
     auto materials = source->materials();
-    if (options.convert_textures) NAVE_RETURN_IF_ERROR(source->WriteGeneratedTextures(temp.path()));
+    if (options.convert_textures)
+        NAVE_RETURN_IF_ERROR(temp.Annotate(source->WriteGeneratedTextures(temp.path())));
     source.reset();  // frees importer memory (OBJ/PLY vertex arrays) before the split
 
-    // Textures the materials reference become tiled, MIP-mapped files beside the store, and the material
-    // table points at them (texture_convert.h). Texture names are relative to their model's directory.
+    // Textures the materials reference become tiled, MIP-mapped files beside the store, and the
+    // material table points at them (texture_convert.h). Texture names are relative to their
+    // model's directory.
     TextureFolderGuard texture_folder(TextureFolderFor(options.output));
     uint64_t texture_reserve = 0;  // taken from the budget of the work that follows
-    const bool any_texture = std::any_of(materials.begin(), materials.end(),
-                                         [](const store::MaterialRecord& m) { return !m.textures.empty(); });
+    const bool any_texture =
+        std::any_of(materials.begin(), materials.end(),
+                    [](const store::MaterialRecord& m) { return !m.textures.empty(); });
     if (any_texture && !options.convert_textures) {
         for (store::MaterialRecord& m : materials) m.textures.clear();
     } else if (any_texture) {
-        // OpenImageIO stays loaded to the end of the run: the rest of the work gets the budget minus its cost.
+        // OpenImageIO stays loaded to the end of the run: the rest of the work gets the budget
+        // minus its cost.
         const uint64_t need = kFixedBytes + per_brick + kTextureConversionBytes;
         if (stats.memory_budget < need) {
             return ResourceExhaustedError(
-                "--memory {} cannot hold texture conversion ({} for OpenImageIO) beside the work for one brick "
-                "({}): raise --memory to at least {}, or pass --no-textures to store flat colours only",
+                "--memory {} cannot hold texture conversion ({} for OpenImageIO) beside the work "
+                "for one brick "
+                "({}): raise --memory to at least {}, or pass --no-textures to store flat colours "
+                "only",
                 FormatBytes(stats.memory_budget), FormatBytes(kTextureConversionBytes),
                 FormatBytes(need - kTextureConversionBytes), FormatBytes(need));
         }
         texture_reserve = kTextureConversionBytes;
         std::vector<std::filesystem::path> source_dirs;
         for (const auto& input : options.inputs)
-            source_dirs.push_back(input.has_parent_path() ? input.parent_path() : std::filesystem::path("."));
+            source_dirs.push_back(input.has_parent_path() ? input.parent_path()
+                                                          : std::filesystem::path("."));
         source_dirs.push_back(temp.path());  // a generator's textures (WriteGeneratedTextures)
-        NAVE_ASSIGN_OR_RETURN(TextureConvertStats textures, ConvertTextures(&materials, source_dirs, options.output));
+        NAVE_ASSIGN_OR_RETURN(TextureConvertStats textures,
+                              ConvertTextures(&materials, source_dirs, options.output));
         for (const std::string& w : textures.warnings) {
             log::Warning("{}", w);
             stats.warnings.push_back(w);
@@ -242,15 +251,16 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
                 "overlap) needs {} to "
                 "encode, more than --memory {} allows; raise --memory to at least {}",
                 leaf.triangles, fmt::streamed(leaf.cell), FormatBytes(need),
-                FormatBytes(stats.memory_budget), FormatBytes(need + kFixedBytes + texture_reserve));
+                FormatBytes(stats.memory_budget),
+                FormatBytes(need + kFixedBytes + texture_reserve));
         }
     }
     store::StoreProvenance provenance;
     for (const auto& in : options.inputs) provenance.source_files.push_back(in.string());
     if (!options.generate.empty()) provenance.source_files.push_back(options.generate);
     provenance.tool_version = options.tool_version;
-    provenance.options =
-        OptionsText(options, brick_triangles, stats.memory_budget, stats.grid_step, stats.threads, stats.units);
+    provenance.options = OptionsText(options, brick_triangles, stats.memory_budget, stats.grid_step,
+                                     stats.threads, stats.units);
     NAVE_ASSIGN_OR_RETURN(auto writer,
                           store::StoreWriter::Create(options.output, grid, provenance));
 
@@ -261,9 +271,9 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     std::mutex mutex;
     size_t next = 0;
     Status failure;
-    // Bricks are appended in leaf order whatever order the threads finish them in, so that brick ids, and
-    // the store's bytes, do not depend on the thread count. A finished brick waits here (compressed) until
-    // the leaves before it are appended.
+    // Bricks are appended in leaf order whatever order the threads finish them in, so that brick
+    // ids, and the store's bytes, do not depend on the thread count. A finished brick waits here
+    // (compressed) until the leaves before it are appended.
     std::map<size_t, std::optional<store::EncodedBrick>> finished;
     size_t next_append = 0;
     auto append_ready = [&]() -> Status {  // with `mutex` held
@@ -385,8 +395,9 @@ std::string FormatSummary(const PreprocessStats& s) {
             s.oversized_bricks);
     }
     if (s.textures_converted > 0) {
-        out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}", s.textures_converted,
-                           FormatBytes(s.texture_bytes), FormatDuration(s.texture_seconds));
+        out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}",
+                           s.textures_converted, FormatBytes(s.texture_bytes),
+                           FormatDuration(s.texture_seconds));
     }
     for (const auto& w : s.warnings) out += "\nwarning:     " + w;
     return out;

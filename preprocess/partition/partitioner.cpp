@@ -80,7 +80,9 @@ void Partitioner::AddTempBytes(int64_t delta) {
 
 Status Partitioner::Bin(TriangleSource& source, ProgressBar& progress) {
     root_.file = NewBinPath();
-    NAVE_ASSIGN_OR_RETURN(auto writer, BinWriter::Create(root_.file, config_.block_bytes));
+    auto created = BinWriter::Create(root_.file, config_.block_bytes);
+    if (!created.ok()) return temp_.Annotate(created.status());
+    std::unique_ptr<BinWriter> writer = std::move(created).value();
     Reservoir sample(config_.root_sample, 1);
     std::vector<Triangle> batch;
     while (true) {
@@ -90,13 +92,13 @@ Status Partitioner::Bin(TriangleSource& source, ProgressBar& progress) {
         for (const Triangle& t : batch) {
             for (const Vec3f& p : t.p) bounds_.Extend(Vec3d(p));
             sample.Offer(Centroid(t));
-            NAVE_RETURN_IF_ERROR(writer->Append(t));
+            NAVE_RETURN_IF_ERROR(temp_.Annotate(writer->Append(t)));
         }
         source_triangles_ += batch.size();
         uint64_t done = source.progress_done();
         if (done > progress.done()) progress.Add(done - progress.done());
     }
-    NAVE_RETURN_IF_ERROR(writer->Close());
+    NAVE_RETURN_IF_ERROR(temp_.Annotate(writer->Close()));
     AddTempBytes(int64_t(writer->file_bytes()));
     root_.triangles = source_triangles_;
     root_.sample = std::move(sample.points());
@@ -252,7 +254,9 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::vector<Reservoir> samples;
     std::vector<Bounds3d> grown(fanout);
     for (size_t i = 0; i < fanout; ++i) {
-        NAVE_ASSIGN_OR_RETURN(writers[i], BinWriter::Create(NewBinPath(), block));
+        auto created = BinWriter::Create(NewBinPath(), block);
+        if (!created.ok()) return temp_.Annotate(created.status());
+        writers[i] = std::move(created).value();
         samples.emplace_back(config_.child_sample, uint64_t(task.node) * 1000 + i + 7);
         grown[i] = Grow(lleaves[i].cell, margin_);
     }
@@ -283,14 +287,14 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
             bool placed = false;
             for (int c : candidates) {
                 if (candidates.size() > 1 && !TriangleOverlapsBox(t.p, grown[c])) continue;
-                NAVE_RETURN_IF_ERROR(writers[c]->Append(t));
+                NAVE_RETURN_IF_ERROR(temp_.Annotate(writers[c]->Append(t)));
                 samples[c].Offer(ClampTo(Centroid(t), lleaves[c].cell));
                 placed = true;
             }
             if (!placed && !candidates.empty()) {
                 // Only rounding can get here (the triangle touches the parent cell): keep it
                 // somewhere near.
-                NAVE_RETURN_IF_ERROR(writers[candidates[0]]->Append(t));
+                NAVE_RETURN_IF_ERROR(temp_.Annotate(writers[candidates[0]]->Append(t)));
             }
         }
         progress_->Add(batch.size());
@@ -324,7 +328,7 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         g.brick = store::kNoBrick;
     }
     for (size_t i = 0; i < fanout; ++i) {
-        NAVE_RETURN_IF_ERROR(writers[i]->Close());
+        NAVE_RETURN_IF_ERROR(temp_.Annotate(writers[i]->Close()));
         child_bytes += int64_t(writers[i]->file_bytes());
         uint64_t count = writers[i]->triangles();
         if (count == 0) {

@@ -59,6 +59,12 @@ StatusOr<TempDir> TempDir::Create(const std::filesystem::path& parent) {
     return IoError("{}: cannot create a temporary directory", dir.string());
 }
 
+Status TempDir::Annotate(Status s) const {
+    if (s.ok()) return s;
+    return s.WithContext("writing temporary files in " + path_.parent_path().string() +
+                         " (--temp-dir chooses where)");
+}
+
 TempDir::~TempDir() {
     if (path_.empty()) return;
     std::error_code ec;

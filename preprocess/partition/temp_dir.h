@@ -24,6 +24,10 @@ class TempDir {
     const std::filesystem::path& path() const { return path_; }
     /// "<dir>/<name>"
     std::filesystem::path File(const std::string& name) const { return path_ / name; }
+    /// A failed write of a temporary file (a full disk, most often) with where the temporary files
+    /// go and how to move them: "writing temporary files in <parent> (--temp-dir chooses where):
+    /// ...". Ok stays Ok.
+    Status Annotate(Status s) const;
 
   private:
     explicit TempDir(std::filesystem::path path) : path_(std::move(path)) {}

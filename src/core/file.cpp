@@ -17,7 +17,8 @@ std::string ErrnoText() { return std::strerror(errno); }
 
 Status FsyncDirectory(const std::filesystem::path& dir) {
     int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) return IoError("cannot open directory {} to sync it: {}", dir.string(), ErrnoText());
+    if (fd < 0)
+        return IoError("cannot open directory {} to sync it: {}", dir.string(), ErrnoText());
     int rc = ::fsync(fd);
     ::close(fd);
     if (rc != 0) return IoError("cannot sync directory {}: {}", dir.string(), ErrnoText());
@@ -79,7 +80,8 @@ Status AtomicFile::WriteAt(uint64_t offset, const void* data, size_t size) {
         ssize_t n = ::pwrite(fd_, p, left, static_cast<off_t>(at));
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) {
-            return IoError("cannot write {} bytes to {} at offset {}: {}", left, temp_path_.string(), at,
+            return IoError("cannot write {} bytes to {} (temporary file for {}) at offset {}: {}",
+                           left, temp_path_.string(), path_.string(), at,
                            n < 0 ? ErrnoText() : "no space written (disk full?)");
         }
         p += n;
@@ -99,7 +101,8 @@ Status AtomicFile::Commit() {
     }
     fd_ = -1;
     if (::rename(temp_path_.c_str(), path_.c_str()) != 0) {
-        return IoError("cannot rename {} to {}: {}", temp_path_.string(), path_.string(), ErrnoText());
+        return IoError("cannot rename {} to {}: {}", temp_path_.string(), path_.string(),
+                       ErrnoText());
     }
     temp_path_.clear();
     return FsyncDirectory(path_.parent_path());
@@ -119,7 +122,8 @@ StatusOr<ReadOnlyFile> ReadOnlyFile::Open(const std::filesystem::path& path) {
     return ReadOnlyFile(path, fd, uint64_t(st.st_size));
 }
 
-ReadOnlyFile::ReadOnlyFile(ReadOnlyFile&& o) noexcept : path_(std::move(o.path_)), fd_(o.fd_), size_(o.size_) {
+ReadOnlyFile::ReadOnlyFile(ReadOnlyFile&& o) noexcept
+    : path_(std::move(o.path_)), fd_(o.fd_), size_(o.size_) {
     o.fd_ = -1;
 }
 
@@ -140,8 +144,9 @@ ReadOnlyFile::~ReadOnlyFile() {
 
 Status ReadOnlyFile::ReadAt(uint64_t offset, void* out, size_t size) const {
     if (offset > size_ || size > size_ - offset) {
-        return DataLossError("{}: truncated: need {} bytes at offset {} (0x{:x}) but the file has {} bytes",
-                             path_.string(), size, offset, offset, size_);
+        return DataLossError(
+            "{}: truncated: need {} bytes at offset {} (0x{:x}) but the file has {} bytes",
+            path_.string(), size, offset, offset, size_);
     }
     char* p = static_cast<char*>(out);
     uint64_t at = offset;
@@ -149,8 +154,11 @@ Status ReadOnlyFile::ReadAt(uint64_t offset, void* out, size_t size) const {
     while (left > 0) {
         ssize_t n = ::pread(fd_, p, left, static_cast<off_t>(at));
         if (n < 0 && errno == EINTR) continue;
-        if (n < 0) return IoError("{}: read of {} bytes at offset {} failed: {}", path_.string(), left, at, ErrnoText());
-        if (n == 0) return DataLossError("{}: truncated at offset {} (0x{:x})", path_.string(), at, at);
+        if (n < 0)
+            return IoError("{}: read of {} bytes at offset {} failed: {}", path_.string(), left, at,
+                           ErrnoText());
+        if (n == 0)
+            return DataLossError("{}: truncated at offset {} (0x{:x})", path_.string(), at, at);
         p += n;
         at += uint64_t(n);
         left -= size_t(n);
