@@ -34,16 +34,25 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
     // At most three vertices per triangle.
     vertices_.Reset(3 * triangles.size());
     for (const Triangle& t : triangles) {
+        const Vec3i q[3] = {grid.Quantize(t.p[0]), grid.Quantize(t.p[1]), grid.Quantize(t.p[2])};
+        // A triangle without normals in a brick with normals carries the normal of its snapped
+        // corners: the encoder, which tests flatness on the snapped corners, then finds it flat
+        // however small it is (from the unsnapped corners, millimetre faces of the billion-triangle
+        // abbey came out up to degrees off and kept three stored normals each).
         Vec3f face_normal(0, 0, 1);
         if (normals) {
-            Vec3f n = Cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-            float len = Length(n);
-            if (len > 0 && std::isfinite(len)) face_normal = n / len;
+            auto edge = [&](int a, int b) {
+                return Vec3d(double(q[b].x) - q[a].x, double(q[b].y) - q[a].y,
+                             double(q[b].z) - q[a].z);
+            };
+            const Vec3d n = Cross(edge(0, 1), edge(0, 2));
+            const double len = Length(n);
+            if (len > 0 && std::isfinite(len)) face_normal = Vec3f(n / len);
         }
         uint32_t idx[3];
         for (int j = 0; j < 3; ++j) {
             VertexKey k{};
-            k.q = grid.Quantize(t.p[j]);
+            k.q = q[j];
             Vec3f n = normals ? (t.has_normals ? t.n[j] : face_normal) : Vec3f();
             if (normals && t.has_normals) {
                 // Bad input normals (zero, NaN, not unit) are replaced or renormalised, not passed
