@@ -7,8 +7,8 @@
 #     bash bench/bench_billion.sh --detail 1 --resolution 160x107 --spp 1 --memory 1G   # the script in a minute
 #
 # Defaults: detail 1250, --memory 4G for both phases, configs/abbey.toml, path mode, 1920x1080, 4 spp.
-# Everything goes under --dir (default /tmp/nave-billion): the store of detail 1250 takes 3.0 GiB
-# (3.13 bytes per triangle), the preprocess's temporary files 17.8 GiB at their peak (1.45 GiB at
+# Everything goes under --dir (default /tmp/nave-billion): the store of detail 1250 takes 988 MiB
+# (1.01 bytes per triangle), the preprocess's temporary files 17.8 GiB at their peak (1.45 GiB at
 # detail 110), the render's brick cache 17.4 GiB and its spill files a few hundred MiB. On a RAM file
 # system they would count against memory.
 # An existing store of the same detail is reused (--fresh: generate it again).
