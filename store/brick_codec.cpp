@@ -92,8 +92,8 @@ Status CopyFloatValues(const draco::PointAttribute& att, uint32_t point_count,
 /// angle-weighted normals of its faces that count (stored or derived), then added up per (grid
 /// point, material, smoothing group) as the encoder did (ChooseFaceShading), not per Draco point,
 /// since Draco splits a point at a non-manifold vertex; normalised into the derived faces' points.
-Status DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
-                     const PlainAttribute& values, std::vector<Vec3f>* normals) {
+void DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
+                   const PlainAttribute& values, std::vector<Vec3f>* normals) {
     enum : uint8_t { kNotCounted = 0, kCounted = 1, kDerived = 2 };
     const uint32_t point_count = dm.num_points();
     std::vector<uint8_t> role(point_count, kNotCounted);
@@ -138,7 +138,6 @@ Status DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
         // normal rather than divide by zero.
         (*normals)[p] = length > 0 ? n / length : Vec3f(0, 0, 0);
     }
-    return Status::Ok();
 }
 
 }  // namespace
@@ -299,7 +298,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         const uint32_t t = kept[k];
         const uint32_t value = material_value(k);
         const uint8_t face_shading = shading.shading[k];
-        const bool stored = face_shading == kShadingStored || face_shading == kShadingStoredApart;
+        const bool stored = StoresNormals(face_shading);
         for (int c = 0; c < 3; ++c) {
             const uint32_t v = mesh.indices[3 * size_t(t) + c];
             uint32_t point;
@@ -367,10 +366,9 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
             for (size_t p = 0; p < point_count; ++p) {
                 // Flat and derived faces' points carry one constant (cheap to code); decoding
                 // replaces it.
-                const Vec3f n =
-                    point_shading[p] != kShadingStored && point_shading[p] != kShadingStoredApart
-                        ? Vec3f(0, 0, 1)
-                        : Normalized(mesh.normals[point_vertex[p]]);
+                const Vec3f n = StoresNormals(point_shading[p])
+                                    ? Normalized(mesh.normals[point_vertex[p]])
+                                    : Vec3f(0, 0, 1);
                 const float value[3] = {n.x, n.y, n.z};
                 att->SetAttributeValue(draco::AttributeValueIndex(uint32_t(p)), value);
             }
@@ -563,8 +561,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         const int shading = shading_marked ? value & 3
                             : flat_marked  ? ((value & 1) != 0 ? kShadingFlat : kShadingStored)
                                            : kShadingStored;
-        const bool stored = shading == kShadingStored || shading == kShadingStoredApart;
-        if (stored && shading_marked && normal == nullptr) {
+        if (StoresNormals(shading) && shading_marked && normal == nullptr) {
             return DataLossError(
                 "{}: triangle {} keeps its normals, but the mesh section stores none", what, f);
         }
@@ -574,7 +571,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         }
         any_derived |= shading == kShadingDerived;
     }
-    if (any_derived) NAVE_RETURN_IF_ERROR(DeriveNormals(*dm, positions, materials, &out.normals));
+    if (any_derived) DeriveNormals(*dm, positions, materials, &out.normals);
     return out;
 }
 

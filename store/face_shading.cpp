@@ -45,12 +45,6 @@ bool IsFlat(const BrickMesh& mesh, const uint32_t* corner, const std::vector<Vec
 
 }  // namespace
 
-Vec3d GridNormal(const Vec3i& a, const Vec3i& b, const Vec3i& c) {
-    const Vec3d e1(double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z);
-    const Vec3d e2(double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z);
-    return Cross(e1, e2);
-}
-
 std::array<Vec3d, 3> AngleWeightedNormals(const Vec3i& a, const Vec3i& b, const Vec3i& c) {
     const Vec3i p[3] = {a, b, c};
     const Vec3d n = GridNormal(a, b, c);

@@ -10,6 +10,7 @@
 
 #include "core/vecmath.h"
 #include "store/brick_mesh.h"
+#include "store/grid.h"
 
 namespace nave::store::codec {
 
@@ -20,17 +21,16 @@ enum Shading : uint8_t {
     kShadingDerived = 2,      ///< normals recomputed from its smoothing group's faces
     kShadingStoredApart = 3,  ///< normals in Draco; in no smoothing group
 };
+/// Whether a face of this shading keeps its normals in Draco.
+inline bool StoresNormals(int shading) {
+    return shading == kShadingStored || shading == kShadingStoredApart;
+}
 /// Smoothing groups at one grid point: the next two bits of the material attribute value.
 inline constexpr int kSmoothingGroups = 4;
 
 /// A face is flat when every corner normal is within 0.8 degrees of its geometric normal (cos >=
 /// 0.9999): ten-bit octahedral normals, what stored faces keep, already err by up to ~0.2 degrees.
 inline constexpr double kFlatCosine = 0.9999;
-
-/// The geometric normal of a triangle of grid points, times twice its area (in grid steps^2).
-/// Encoder and decoder compute derived normals from integer grid positions, so they agree to
-/// rounding whatever the float positions are.
-Vec3d GridNormal(const Vec3i& a, const Vec3i& b, const Vec3i& c);
 
 /// A face's contribution to the derived normal at each of its corners: its unit geometric normal
 /// times the corner's angle (G. Thuermer, C. Wuethrich, "Computing vertex normals from polygonal

@@ -27,4 +27,13 @@ struct GlobalGrid {
     double MaxAxisError() const { return 0.5 * step; }
 };
 
+/// The geometric normal of a triangle of grid points, times twice its area (in grid steps^2), in
+/// double from the integer differences: every step that judges or recomputes normals on snapped
+/// positions (preprocess, the store's encoder and decoder) gets the same answer.
+inline Vec3d GridNormal(const Vec3i& a, const Vec3i& b, const Vec3i& c) {
+    const Vec3d e1(double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z);
+    const Vec3d e2(double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z);
+    return Cross(e1, e2);
+}
+
 }  // namespace nave::store

@@ -41,11 +41,7 @@ const BuiltBrick& BrickBuilder::Build(const std::vector<Triangle>& triangles,
         // abbey came out up to degrees off and kept three stored normals each).
         Vec3f face_normal(0, 0, 1);
         if (normals) {
-            auto edge = [&](int a, int b) {
-                return Vec3d(double(q[b].x) - q[a].x, double(q[b].y) - q[a].y,
-                             double(q[b].z) - q[a].z);
-            };
-            const Vec3d n = Cross(edge(0, 1), edge(0, 2));
+            const Vec3d n = store::GridNormal(q[0], q[1], q[2]);
             const double len = Length(n);
             if (len > 0 && std::isfinite(len)) face_normal = Vec3f(n / len);
         }

@@ -66,8 +66,11 @@ struct LocalLeaf {
 
 }  // namespace
 
-std::filesystem::path Partitioner::NewBinPath() {
-    return temp_.File("bin-" + std::to_string(bin_counter_.fetch_add(1)) + ".lz4");
+StatusOr<std::unique_ptr<BinWriter>> Partitioner::NewBin(size_t block_bytes) {
+    auto created = BinWriter::Create(
+        temp_.File("bin-" + std::to_string(bin_counter_.fetch_add(1)) + ".lz4"), block_bytes);
+    if (!created.ok()) return temp_.Annotate(created.status());
+    return created;
 }
 
 void Partitioner::AddTempBytes(int64_t delta) {
@@ -79,10 +82,8 @@ void Partitioner::AddTempBytes(int64_t delta) {
 }
 
 Status Partitioner::Bin(TriangleSource& source, ProgressBar& progress) {
-    root_.file = NewBinPath();
-    auto created = BinWriter::Create(root_.file, config_.block_bytes);
-    if (!created.ok()) return temp_.Annotate(created.status());
-    std::unique_ptr<BinWriter> writer = std::move(created).value();
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<BinWriter> writer, NewBin(config_.block_bytes));
+    root_.file = writer->path();
     Reservoir sample(config_.root_sample, 1);
     std::vector<Triangle> batch;
     while (true) {
@@ -254,9 +255,7 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     std::vector<Reservoir> samples;
     std::vector<Bounds3d> grown(fanout);
     for (size_t i = 0; i < fanout; ++i) {
-        auto created = BinWriter::Create(NewBinPath(), block);
-        if (!created.ok()) return temp_.Annotate(created.status());
-        writers[i] = std::move(created).value();
+        NAVE_ASSIGN_OR_RETURN(writers[i], NewBin(block));
         samples.emplace_back(config_.child_sample, uint64_t(task.node) * 1000 + i + 7);
         grown[i] = Grow(lleaves[i].cell, margin_);
     }

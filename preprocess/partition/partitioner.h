@@ -17,11 +17,13 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <vector>
 
 #include "core/progress.h"
 #include "core/status.h"
+#include "preprocess/partition/bin_file.h"
 #include "preprocess/partition/temp_dir.h"
 #include "preprocess/triangle_source.h"
 #include "store/brick_tree.h"
@@ -80,7 +82,9 @@ class Partitioner {
     };
     Status SplitTask(Task task, std::vector<Task>& children);
     void AddTempBytes(int64_t delta);
-    std::filesystem::path NewBinPath();
+    /// A new bin in the temporary directory; a failure says where temporaries go
+    /// (TempDir::Annotate).
+    StatusOr<std::unique_ptr<BinWriter>> NewBin(size_t block_bytes);
 
     PartitionConfig config_;
     const TempDir& temp_;
