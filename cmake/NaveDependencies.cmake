@@ -13,6 +13,8 @@ find_package(TinyGLTF REQUIRED)                  # target: TinyGLTF::TinyGLTF
 find_package(assimp REQUIRED)                    # target: assimp::assimp
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
+# jemalloc: the `nave` executable's allocator (glibc's heap fragments under paging: docs/pager.md, "Memory").
+pkg_check_modules(JEMALLOC REQUIRED IMPORTED_TARGET jemalloc)
 
 # OpenImageIO's exported target names /usr/include/opencv4, which exists only when OpenCV is installed.
 foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)

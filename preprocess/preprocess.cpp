@@ -10,7 +10,6 @@
 #include <thread>
 
 #ifdef __GLIBC__
-#include <malloc.h>
 #endif
 
 #include <fmt/format.h>
@@ -75,14 +74,6 @@ double DefaultGridStep(double diagonal) { return diagonal > 0 ? diagonal / doubl
 StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     const auto start = Clock::now();
     InstallInterruptHandlers();
-#ifdef __GLIBC__
-    // Bricks allocate and free buffers of tens of MB over and over (ours and the encoder's). By
-    // default glibc maps each one afresh and the kernel zero-fills every page again: a third of the
-    // run in page faults. Keeping freed memory in the heap for reuse avoids that; the peak is
-    // unchanged.
-    mallopt(M_MMAP_THRESHOLD, 256 << 20);
-    mallopt(M_TRIM_THRESHOLD, 512 << 20);
-#endif
     PreprocessStats stats;
     if (options.output.empty()) return InvalidArgumentError("no output file given (-o MODEL.nave)");
     if (options.brick_triangles != 0 && options.brick_triangles < kMinBrickTriangles) {

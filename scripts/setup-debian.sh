@@ -12,6 +12,7 @@ packages=(
   libopenimageio-dev openimageio-tools  # OpenImageIO: EXR/PNG output, textures (its CMake config requires the tools)
   liblz4-dev               # LZ4: side sections and temporary bins
   libxxhash-dev            # xxHash: checksums of every stored section
+  libjemalloc-dev          # jemalloc: nave's allocator (paging bricks fragments glibc's heap)
   libtbb-dev               # TBB: thread pools
   libgtest-dev libgmock-dev googletest  # GoogleTest
   libbenchmark-dev         # Google Benchmark

@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <optional>
 #if defined(__GLIBC__)
-#include <malloc.h>
 #endif
 
 #include "cli/commands.h"
@@ -66,12 +65,6 @@ uint64_t MaxLoadScratchBytes(const render::BrickSource& source) {
 }
 
 Status RunRender(const RenderOptions& o) {
-#if defined(__GLIBC__)
-    // One malloc arena for all threads: a brick freed by one thread (an eviction) is then reused by
-    // the next load on any other, where per-thread arenas each kept their own freed bricks (the
-    // abbey at --memory 2G peaked at 2.14 GiB with them, 1.88 GiB with one arena, and ran faster).
-    mallopt(M_ARENA_MAX, 1);
-#endif
     if (o.model.empty() == o.procedural.empty()) {
         return InvalidArgumentError("give either MODEL.nave or --procedural NAME (not both, not neither)");
     }
@@ -210,12 +203,10 @@ Status RunRender(const RenderOptions& o) {
     render::Film film(config.camera.width, config.camera.height, config.output);
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, &options));
-    // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB), so
-    // that the two never add up (glibc keeps freed heap pages otherwise).
+    // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),
+    // so that the two never add up (the allocator keeps freed pages a while otherwise).
     for (uint32_t b = 0; b < source->brick_count(); ++b) source->Evict(b);
-#if defined(__GLIBC__)
-    malloc_trim(0);
-#endif
+    ReturnFreeMemory();
 
     const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);

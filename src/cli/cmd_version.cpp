@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "core/memory.h"
 
 namespace nave::cli {
 
@@ -16,6 +17,7 @@ void RegisterVersionCommand(CLI::App& app, CommandRun& run) {
                         "debug"
 #endif
             );
+            std::printf("allocator: %s\n", AllocatorName().c_str());
             return Status::Ok();
         };
     });

@@ -1,9 +1,6 @@
 // `nave`: one executable, one subcommand per tool. Exit codes: 0 success, 1 bad data or failed
 // work, 2 bad usage (unknown option, invalid argument), 130 interrupted.
 
-#include <malloc.h>
-#include <unistd.h>
-
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +9,25 @@
 #include "cli/commands.h"
 #include "core/log.h"
 #include "core/progress.h"
+
+/// jemalloc's settings, read when it starts (before main; MALLOC_CONF in the environment overrides
+/// them). nave allocates and frees pieces of many sizes, from kilobytes to tens of megabytes
+/// (Embree's BVH blocks, Draco's decoder, ray queues, brick meshes), for hours. glibc's heap kept
+/// every page it ever used around holes the next piece did not fit: under `render --memory 1G` the
+/// billion-triangle abbey grew to 2.2 GiB. jemalloc keeps the process within a few percent of what
+/// it holds.
+/// - thp:always: transparent huge pages for the heap; a 4 KiB page costs a fault on first touch (12
+/// us
+///   on virtual machines, 3.2 s per GiB), and bricks and queues touch gigabytes.
+/// - dirty_decay_ms:20000, muzzy_decay_ms:0: freed pages stay for reuse up to 20 s (the next brick
+///   load takes them without faults), then go back to the system at once.
+/// - narenas:1: one arena for all threads, so what one thread frees (an eviction) is what the next
+///   load on any other reuses.
+/// Measured in docs/pager.md ("Memory").
+extern "C" {
+// NOLINTNEXTLINE: the name jemalloc looks up
+const char* malloc_conf = "thp:always,dirty_decay_ms:20000,muzzy_decay_ms:0,narenas:1";
+}
 
 namespace {
 
@@ -28,38 +44,9 @@ int ExitCodeFor(const nave::Status& status) {
     }
 }
 
-/// Restarts nave with glibc's malloc backing its heap with transparent huge pages (the
-/// glibc.malloc.hugetlb tunable, glibc >= 2.35, read only at process start). A fresh 4 KiB page
-/// costs a fault, on virtual machines 12 us (3.2 s per GiB touched); decoded bricks and ray queues
-/// touch gigabytes. Measured on the detail-110 abbey in-core: 38.5 s -> 31.3 s, 600 k -> 56 k
-/// faults. A GLIBC_TUNABLES that already names the tunable is kept as it is (glibc.malloc.hugetlb=0
-/// turns this off); if the restart fails, nave runs on without.
-void RestartWithHugePageHeap(char** argv) {
-#if defined(__GLIBC__) && defined(__linux__)
-    const char* tunables = std::getenv("GLIBC_TUNABLES");
-    const std::string current = tunables != nullptr ? tunables : "";
-    if (current.find("glibc.malloc.hugetlb") != std::string::npos) return;
-    const std::string wanted =
-        current.empty() ? "glibc.malloc.hugetlb=1" : current + ":glibc.malloc.hugetlb=1";
-    if (::setenv("GLIBC_TUNABLES", wanted.c_str(), 1) != 0) return;
-    ::execv("/proc/self/exe", argv);
-    ::unsetenv("GLIBC_TUNABLES");  // execv returned: it failed; run on as we are
-    if (tunables != nullptr) ::setenv("GLIBC_TUNABLES", tunables, 1);
-#else
-    (void)argv;
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-    RestartWithHugePageHeap(argv);
-    // Brick decoding allocates and frees large buffers all the time. With glibc's defaults each one
-    // is a fresh mmap whose page faults cost more than Draco's decoding itself (measured 2-5x
-    // slower in bench_store_decode); keep such buffers in the heap and return memory to the OS less
-    // eagerly.
-    mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    mallopt(M_TRIM_THRESHOLD, 1 << 30);
     // A write past the file size limit (ulimit -f) then fails like a full disk, with a message
     // naming the file or spill directory, instead of killing the process.
     std::signal(SIGXFSZ, SIG_IGN);

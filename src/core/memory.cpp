@@ -1,12 +1,20 @@
 #include "core/memory.h"
 
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <string>
+
+// jemalloc's control interface, present when the executable links jemalloc (`nave` does, the tests
+// do not): a weak reference is null otherwise.
+extern "C" int mallctl(const char* name, void* oldp, size_t* oldlenp, void* newp, size_t newlen)
+    __attribute__((weak));
 
 namespace nave {
 
@@ -62,6 +70,27 @@ uint64_t PhysicalMemoryBytes() {
     long pages = sysconf(_SC_PHYS_PAGES);
     long page_size = sysconf(_SC_PAGE_SIZE);
     return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
+}
+
+void ReturnFreeMemory() {
+    if (mallctl != nullptr) {
+        // "arena.4096.purge": 4096 is MALLCTL_ARENAS_ALL, every arena.
+        mallctl("arena.4096.purge", nullptr, nullptr, nullptr, 0);
+        return;
+    }
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
+std::string AllocatorName() {
+    const char* version = nullptr;
+    size_t length = sizeof(version);
+    if (mallctl != nullptr && mallctl("version", &version, &length, nullptr, 0) == 0 &&
+        version != nullptr) {
+        return std::string("jemalloc ") + version;
+    }
+    return "glibc malloc";
 }
 
 }  // namespace nave

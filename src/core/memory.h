@@ -20,5 +20,11 @@ uint64_t PeakRssBytes();
 uint64_t CurrentRssBytes();
 /// Physical memory of the machine, in bytes.
 uint64_t PhysicalMemoryBytes();
+/// Gives the pages the allocator holds free back to the system now (jemalloc's purge, in the `nave`
+/// executable; glibc's malloc_trim elsewhere), e.g. before a phase that needs memory the last one
+/// freed.
+void ReturnFreeMemory();
+/// The allocator serving malloc in this process: "jemalloc 5.3.0-..." or "glibc malloc".
+std::string AllocatorName();
 
 }  // namespace nave

@@ -11,15 +11,14 @@ StatusOr<store::SpillExtent> WriteVector(store::SpillFile& file, const std::vect
     return file.Write(v.data(), v.size() * sizeof(T));
 }
 
-/// Reads `extent` into a vector of `n` elements. `spare` more elements are reserved (positions
-/// keep room for Embree's 16-byte loads past the last vertex, so building the brick does not copy
-/// them).
+/// Reads `extent` into `out`, which must hold exactly its bytes.
 template <typename T>
-Status ReadVector(const store::SpillFile& file, const store::SpillExtent& extent, size_t n,
-                  size_t spare, std::vector<T>* v) {
-    v->reserve(n + spare);
-    v->resize(n);
-    return file.Read(extent, v->data());
+Status ReadSpan(const store::SpillFile& file, const store::SpillExtent& extent, std::span<T> out) {
+    if (extent.raw_bytes != out.size_bytes()) {
+        return InternalError("a cached array holds {} bytes where {} were expected",
+                             extent.raw_bytes, out.size_bytes());
+    }
+    return out.empty() ? Status::Ok() : file.Read(extent, out.data());
 }
 
 }  // namespace
@@ -79,26 +78,23 @@ void BrickMeshCache::Put(uint32_t id, const store::BrickMesh& mesh) {
         }
         return;
     }
-    e.positions_n = mesh.positions.size();
-    e.normals_n = mesh.normals.size();
-    e.uvs_n = mesh.uvs.size();
-    e.indices_n = mesh.indices.size();
-    e.materials_n = mesh.material_ids.size();
+    e.counts = {mesh.VertexCount(), mesh.TriangleCount(), mesh.HasNormals(), mesh.HasUvs()};
     stats_.disk_bytes += stored;
     stats_.mesh_bytes += mesh_bytes;
     ++stats_.bricks_written;
     e.ready.store(true, std::memory_order_release);
 }
 
-StatusOr<store::BrickMesh> BrickMeshCache::Get(uint32_t id) const {
+StatusOr<ResidentMesh> BrickMeshCache::Get(uint32_t id) const {
     if (!Has(id)) return InternalError("brick {} is not in the brick cache", id);
     const Entry& e = *entries_[id];
-    store::BrickMesh mesh;
-    Status s = ReadVector(*file_, e.positions, e.positions_n, 1, &mesh.positions);
-    if (s.ok()) s = ReadVector(*file_, e.normal_data, e.normals_n, 0, &mesh.normals);
-    if (s.ok()) s = ReadVector(*file_, e.uv_data, e.uvs_n, 0, &mesh.uvs);
-    if (s.ok()) s = ReadVector(*file_, e.indices, e.indices_n, 0, &mesh.indices);
-    if (s.ok()) s = ReadVector(*file_, e.materials, e.materials_n, 0, &mesh.material_ids);
+    ResidentMesh::Writable w;
+    NAVE_ASSIGN_OR_RETURN(ResidentMesh mesh, ResidentMesh::Allocate(e.counts, &w));
+    Status s = ReadSpan(*file_, e.positions, w.positions);
+    if (s.ok()) s = ReadSpan(*file_, e.normal_data, w.normals);
+    if (s.ok()) s = ReadSpan(*file_, e.uv_data, w.uvs);
+    if (s.ok()) s = ReadSpan(*file_, e.indices, w.indices);
+    if (s.ok()) s = ReadSpan(*file_, e.materials, w.material_ids);
     if (!s.ok()) return s.WithContext(fmt::format("reading brick {} from the brick cache", id));
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.reads;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "render/resident_mesh.h"
 #include "store/brick_mesh.h"
 #include "store/spill_file.h"
 
@@ -39,8 +40,9 @@ class BrickMeshCache {
     /// Caches `mesh` for brick `id` unless it is cached already or the cache is full. A write
     /// error stops the caching (one warning, naming the directory): the render goes on without.
     void Put(uint32_t id, const store::BrickMesh& mesh);
-    /// Reads brick `id`'s mesh back (Has(id) must be true). Errors name the brick.
-    StatusOr<store::BrickMesh> Get(uint32_t id) const;
+    /// Reads brick `id`'s mesh back into pages of its own (Has(id) must be true). Errors name the
+    /// brick.
+    StatusOr<ResidentMesh> Get(uint32_t id) const;
 
     BrickMeshCacheStats stats() const;
     const store::SpillFile& file() const { return *file_; }
@@ -48,8 +50,7 @@ class BrickMeshCache {
   private:
     struct Entry {
         std::atomic<bool> ready{false};
-        // Element counts of the mesh's vectors.
-        size_t positions_n = 0, normals_n = 0, uvs_n = 0, indices_n = 0, materials_n = 0;
+        MeshCounts counts;
         store::SpillExtent positions, normal_data, uv_data, indices, materials;
     };
     std::unique_ptr<store::SpillFile> file_;

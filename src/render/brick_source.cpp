@@ -67,7 +67,7 @@ Status EmbreeDevice::TakeError(const std::string& context) {
 
 // ---------------------------------------------------------------------------------------------- ResidentBrick
 
-ResidentBrick::ResidentBrick(uint32_t id, Bounds3f cell, store::BrickMesh mesh)
+ResidentBrick::ResidentBrick(uint32_t id, Bounds3f cell, ResidentMesh mesh)
     : id_(id), cell_(cell), mesh_(std::move(mesh)) {}
 
 ResidentBrick::~ResidentBrick() {
@@ -90,7 +90,7 @@ void AlphaFilter(const RTCFilterFunctionNArguments* args) {
 }
 
 /// Whether any triangle of `m` has a material with an alpha mask.
-bool NeedsAlphaFilter(const store::BrickMesh& m, const AlphaMasks* masks) {
+bool NeedsAlphaFilter(const ResidentMesh& m, const AlphaMasks* masks) {
     if (masks == nullptr || masks->empty() || !m.HasUvs()) return false;
     std::vector<bool> seen(masks->size(), false);
     for (uint32_t id : m.material_ids) {
@@ -115,12 +115,11 @@ bool ResidentBrick::SurfacePresent(uint32_t triangle, float u, float v) const {
 }
 
 StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
-                                                              Bounds3f cell, store::BrickMesh mesh,
-                                                              const AlphaMasks* masks, const BvhSettings& bvh) {
-    // Embree reads vertex buffers with 16-byte loads: the last vertex needs 4 readable bytes after it.
-    mesh.positions.reserve(mesh.positions.size() + 1);
+                                                              Bounds3f cell, ResidentMesh mesh,
+                                                              const AlphaMasks* masks,
+                                                              const BvhSettings& bvh) {
     std::unique_ptr<ResidentBrick> brick(new ResidentBrick(id, cell, std::move(mesh)));
-    const store::BrickMesh& m = brick->mesh_;
+    const ResidentMesh& m = brick->mesh_;
     RTCDevice dev = static_cast<RTCDevice>(device.handle());
     RTCScene scene = rtcNewScene(dev);
     brick->scene_ = scene;
@@ -155,12 +154,18 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     return brick;
 }
 
+StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
+                                                              Bounds3f cell,
+                                                              const store::BrickMesh& mesh,
+                                                              const AlphaMasks* masks,
+                                                              const BvhSettings& bvh) {
+    NAVE_ASSIGN_OR_RETURN(ResidentMesh copy, ResidentMesh::CopyOf(mesh));
+    return Build(device, id, cell, std::move(copy), masks, bvh);
+}
+
 uint64_t ResidentBrick::EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
                                             bool has_uvs, const BvhSettings& bvh) {
-    // Build's vectors as BrickMesh::MemoryBytes counts them: positions hold one spare vertex (the reserve
-    // above), the other vectors exactly their size.
-    uint64_t per_vertex = sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) + (has_uvs ? 2 * sizeof(float) : 0);
-    return vertex_count * per_vertex + sizeof(Vec3f) + triangle_count * (4 * sizeof(uint32_t)) +
+    return ResidentMesh::MemoryBytesFor({vertex_count, triangle_count, has_normals, has_uvs}) +
            bvh.BytesPerTriangle() * triangle_count;
 }
 
@@ -267,7 +272,10 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     uint64_t bytes = 0;
     const bool cached = mesh_cache_ != nullptr && mesh_cache_->Has(id);
     TraceSpan decode(trace_, cached ? "read from the brick cache" : "read and decode", "pager");
-    StatusOr<store::BrickMesh> mesh = store::BrickMesh();
+    // The mesh ends in pages of its own (ResidentMesh): read back from the cache straight into
+    // them, or decoded into the heap and copied, so that what the heap holds is freed before the
+    // next load.
+    StatusOr<ResidentMesh> mesh = ResidentMesh();
     if (cached) {
         mesh = mesh_cache_->Get(id);
     } else {
@@ -276,7 +284,13 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
             decode_cv_.wait(decode_lock, [&] { return decodes_ < decode_limit_; });
             ++decodes_;
         }
-        mesh = LoadMesh(id, &bytes);
+        StatusOr<store::BrickMesh> decoded = LoadMesh(id, &bytes);
+        if (decoded.ok() && mesh_cache_ != nullptr) {
+            TraceSpan put(trace_, "write to the brick cache", "pager");
+            mesh_cache_->Put(id, *decoded);
+        }
+        mesh = decoded.ok() ? ResidentMesh::CopyOf(*decoded)
+                            : StatusOr<ResidentMesh>(decoded.status());
         if (decode_limit_ > 0) {
             {
                 std::lock_guard<std::mutex> decode_lock(decode_mutex_);
@@ -286,10 +300,6 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         }
     }
     decode.End();
-    if (mesh.ok() && mesh_cache_ != nullptr && !cached) {
-        TraceSpan put(trace_, "write to the brick cache", "pager");
-        mesh_cache_->Put(id, *mesh);
-    }
     if (mesh.ok()) load.AddArg({"triangles", mesh->TriangleCount()});
     load.AddArg({"bytes_read", bytes});
     TraceSpan build(trace_, "bvh build", "pager");

@@ -16,6 +16,7 @@
 
 #include "core/status.h"
 #include "core/vecmath.h"
+#include "render/resident_mesh.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
@@ -75,17 +76,24 @@ class ResidentBrick {
     /// memory, invalid geometry) come back as a Status naming the brick. With `masks`, hits on masked
     /// materials where the mask says the surface is absent are skipped by every query (the masks must outlive
     /// the brick).
-    static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id, Bounds3f cell,
-                                                          store::BrickMesh mesh, const AlphaMasks* masks = nullptr,
+    static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id,
+                                                          Bounds3f cell, ResidentMesh mesh,
+                                                          const AlphaMasks* masks = nullptr,
+                                                          const BvhSettings& bvh = {});
+    /// The same over a copy of `mesh`.
+    static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id,
+                                                          Bounds3f cell,
+                                                          const store::BrickMesh& mesh,
+                                                          const AlphaMasks* masks = nullptr,
                                                           const BvhSettings& bvh = {});
 
     uint32_t id() const { return id_; }
     const Bounds3f& cell() const { return cell_; }
-    const store::BrickMesh& mesh() const { return mesh_; }
+    const ResidentMesh& mesh() const { return mesh_; }
     /// Bytes of the mesh plus an estimate of Embree's BVH (for budgets and statistics).
     uint64_t memory_bytes() const { return memory_bytes_; }
-    /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory says). Exact
-    /// for meshes whose vectors hold no spare capacity (decoded and copied meshes); the pager checks it.
+    /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory
+    /// says). Exact: the pager checks it.
     static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
                                         bool has_uvs, const BvhSettings& bvh = {});
 
@@ -98,11 +106,11 @@ class ResidentBrick {
     bool SurfacePresent(uint32_t triangle, float u, float v) const;
 
   private:
-    ResidentBrick(uint32_t id, Bounds3f cell, store::BrickMesh mesh);
+    ResidentBrick(uint32_t id, Bounds3f cell, ResidentMesh mesh);
     uint32_t id_;
     const AlphaMasks* masks_ = nullptr;
     Bounds3f cell_;
-    store::BrickMesh mesh_;
+    ResidentMesh mesh_;
     void* scene_ = nullptr;  // RTCScene
     uint64_t memory_bytes_ = 0;
 };

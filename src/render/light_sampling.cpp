@@ -67,7 +67,7 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
     }
     NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
         scene, scheduler, [](const SurfaceMaterial& m) { return m.portal; },
-        [&](const store::BrickMesh& m, size_t t, uint32_t) {
+        [&](const ResidentMesh& m, size_t t, uint32_t) {
             triangles.push_back(m.TrianglePositions(t));
         }));
     if (triangles.empty()) {

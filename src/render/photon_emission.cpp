@@ -79,7 +79,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
         NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
             scene_, scheduler,
             [&](const SurfaceMaterial& sm) { return sm.emissive || (want_portals && sm.portal); },
-            [&](const store::BrickMesh& m, size_t t, uint32_t) {
+            [&](const ResidentMesh& m, size_t t, uint32_t) {
                 const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
                 const std::array<Vec3f, 3> v = m.TrianglePositions(t);
                 if (want_portals && sm.portal) portal_triangles.push_back(v);

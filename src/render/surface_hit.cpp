@@ -4,7 +4,7 @@ namespace nave::render {
 
 SurfaceHit MakeSurfaceHit(const RenderScene& scene, const ResidentBrick& brick, const BrickHit& hit,
                           const Vec3f& dir) {
-    const store::BrickMesh& m = brick.mesh();
+    const ResidentMesh& m = brick.mesh();
     const uint32_t i0 = m.indices[3 * hit.triangle], i1 = m.indices[3 * hit.triangle + 1],
                    i2 = m.indices[3 * hit.triangle + 2];
     const float w0 = 1 - hit.u - hit.v;

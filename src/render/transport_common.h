@@ -67,7 +67,7 @@ inline float PowerHeuristic(float a, float b) {
 Status ForEachOwnedTriangle(
     const RenderScene& scene, StreamScheduler& scheduler,
     const std::function<bool(const SurfaceMaterial&)>& want,
-    const std::function<void(const store::BrickMesh&, size_t, uint32_t)>& visit);
+    const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit);
 
 /// Traces a path or photon ray `r` inside brick `b` (pinned as `brick`) from its segment there. At
 /// each hit, `shade(r, hit)` scatters the ray in place and returns whether it goes on. A ray that

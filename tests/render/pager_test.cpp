@@ -517,6 +517,14 @@ TEST(PagerCliTest, MemoryBudgetRendersAndReportsPaging) {
     std::filesystem::remove(std::filesystem::path(out).replace_extension(".png"));
 }
 
+// Paging thousands of bricks in and out keeps the process within its budget only with jemalloc:
+// glibc's heap grew to twice what it held (docs/pager.md, "Memory").
+TEST(PagerCliTest, NaveAllocatesWithJemalloc) {
+    const test::CommandResult r = test::RunNave("version");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("allocator: jemalloc 5."), std::string::npos) << r.output;
+}
+
 // The whole process, not only its bricks, stays within --memory + 64 MiB (VmHWM as nave reports it
 // at exit, image writing included) at the smallest budget nave accepts, halfway to in-core, and
 // with room for every brick: a store of 6 x 6 dense balls in 72 bricks.
