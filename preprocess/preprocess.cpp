@@ -135,9 +135,12 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     PartitionConfig config;
     config.brick_triangles = brick_triangles;
     config.threads = stats.threads;
-    // Split buffers: each thread holds up to 64 writers' blocks (two copies each).
-    config.block_bytes = std::clamp<uint64_t>(
-        stats.memory_budget / 16 / (uint64_t(stats.threads) * 64 * 2), 16 << 10, 256 << 10);
+    // A sixteenth of the budget for the split's block buffers, and as many leaves per pass as they
+    // and the open-file limit allow.
+    config.split_buffer_bytes = stats.memory_budget / 16;
+    config.block_bytes =
+        std::clamp<uint64_t>(config.split_buffer_bytes / (64 * 2), 16 << 10, 256 << 10);
+    config.max_fanout = MaxSplitFanout(config.split_buffer_bytes);
     Partitioner partitioner(config, temp);
     auto phase = Clock::now();
     {

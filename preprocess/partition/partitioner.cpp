@@ -1,9 +1,11 @@
 #include "preprocess/partition/partitioner.h"
 
+#include <sys/resource.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
-#include <condition_variable>
 #include <deque>
-#include <thread>
 
 #include "preprocess/partition/bin_file.h"
 #include "preprocess/partition/triangle_box.h"
@@ -64,7 +66,131 @@ struct LocalLeaf {
     bool splittable = true;
 };
 
+// Where a split pass sends triangles: the bin's local kd-tree and its leaves' cells grown by the
+// margin (the grid step).
+struct RouteTree {
+    const std::vector<LocalNode>& nodes;
+    const std::vector<LocalLeaf>& leaves;
+    std::vector<Bounds3d> grown;
+    float margin;
+};
+
+// The pass of a split: every triangle of `reader` to each leaf cell of `tree` it overlaps (its
+// leaf's writer and sample), on `threads` threads. A pipeline of chunks: read (LZ4) in order,
+// routed on any thread, appended in order, so that each leaf receives its triangles in the bin's
+// order and the bins (and the store) do not depend on the thread count.
+Status RoutePass(BinReader& reader, const RouteTree& tree, int threads,
+                 std::vector<std::unique_ptr<BinWriter>>& writers, std::vector<Reservoir>& samples,
+                 ProgressBar& progress, const TempDir& temp) {
+    // A chunk of the bin and where its triangles go: (triangle, leaf) pairs in the chunk's order;
+    // kUnsampled marks a triangle kept in a cell it touches only through rounding.
+    struct Chunk {
+        std::vector<Triangle> triangles;
+        std::vector<std::pair<uint32_t, uint32_t>> routes;
+    };
+    constexpr uint32_t kUnsampled = 1u << 31;
+    constexpr size_t kChunkTriangles = size_t(1) << 15;
+    const size_t tokens = 2 * size_t(std::max(1, threads));
+    std::vector<std::unique_ptr<Chunk>> pool;  // chunks recycled, at most `tokens` of them
+    std::mutex pool_mutex;
+    const float m = tree.margin;
+    Status failure;  // set by the first and the last stage only, which run one at a time
+
+    auto read = [&](tbb::flow_control& flow) -> Chunk* {
+        std::unique_ptr<Chunk> chunk;
+        {
+            std::lock_guard<std::mutex> lock(pool_mutex);
+            if (!pool.empty()) {
+                chunk = std::move(pool.back());
+                pool.pop_back();
+            }
+        }
+        if (!chunk) chunk = std::make_unique<Chunk>();
+        chunk->triangles.clear();
+        Status cancelled = CheckCancelled();
+        StatusOr<bool> more =
+            cancelled.ok() ? reader.Read(chunk->triangles, kChunkTriangles) : cancelled;
+        if (!more.ok() || !*more || !failure.ok()) {
+            if (!more.ok() && failure.ok()) failure = more.status();
+            flow.stop();
+            return nullptr;
+        }
+        return chunk.release();
+    };
+    auto route = [&](Chunk* chunk) -> Chunk* {
+        chunk->routes.clear();
+        std::vector<int> candidates, stack;
+        for (size_t i = 0; i < chunk->triangles.size(); ++i) {
+            const Triangle& t = chunk->triangles[i];
+            Bounds3f box;
+            for (const Vec3f& p : t.p) box.Extend(p);
+            candidates.clear();
+            stack.assign(1, 0);
+            while (!stack.empty()) {
+                const LocalNode& n = tree.nodes[size_t(stack.back())];
+                stack.pop_back();
+                if (n.axis == 3) {
+                    candidates.push_back(n.leaf);
+                    continue;
+                }
+                if (box.min[n.axis] - m <= n.split) stack.push_back(n.child[0]);
+                if (box.max[n.axis] + m >= n.split) stack.push_back(n.child[1]);
+            }
+            bool placed = false;
+            for (int c : candidates) {
+                if (candidates.size() > 1 && !TriangleOverlapsBox(t.p, tree.grown[size_t(c)]))
+                    continue;
+                chunk->routes.emplace_back(uint32_t(i), uint32_t(c));
+                placed = true;
+            }
+            // Only rounding can leave a triangle unplaced (it touches the parent cell): keep it
+            // somewhere near.
+            if (!placed && !candidates.empty())
+                chunk->routes.emplace_back(uint32_t(i), uint32_t(candidates[0]) | kUnsampled);
+        }
+        return chunk;
+    };
+    auto append = [&](Chunk* chunk) {
+        std::unique_ptr<Chunk> owned(chunk);
+        for (const auto& [index, entry] : chunk->routes) {
+            if (!failure.ok()) break;
+            const uint32_t leaf = entry & ~kUnsampled;
+            const Triangle& t = chunk->triangles[index];
+            Status appended = writers[leaf]->Append(t);
+            if (!appended.ok()) {
+                failure = temp.Annotate(appended);
+                break;
+            }
+            if (!(entry & kUnsampled))
+                samples[leaf].Offer(ClampTo(Centroid(t), tree.leaves[leaf].cell));
+        }
+        progress.Add(chunk->triangles.size());
+        std::lock_guard<std::mutex> lock(pool_mutex);
+        pool.push_back(std::move(owned));
+    };
+    tbb::parallel_pipeline(
+        tokens, tbb::make_filter<void, Chunk*>(tbb::filter_mode::serial_in_order, read) &
+                    tbb::make_filter<Chunk*, Chunk*>(tbb::filter_mode::parallel, route) &
+                    tbb::make_filter<Chunk*, void>(tbb::filter_mode::serial_in_order, append));
+    return failure;
+}
+
 }  // namespace
+
+int MaxSplitFanout(size_t split_buffer_bytes) {
+    rlimit files{};
+    if (getrlimit(RLIMIT_NOFILE, &files) != 0) return 64;
+    if (files.rlim_cur < files.rlim_max) {
+        rlimit raised = files;
+        raised.rlim_cur = files.rlim_max;
+        if (setrlimit(RLIMIT_NOFILE, &raised) == 0) files = raised;
+    }
+    const uint64_t open_files =
+        files.rlim_cur == RLIM_INFINITY ? uint64_t(1) << 20 : uint64_t(files.rlim_cur);
+    const uint64_t by_files = open_files > 130 ? open_files - 128 : 2;
+    const uint64_t by_memory = split_buffer_bytes / (2 * (size_t(16) << 10));
+    return int(std::clamp<uint64_t>(std::min(by_files, by_memory), 2, 4096));
+}
 
 StatusOr<std::unique_ptr<BinWriter>> Partitioner::NewBin(size_t block_bytes) {
     auto created = BinWriter::Create(
@@ -120,47 +246,26 @@ Status Partitioner::Split(const Bounds3f& root, double margin, ProgressBar& prog
     root_.cell = root;
     root_.node = 0;
 
-    // A work queue of bins; workers split or retire them until none is left.
-    std::mutex qm;
-    std::condition_variable cv;
+    // Bins are split one at a time, each pass on every thread (SplitTask): the root's pass cuts
+    // most of the model into leaves at once, and the few children still too big follow.
+    tbb::task_arena arena(std::max(1, config_.threads));
     std::deque<Task> queue;
     queue.push_back(std::move(root_));
-    int busy = 0;
-    Status failure;
-    auto worker = [&] {
-        while (true) {
-            Task task;
-            {
-                std::unique_lock<std::mutex> lock(qm);
-                cv.wait(lock, [&] { return !queue.empty() || busy == 0 || !failure.ok(); });
-                if (!failure.ok() || (queue.empty() && busy == 0)) {
-                    cv.notify_all();
-                    return;
-                }
-                task = std::move(queue.front());
-                queue.pop_front();
-                ++busy;
-            }
+    Status status;
+    arena.execute([&] {
+        while (!queue.empty() && status.ok()) {
+            Task task = std::move(queue.front());
+            queue.pop_front();
             std::vector<Task> children;
-            Status s = SplitTask(std::move(task), children);
-            {
-                std::lock_guard<std::mutex> lock(qm);
-                --busy;
-                if (!s.ok() && failure.ok()) failure = s;
-                for (Task& c : children) queue.push_back(std::move(c));
-            }
-            cv.notify_all();
+            status = SplitTask(std::move(task), children);
+            for (Task& c : children) queue.push_back(std::move(c));
         }
-    };
-    std::vector<std::thread> threads;
-    for (int i = 1; i < config_.threads; ++i) threads.emplace_back(worker);
-    worker();
-    for (auto& t : threads) t.join();
+    });
     // Bigger bricks first: the encoder's threads balance better.
     std::sort(leaves_.begin(), leaves_.end(), [](const LeafBin& a, const LeafBin& b) {
         return a.triangles != b.triangles ? a.triangles > b.triangles : a.node < b.node;
     });
-    return failure;
+    return status;
 }
 
 Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
@@ -247,57 +352,23 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         return Status::Ok();
     }
 
-    // One pass over the bin: each triangle to every leaf cell it overlaps.
+    // One pass over the bin: each triangle to every leaf cell it overlaps. A pipeline of chunks:
+    // read (LZ4) in order, routed on any thread, appended in order, so that each child receives its
+    // triangles in the bin's order and the bins (and the store) do not depend on the thread count.
     const size_t fanout = lleaves.size();
-    size_t block =
-        std::max<size_t>(16 << 10, std::min(config_.block_bytes, (size_t(64) << 20) / fanout));
+    const size_t block = std::clamp<size_t>(config_.split_buffer_bytes / (2 * fanout), 16 << 10,
+                                            config_.block_bytes);
     std::vector<std::unique_ptr<BinWriter>> writers(fanout);
     std::vector<Reservoir> samples;
-    std::vector<Bounds3d> grown(fanout);
+    RouteTree tree{lnodes, lleaves, std::vector<Bounds3d>(fanout), float(margin_)};
     for (size_t i = 0; i < fanout; ++i) {
         NAVE_ASSIGN_OR_RETURN(writers[i], NewBin(block));
         samples.emplace_back(config_.child_sample, uint64_t(task.node) * 1000 + i + 7);
-        grown[i] = Grow(lleaves[i].cell, margin_);
+        tree.grown[i] = Grow(lleaves[i].cell, margin_);
     }
     NAVE_ASSIGN_OR_RETURN(auto reader, BinReader::Open(task.file));
-    std::vector<Triangle> batch;
-    std::vector<int> candidates, stack;
-    const float m = float(margin_);
-    while (true) {
-        batch.clear();
-        NAVE_ASSIGN_OR_RETURN(bool more, reader->Read(batch, 1 << 14));
-        if (!more) break;
-        NAVE_RETURN_IF_ERROR(CheckCancelled());
-        for (const Triangle& t : batch) {
-            Bounds3f box;
-            for (const Vec3f& p : t.p) box.Extend(p);
-            candidates.clear();
-            stack.assign(1, 0);
-            while (!stack.empty()) {
-                const LocalNode& n = lnodes[stack.back()];
-                stack.pop_back();
-                if (n.axis == 3) {
-                    candidates.push_back(n.leaf);
-                    continue;
-                }
-                if (box.min[n.axis] - m <= n.split) stack.push_back(n.child[0]);
-                if (box.max[n.axis] + m >= n.split) stack.push_back(n.child[1]);
-            }
-            bool placed = false;
-            for (int c : candidates) {
-                if (candidates.size() > 1 && !TriangleOverlapsBox(t.p, grown[c])) continue;
-                NAVE_RETURN_IF_ERROR(temp_.Annotate(writers[c]->Append(t)));
-                samples[c].Offer(ClampTo(Centroid(t), lleaves[c].cell));
-                placed = true;
-            }
-            if (!placed && !candidates.empty()) {
-                // Only rounding can get here (the triangle touches the parent cell): keep it
-                // somewhere near.
-                NAVE_RETURN_IF_ERROR(temp_.Annotate(writers[candidates[0]]->Append(t)));
-            }
-        }
-        progress_->Add(batch.size());
-    }
+    NAVE_RETURN_IF_ERROR(
+        RoutePass(*reader, tree, config_.threads, writers, samples, *progress_, temp_));
     reader.reset();
     std::error_code ec;
     int64_t parent_bytes = int64_t(std::filesystem::file_size(task.file, ec));

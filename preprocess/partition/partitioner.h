@@ -3,16 +3,17 @@
 //
 // Phase 1 (Bin): the source is streamed once into an LZ4-compressed temporary bin, while its
 // bounds, its triangle count and a reservoir sample of triangle centroids are gathered. Phase 2
-// (Split): a bin with more triangles than a brick may hold is split: the sample gives a small
-// kd-tree (median of the sample along the cell's longest axis, repeated until each leaf's estimated
-// count is under the target, at most 64 leaves), then one pass over the bin sends each triangle to
+// (Split): a bin with more triangles than a brick may hold is split: the sample gives a kd-tree
+// (median of the sample along the cell's longest axis, repeated until each leaf's estimated count
+// is under the target, at most max_fanout leaves), then one pass over the bin, on every thread,
+// sends each triangle to
 // every leaf cell it overlaps (exact triangle/box test, cells grown by the grid step so that
 // snapping cannot move a triangle out of a cell that needs it). Children still too big are split
 // again. Empty cells get no brick. The result is the tree's nodes and the leaf bins, ready to be
 // encoded.
 //
-// Memory: the sample (12 bytes per point), one block buffer per open bin (2 x block_bytes) per
-// thread; never the triangles themselves.
+// Memory: the sample (12 bytes per point), one block buffer per open bin (two copies of a block),
+// a chunk of 64 K triangles being routed; never the whole bin.
 
 #include <atomic>
 #include <cstdint>
@@ -32,12 +33,23 @@ namespace nave::preprocess {
 
 struct PartitionConfig {
     uint64_t brick_triangles = 1'000'000;  ///< target per brick; a leaf may hold up to 5/4 of it
-    size_t block_bytes = 256 << 10;        ///< bin block size (uncompressed)
-    int threads = 1;
+    size_t block_bytes =
+        256 << 10;    ///< the root bin's block size (uncompressed), and the most for others
+    int threads = 1;  ///< threads of each bin's split pass
     size_t root_sample = 1 << 18;   ///< centroids sampled from the whole input
-    size_t child_sample = 1 << 12;  ///< per child bin (64 children: 3 MiB per splitting thread)
+    size_t child_sample = 1 << 12;  ///< per child bin
+    /// Leaves one split pass may cut a bin into: every one is an open file with its block buffers.
+    /// The root's pass cuts a model of up to max_fanout bricks at once (MaxSplitFanout).
     int max_fanout = 64;
+    /// Memory for the block buffers of one pass's child bins (two copies of a block each; a block
+    /// is 16 KiB to block_bytes).
+    size_t split_buffer_bytes = size_t(64) << 20;
 };
+
+/// The most leaves one split pass may cut a bin into (PartitionConfig::max_fanout): each is an open
+/// file with two block buffers of 16 KiB or more, within `split_buffer_bytes` and the process's
+/// open-file limit (raised to its hard limit here, less 128 files for the rest), from 2 to 4096.
+int MaxSplitFanout(size_t split_buffer_bytes);
 
 /// A bin of triangles and the tree leaf it belongs to.
 struct LeafBin {

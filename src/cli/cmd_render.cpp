@@ -193,6 +193,7 @@ Status RunRender(const RenderOptions& o) {
         }
         options.brick_budget_bytes = memory - reserve;
         if (options.in_core()) --options.brick_budget_bytes;
+        options.process_memory_bytes = memory;
         log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
                   "reserved{}", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
                   FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
@@ -215,15 +216,20 @@ Status RunRender(const RenderOptions& o) {
         ModeName(config.render.mode), stats.samples_per_pixel, stats.iterations, config.render.photons_per_iteration,
         config.render.seed, config.render.max_depth, config.render.threads);
     std::string statistics = fmt::format(
-        "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} brick_visits={} brick_loads={} "
-        "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} brick_reloads={} "
-        "prefetch_loads={} prefetch_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
-        "spilled_rays={} spill_bytes_written={}",
-        stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons, stats.brick_moves,
-        stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
-        stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes) : std::string("in-core"),
-        stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads, stats.prefetch_hits,
-        stats.stall_seconds, stats.cache_reads, stats.cache_disk_bytes, stats.spilled_rays, stats.spill_bytes_written);
+        "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} "
+        "brick_visits={} brick_loads={} "
+        "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} "
+        "brick_reloads={} "
+        "prefetch_loads={} prefetch_hits={} stall={:.3f}s brick_cache_reads={} "
+        "brick_cache_disk_bytes={} "
+        "spilled_rays={} spill_bytes_written={} memory_returns={}",
+        stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons,
+        stats.brick_moves, stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
+        stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes)
+                                     : std::string("in-core"),
+        stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads,
+        stats.prefetch_hits, stats.stall_seconds, stats.cache_reads, stats.cache_disk_bytes,
+        stats.spilled_rays, stats.spill_bytes_written, stats.memory_returns);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -258,18 +264,29 @@ Status RunRender(const RenderOptions& o) {
                  FormatBytes(stats.bytes_read).c_str(), FormatBytes(process_peak).c_str(),
                  static_cast<unsigned long long>(process_peak),
                  FormatBytes(stats.peak_queue_bytes).c_str());
-    std::fprintf(stderr, "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
-                 "resident when needed %s of %s, workers stalled on loads %s\n",
-                 memory_limit ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")").c_str()
-                        : "in-core",
-                 FormatBytes(stats.peak_brick_bytes).c_str(),
-                 memory_limit ? fmt::format(" ({:.0f}% of budget)",
-                                      100.0 * double(stats.peak_brick_bytes) / double(stats.brick_budget_bytes))
-                              .c_str()
-                        : "",
-                 FormatCount(double(stats.brick_evictions)).c_str(), FormatCount(double(stats.brick_reloads)).c_str(),
-                 FormatCount(double(stats.prefetch_loads)).c_str(), FormatCount(double(stats.prefetch_hits)).c_str(),
-                 FormatCount(double(stats.brick_acquires)).c_str(), FormatDuration(stats.stall_seconds).c_str());
+    std::fprintf(
+        stderr,
+        "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
+        "resident when needed %s of %s, workers stalled on loads %s%s\n",
+        memory_limit
+            ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")")
+                  .c_str()
+            : "in-core",
+        FormatBytes(stats.peak_brick_bytes).c_str(),
+        memory_limit ? fmt::format(" ({:.0f}% of budget)", 100.0 * double(stats.peak_brick_bytes) /
+                                                               double(stats.brick_budget_bytes))
+                           .c_str()
+                     : "",
+        FormatCount(double(stats.brick_evictions)).c_str(),
+        FormatCount(double(stats.brick_reloads)).c_str(),
+        FormatCount(double(stats.prefetch_loads)).c_str(),
+        FormatCount(double(stats.prefetch_hits)).c_str(),
+        FormatCount(double(stats.brick_acquires)).c_str(),
+        FormatDuration(stats.stall_seconds).c_str(),
+        stats.memory_returns > 0
+            ? fmt::format(", free pages given back {} times near --memory", stats.memory_returns)
+                  .c_str()
+            : "");
     if (stats.spilled_rays > 0) {
         std::fprintf(stderr, "  ray queues: %s rays spilled to disk (%s written, at most %s on disk at once)\n",
                      FormatCount(double(stats.spilled_rays)).c_str(), FormatBytes(stats.spill_bytes_written).c_str(),

@@ -17,16 +17,17 @@
 /// billion-triangle abbey grew to 2.2 GiB. jemalloc keeps the process within a few percent of what
 /// it holds.
 /// - thp:always: transparent huge pages for the heap; a 4 KiB page costs a fault on first touch (12
-/// us
-///   on virtual machines, 3.2 s per GiB), and bricks and queues touch gigabytes.
-/// - dirty_decay_ms:20000, muzzy_decay_ms:0: freed pages stay for reuse up to 20 s (the next brick
-///   load takes them without faults), then go back to the system at once.
+///   us on virtual machines, 3.2 s per GiB), and bricks and queues touch gigabytes.
+/// - dirty_decay_ms:-1, muzzy_decay_ms:0: freed pages stay with jemalloc for reuse (the next brick
+///   load takes them without faults) until the render's ResidentSizeGuard finds the process near
+///   --memory and gives them back (core/memory.h). Returning them on a timer instead (20 s) made
+///   the detail-110 abbey under --memory 2G 1.18x slower.
 /// - narenas:1: one arena for all threads, so what one thread frees (an eviction) is what the next
 ///   load on any other reuses.
 /// Measured in docs/pager.md ("Memory").
 extern "C" {
 // NOLINTNEXTLINE: the name jemalloc looks up
-const char* malloc_conf = "thp:always,dirty_decay_ms:20000,muzzy_decay_ms:0,narenas:1";
+const char* malloc_conf = "thp:always,dirty_decay_ms:-1,muzzy_decay_ms:0,narenas:1";
 }
 
 namespace {

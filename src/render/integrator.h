@@ -45,6 +45,7 @@ struct RenderStats {
     uint64_t prefetch_loads = 0;       ///< loads done by the background loader
     uint64_t prefetch_hits = 0;        ///< bricks already resident when the scheduler asked for them
     uint64_t brick_acquires = 0;
+    uint64_t memory_returns = 0;  ///< times the allocator gave its free pages back before a load
     double stall_seconds = 0;          ///< time the workers idled while the scheduler waited for a load
     uint64_t peak_rss_bytes = 0;
     uint64_t peak_queue_bytes = 0;

@@ -217,6 +217,7 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
     : source_(source),
       options_(options),
       waiting_(std::move(waiting)),
+      resident_guard_(options.process_memory_bytes),
       state_(source.brick_count(), State::kAbsent),
       bytes_(source.brick_count(), 0),
       last_used_(source.brick_count(), 0),
@@ -448,6 +449,7 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
         }
         Reserve(id, need);
         lock.unlock();
+        resident_guard_.MakeRoom(need);
         StatusOr<BrickHandle> handle = source_.Acquire(id);
         lock.lock();
         if (!handle.ok()) {
@@ -494,7 +496,9 @@ void Pager::Stalled(uint32_t id, std::chrono::steady_clock::time_point start) {
 
 PagerStats Pager::stats() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return stats_;
+    PagerStats stats = stats_;
+    stats.memory_returns = resident_guard_.returns();
+    return stats;
 }
 
 void Pager::LoaderLoop(size_t index) {
@@ -540,6 +544,7 @@ void Pager::LoaderLoop(size_t index) {
         }
         if (reserved) {
             lock.unlock();
+            resident_guard_.MakeRoom(need);
             StatusOr<BrickHandle> handle = BrickHandle();
             arena.execute([&] { handle = source_.Acquire(target); });
             const bool ok = handle.ok();

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/memory.h"
 #include "core/status.h"
 #include "render/brick_source.h"
 
@@ -77,6 +78,11 @@ struct PagerOptions {
     uint64_t queue_memory_bytes = kAutoQueueMemory;
     /// Where spill files go (the brick cache, the ray queues). Empty: the current directory.
     std::filesystem::path spill_dir;
+    /// The whole process's memory (the user's --memory; 0: none). Before each load, when the
+    /// process's resident size plus the brick's estimate would pass it, the allocator gives its
+    /// free pages back (ResidentSizeGuard): freed pages are otherwise kept for the next loads to
+    /// reuse.
+    uint64_t process_memory_bytes = 0;
 };
 
 /// The queue memory (PagerOptions::queue_memory_bytes) for a brick budget: 1/32 of it, at least
@@ -143,6 +149,8 @@ struct PagerStats {
     uint64_t acquires = 0;         ///< bricks pinned for a batch (or for the emitters' pass)
     uint64_t prefetch_hits = 0;    ///< of which were already resident when asked for
     uint64_t estimate_misses = 0;  ///< loads whose real size exceeded the estimate (should stay 0)
+    uint64_t memory_returns =
+        0;  ///< times the allocator's free pages were given back before a load
     double stall_seconds = 0;      ///< time the scheduler waited for a load while the workers idled
 };
 
@@ -206,6 +214,7 @@ class Pager {
     const PagerOptions options_;
     const WaitingFn waiting_;
     std::vector<uint64_t> estimate_;  // by brick: estimated resident bytes
+    ResidentSizeGuard resident_guard_;  // process_memory_bytes, checked before each load
 
     mutable std::mutex mutex_;
     std::condition_variable loader_cv_;  // the loader waits here for requests and batch ends

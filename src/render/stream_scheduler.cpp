@@ -227,6 +227,7 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
         stats->prefetch_hits = p.prefetch_hits;
         stats->brick_acquires = p.acquires;
         stats->stall_seconds = p.stall_seconds;
+        stats->memory_returns = p.memory_returns;
         if (queue_spill_) {
             const store::SpillStats q = queue_spill_->stats();
             stats->spilled_rays = spilled_rays_;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <string>
+
 namespace nave {
 namespace {
 
@@ -28,6 +31,38 @@ TEST(MemoryTest, ProcessAndMachineSizesAreMeasured) {
     EXPECT_GT(PhysicalMemoryBytes(), PeakRssBytes());
     EXPECT_EQ(FormatBytes(1536), "1.5 KiB");
     EXPECT_EQ(FormatBytes(3ull << 30), "3.00 GiB");
+}
+
+TEST(MemoryTest, CurrentRssAgreesWithTheKernelsStatus) {
+    // CurrentRssBytes reads /proc/self/statm; /proc/self/status says the same in KiB.
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    uint64_t vm_rss = 0;
+    while (std::getline(status, line)) {
+        if (line.rfind("VmRSS:", 0) == 0) vm_rss = std::stoull(line.substr(6)) * 1024;
+    }
+    ASSERT_GT(vm_rss, 0u);
+    const uint64_t rss = CurrentRssBytes();
+    EXPECT_GT(rss, vm_rss / 2);
+    EXPECT_LT(rss, vm_rss * 2);
+}
+
+TEST(ResidentSizeGuardTest, GivesPagesBackOnlyWhenTheNextAllocationWouldPassTheLimit) {
+    ResidentSizeGuard none(0);
+    EXPECT_FALSE(none.MakeRoom(uint64_t(1) << 50));
+    EXPECT_EQ(none.returns(), 0u);
+
+    const uint64_t rss = CurrentRssBytes();
+    ResidentSizeGuard roomy(rss + (uint64_t(1) << 30));
+    EXPECT_FALSE(roomy.MakeRoom(uint64_t(1) << 20));  // 1 MiB more fits under 1 GiB of headroom
+    EXPECT_EQ(roomy.returns(), 0u);
+    EXPECT_TRUE(roomy.MakeRoom(uint64_t(2) << 30));  // 2 GiB more does not
+    EXPECT_EQ(roomy.returns(), 1u);
+
+    ResidentSizeGuard tight(rss / 2);  // already over
+    EXPECT_TRUE(tight.MakeRoom(0));
+    EXPECT_TRUE(tight.MakeRoom(0));
+    EXPECT_EQ(tight.returns(), 2u);
 }
 
 }  // namespace

@@ -10,7 +10,12 @@
 #include <random>
 #include <set>
 
+#include "core/hash.h"
+#include "core/progress.h"
+#include "preprocess/abbey/abbey_source.h"
 #include "preprocess/partition/bin_file.h"
+#include "preprocess/partition/partitioner.h"
+#include "preprocess/partition/temp_dir.h"
 #include "preprocess/partition/triangle_box.h"
 #include "preprocess/preprocess.h"
 #include "store/store_reader.h"
@@ -362,6 +367,84 @@ TEST(PreprocessErrors, BudgetTooSmallSaysWhichOptionToChange) {
     EXPECT_THAT(stats.status().message(), HasSubstr("--memory"));
     EXPECT_THAT(stats.status().message(), HasSubstr("--brick-triangles"));
     EXPECT_FALSE(std::filesystem::exists(o.output));
+}
+
+// What a partition made: each leaf's cell, count and a digest of its bin's triangles, in order.
+struct LeafDigest {
+    Bounds3f cell;
+    uint64_t triangles = 0;
+    uint64_t hash = 0;
+    bool operator==(const LeafDigest& o) const {
+        return cell.min == o.cell.min && cell.max == o.cell.max && triangles == o.triangles &&
+               hash == o.hash;
+    }
+};
+
+std::vector<LeafDigest> PartitionAbbey(int threads, int max_fanout) {
+    auto temp = TempDir::Create(testing::MakeTempDir("split-threads"));
+    EXPECT_TRUE(temp.ok()) << temp.status().ToString();
+    if (!temp.ok()) return {};
+    PartitionConfig config;
+    config.brick_triangles = 4000;
+    config.threads = threads;
+    config.max_fanout = max_fanout;
+    Partitioner partitioner(config, *temp);
+    auto source = MakeAbbeySource(0.25, 1);
+    ProgressBar bar("test", 0, "triangles");
+    EXPECT_TRUE(partitioner.Bin(*source, bar).ok());
+    const Bounds3d& b = partitioner.bounds();
+    const Bounds3f root(Vec3f(b.min) - Vec3f(0.01f, 0.01f, 0.01f),
+                        Vec3f(b.max) + Vec3f(0.01f, 0.01f, 0.01f));
+    Status split = partitioner.Split(root, 0.001, bar);
+    EXPECT_TRUE(split.ok()) << split.ToString();
+    std::vector<LeafDigest> digests;
+    for (const LeafBin& leaf : partitioner.leaves()) {
+        LeafDigest d{leaf.cell, leaf.triangles, 0};
+        auto reader = BinReader::Open(leaf.file);
+        EXPECT_TRUE(reader.ok());
+        if (!reader.ok()) continue;
+        std::vector<Triangle> batch;
+        uint64_t read = 0;
+        while (true) {
+            batch.clear();
+            auto more = (*reader)->Read(batch, 1000);
+            EXPECT_TRUE(more.ok());
+            if (!more.ok() || !*more) break;
+            for (const Triangle& t : batch)
+                d.hash = d.hash * 1000003u ^ Checksum64(&t.p, sizeof(t.p)) ^ t.material;
+            read += batch.size();
+        }
+        EXPECT_EQ(read, leaf.triangles);
+        digests.push_back(d);
+    }
+    return digests;
+}
+
+// A split pass routes chunks of its bin on every thread but appends them in order: the leaves, and
+// the order of the triangles in each, are the same on one thread as on two or three, when the
+// root's pass cuts every leaf at once and when bins are cut again (a fan-out of 4 makes several
+// levels).
+TEST(SplitPass, LeavesDoNotDependOnTheThreadCount) {
+    for (int fanout : {4096, 4}) {
+        const std::vector<LeafDigest> one = PartitionAbbey(1, fanout);
+        ASSERT_GE(one.size(), 16u) << "fan-out " << fanout;
+        uint64_t total = 0;
+        for (const LeafDigest& d : one) total += d.triangles;
+        ASSERT_GT(total, uint64_t(3) << 15) << "more triangles than one chunk of the pass";
+        for (int threads : {2, 3}) {
+            const std::vector<LeafDigest> many = PartitionAbbey(threads, fanout);
+            ASSERT_EQ(many.size(), one.size()) << threads << " threads, fan-out " << fanout;
+            for (size_t i = 0; i < one.size(); ++i)
+                EXPECT_TRUE(many[i] == one[i])
+                    << "leaf " << i << ", " << threads << " threads, fan-out " << fanout;
+        }
+    }
+}
+
+TEST(SplitPass, FanOutFollowsTheBuffersAndTheOpenFileLimit) {
+    EXPECT_EQ(MaxSplitFanout(size_t(1) << 40), 4096) << "at most 4096 leaves a pass";
+    EXPECT_EQ(MaxSplitFanout(size_t(64) * 2 * (16 << 10)), 64) << "two 16 KiB blocks a leaf";
+    EXPECT_EQ(MaxSplitFanout(0), 2);
 }
 
 }  // namespace
