@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "common/file_size_limit.h"
+#include "expect_same_mesh.h"
 
 namespace nave::render {
 namespace {
@@ -25,18 +26,7 @@ std::unique_ptr<store::SpillFile> NewSpillFile() {
     return std::move(file).value();
 }
 
-template <typename T>
-std::vector<T> ToVector(std::span<const T> s) {
-    return std::vector<T>(s.begin(), s.end());
-}
-
-void ExpectSameMesh(const ResidentMesh& a, const store::BrickMesh& b) {
-    EXPECT_EQ(ToVector(a.positions), b.positions);
-    EXPECT_EQ(ToVector(a.normals), b.normals);
-    EXPECT_EQ(ToVector(a.uvs), b.uvs);
-    EXPECT_EQ(ToVector(a.indices), b.indices);
-    EXPECT_EQ(ToVector(a.material_ids), b.material_ids);
-}
+using testing::ExpectSameMesh;
 
 TEST(BrickMeshCache, ReadsBackWhatItWasGivenWithAndWithoutNormalsAndUvs) {
     BrickMeshCache cache(NewSpillFile(), 4, uint64_t(1) << 30);

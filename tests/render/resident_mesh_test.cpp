@@ -4,6 +4,8 @@
 
 #include <cstddef>
 
+#include "expect_same_mesh.h"
+
 namespace nave::render {
 namespace {
 
@@ -21,11 +23,6 @@ store::BrickMesh Strip(size_t triangles, bool normals, bool uvs) {
     return m;
 }
 
-template <typename T>
-std::vector<T> ToVector(std::span<const T> s) {
-    return std::vector<T>(s.begin(), s.end());
-}
-
 TEST(ResidentMesh, CopiesEveryArrayIntoOneRegionOfTheSizeItAnnounces) {
     for (bool normals : {false, true}) {
         for (bool uvs : {false, true}) {
@@ -33,11 +30,7 @@ TEST(ResidentMesh, CopiesEveryArrayIntoOneRegionOfTheSizeItAnnounces) {
             auto r = ResidentMesh::CopyOf(m);
             ASSERT_TRUE(r.ok()) << r.status().ToString();
             const ResidentMesh& mesh = *r;
-            EXPECT_EQ(ToVector(mesh.positions), m.positions);
-            EXPECT_EQ(ToVector(mesh.normals), m.normals);
-            EXPECT_EQ(ToVector(mesh.uvs), m.uvs);
-            EXPECT_EQ(ToVector(mesh.indices), m.indices);
-            EXPECT_EQ(ToVector(mesh.material_ids), m.material_ids);
+            testing::ExpectSameMesh(mesh, m);
             EXPECT_EQ(mesh.TriangleCount(), 1000u);
             EXPECT_EQ(mesh.HasNormals(), normals);
             EXPECT_EQ(mesh.HasUvs(), uvs);
