@@ -1,5 +1,8 @@
 #include "preprocess/preprocess.h"
 
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,12 +11,6 @@
 #include <mutex>
 #include <optional>
 #include <thread>
-
-#ifdef __GLIBC__
-#endif
-
-#include <fmt/format.h>
-#include <fmt/ostream.h>
 
 #include "core/log.h"
 #include "core/memory.h"

@@ -352,9 +352,7 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         return Status::Ok();
     }
 
-    // One pass over the bin: each triangle to every leaf cell it overlaps. A pipeline of chunks:
-    // read (LZ4) in order, routed on any thread, appended in order, so that each child receives its
-    // triangles in the bin's order and the bins (and the store) do not depend on the thread count.
+    // One pass over the bin: each triangle to every leaf cell it overlaps (RoutePass).
     const size_t fanout = lleaves.size();
     const size_t block = std::clamp<size_t>(config_.split_buffer_bytes / (2 * fanout), 16 << 10,
                                             config_.block_bytes);

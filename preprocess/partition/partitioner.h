@@ -6,14 +6,13 @@
 // (Split): a bin with more triangles than a brick may hold is split: the sample gives a kd-tree
 // (median of the sample along the cell's longest axis, repeated until each leaf's estimated count
 // is under the target, at most max_fanout leaves), then one pass over the bin, on every thread,
-// sends each triangle to
-// every leaf cell it overlaps (exact triangle/box test, cells grown by the grid step so that
-// snapping cannot move a triangle out of a cell that needs it). Children still too big are split
-// again. Empty cells get no brick. The result is the tree's nodes and the leaf bins, ready to be
-// encoded.
+// sends each triangle to every leaf cell it overlaps (exact triangle/box test, cells grown by the
+// grid step so that snapping cannot move a triangle out of a cell that needs it). Children still
+// too big are split again. Empty cells get no brick. The result is the tree's nodes and the leaf
+// bins, ready to be encoded.
 //
 // Memory: the sample (12 bytes per point), one block buffer per open bin (two copies of a block),
-// a chunk of 64 K triangles being routed; never the whole bin.
+// two chunks of 32 K triangles per thread in the pass's pipeline; never the whole bin.
 
 #include <atomic>
 #include <cstdint>

@@ -3,14 +3,12 @@
 
 #include <cstdio>
 #include <optional>
-#if defined(__GLIBC__)
-#endif
 
 #include "cli/commands.h"
-#include "core/trace.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "core/progress.h"
+#include "core/trace.h"
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
@@ -217,11 +215,9 @@ Status RunRender(const RenderOptions& o) {
         config.render.seed, config.render.max_depth, config.render.threads);
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} "
-        "brick_visits={} brick_loads={} "
-        "bytes_read={} peak_rss={} brick_budget={} peak_brick_bytes={} brick_evictions={} "
-        "brick_reloads={} "
-        "prefetch_loads={} prefetch_hits={} stall={:.3f}s brick_cache_reads={} "
-        "brick_cache_disk_bytes={} "
+        "brick_visits={} brick_loads={} bytes_read={} peak_rss={} brick_budget={} "
+        "peak_brick_bytes={} brick_evictions={} brick_reloads={} prefetch_loads={} "
+        "prefetch_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
         "spilled_rays={} spill_bytes_written={} memory_returns={}",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons,
         stats.brick_moves, stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,

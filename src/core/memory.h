@@ -41,7 +41,6 @@ class ResidentSizeGuard {
     /// Before allocating about `bytes`: when the resident size plus `bytes` passes the limit, gives
     /// the allocator's free pages back (ReturnFreeMemory). Returns whether it did.
     bool MakeRoom(uint64_t bytes);
-    uint64_t limit_bytes() const { return limit_bytes_; }
     /// How many times MakeRoom gave pages back.
     uint64_t returns() const { return returns_.load(std::memory_order_relaxed); }
 
