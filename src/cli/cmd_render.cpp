@@ -1,6 +1,7 @@
 // `nave render MODEL.nave --config SCENE.toml -o OUT.exr`: spectral rendering with ray streams over the
 // bricks of a store. Writes OUT.exr (linear, with settings and statistics as metadata) and OUT.png beside it.
 
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -27,6 +28,7 @@ struct RenderOptions {
     std::string output;
     std::optional<int> spp, iterations, threads;
     std::optional<uint64_t> seed, photons, wave_paths;
+    std::optional<double> noise, time_limit;
     std::string mode;
     std::string resolution;  // "WxH"
     std::string memory;      // --memory SIZE: page bricks under this budget (docs/pager.md)
@@ -62,6 +64,25 @@ uint64_t MaxLoadScratchBytes(const render::BrickSource& source) {
     return most;
 }
 
+/// The summary's line on the image's noise: the render's own estimate and what it stopped on.
+std::string NoiseLine(const render::RenderSettings& settings, const render::RenderStats& stats) {
+    const bool photon = settings.mode == render::RenderSettings::Mode::kPhoton;
+    const int done = photon ? stats.iterations : stats.samples_per_pixel;
+    std::string line =
+        std::isfinite(stats.noise_relmse)
+            ? fmt::format("noise: estimated relMSE {:.3g} after {} {}", stats.noise_relmse, done,
+                          photon ? "iterations" : "samples per pixel")
+            : fmt::format("noise: not estimated (it takes two {})",
+                          photon ? "iterations" : "passes");
+    if (settings.noise_target > 0) {
+        line += std::isfinite(stats.noise_relmse) && stats.noise_relmse <= settings.noise_target
+                    ? fmt::format(", target {:.3g} reached", settings.noise_target)
+                    : fmt::format(", target {:.3g} not reached (raise --{} or render.time_limit_s)",
+                                  settings.noise_target, photon ? "iterations" : "spp");
+    }
+    return line;
+}
+
 Status RunRender(const RenderOptions& o) {
     if (o.model.empty() == o.procedural.empty()) {
         return InvalidArgumentError("give either MODEL.nave or --procedural NAME (not both, not neither)");
@@ -77,6 +98,8 @@ Status RunRender(const RenderOptions& o) {
     if (o.spp) config.render.spp = *o.spp;
     if (o.iterations) config.render.iterations = *o.iterations;
     if (o.threads) config.render.threads = *o.threads;
+    if (o.noise) config.render.noise_target = *o.noise;
+    if (o.time_limit) config.render.time_limit_s = *o.time_limit;
     if (o.seed) config.render.seed = *o.seed;
     if (o.photons) config.render.photons_per_iteration = *o.photons;
     if (o.wave_paths) {
@@ -210,22 +233,25 @@ Status RunRender(const RenderOptions& o) {
     const uint64_t rays = stats.rays;
     const double secs = std::max(1e-9, stats.wall_seconds);
     std::string settings = fmt::format(
-        "mode={} spp={} iterations={} photons_per_iteration={} seed={} max_depth={} threads={}",
-        ModeName(config.render.mode), stats.samples_per_pixel, stats.iterations, config.render.photons_per_iteration,
-        config.render.seed, config.render.max_depth, config.render.threads);
+        "mode={} spp={} iterations={} photons_per_iteration={} seed={} max_depth={} threads={} "
+        "noise_target={} "
+        "time_limit_s={}",
+        ModeName(config.render.mode), stats.samples_per_pixel, stats.iterations,
+        config.render.photons_per_iteration, config.render.seed, config.render.max_depth,
+        config.render.threads, config.render.noise_target, config.render.time_limit_s);
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} "
         "brick_visits={} brick_loads={} bytes_read={} peak_rss={} brick_budget={} "
         "peak_brick_bytes={} brick_evictions={} brick_reloads={} prefetch_loads={} "
         "prefetch_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
-        "spilled_rays={} spill_bytes_written={} memory_returns={}",
+        "spilled_rays={} spill_bytes_written={} memory_returns={} noise_relmse={:.6g}",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons,
         stats.brick_moves, stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
         stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes)
                                      : std::string("in-core"),
         stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads,
         stats.prefetch_hits, stats.stall_seconds, stats.cache_reads, stats.cache_disk_bytes,
-        stats.spilled_rays, stats.spill_bytes_written, stats.memory_returns);
+        stats.spilled_rays, stats.spill_bytes_written, stats.memory_returns, stats.noise_relmse);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -260,6 +286,7 @@ Status RunRender(const RenderOptions& o) {
                  FormatBytes(stats.bytes_read).c_str(), FormatBytes(process_peak).c_str(),
                  static_cast<unsigned long long>(process_peak),
                  FormatBytes(stats.peak_queue_bytes).c_str());
+    std::fprintf(stderr, "  %s\n", NoiseLine(config.render, stats).c_str());
     std::fprintf(
         stderr,
         "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
@@ -317,6 +344,14 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--resolution", opts->resolution, "Override camera.resolution, as WIDTHxHEIGHT (e.g. 960x640)");
     cmd->add_option("--spp", opts->spp, "Override render.spp")->check(CLI::PositiveNumber);
     cmd->add_option("--iterations", opts->iterations, "Override render.iterations")->check(CLI::PositiveNumber);
+    cmd->add_option("--noise", opts->noise,
+                    "Override render.noise_target: stop once the estimated relMSE of the image is "
+                    "at most this "
+                    "(docs/render.md, \"Noise\"); --spp / --iterations are then the most it does")
+        ->check(CLI::Range(0.0, 100.0));
+    cmd->add_option("--time-limit", opts->time_limit,
+                    "Override render.time_limit_s (seconds; 0: none)")
+        ->check(CLI::Range(0.0, 1e7));
     cmd->add_option("--photons", opts->photons, "Override render.photons_per_iteration")->check(CLI::PositiveNumber);
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");

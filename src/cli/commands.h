@@ -22,5 +22,6 @@ void RegisterSpectrumCommand(CLI::App& app, CommandRun& run);
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run);
 void RegisterGenerateCommand(CLI::App& app, CommandRun& run);
 void RegisterRenderCommand(CLI::App& app, CommandRun& run);
+void RegisterCompareCommand(CLI::App& app, CommandRun& run);
 
 }  // namespace nave::cli

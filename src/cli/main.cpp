@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
     nave::cli::RegisterPreprocessCommand(app, run);
     nave::cli::RegisterGenerateCommand(app, run);
     nave::cli::RegisterRenderCommand(app, run);
+    nave::cli::RegisterCompareCommand(app, run);
 
     try {
         app.parse(argc, argv);

@@ -50,6 +50,11 @@ void ProgressBar::Finish() {
     finished_ = true;
 }
 
+void ProgressBar::SetNote(std::string note) {
+    std::lock_guard lock(draw_mutex_);
+    note_ = std::move(note);
+}
+
 void ProgressBar::Draw(bool final_draw) {
     std::lock_guard lock(draw_mutex_);
     if (finished_) return;
@@ -63,6 +68,7 @@ void ProgressBar::Draw(bool final_draw) {
     if (total > 0 && !final_draw && rate > 0) {
         tail += fmt::format(" | ETA {}", FormatDuration(double(total - std::min(done, total)) / rate));
     }
+    if (!note_.empty()) tail += " | " + note_;
     if (tty_) {
         constexpr int kWidth = 30;
         std::string bar;

@@ -22,6 +22,8 @@ class ProgressBar {
     void Add(uint64_t n);
     /// Sets the total once it becomes known.
     void SetTotal(uint64_t total);
+    /// Shows `note` after the rate and times from the next draw on ("noise 0.03"). Thread-safe.
+    void SetNote(std::string note);
     /// Draws the final state and a newline. Called by the destructor if not before.
     void Finish();
 
@@ -36,6 +38,7 @@ class ProgressBar {
 
     std::string label_;
     std::string unit_;
+    std::string note_;  // under draw_mutex_
     std::atomic<uint64_t> total_;
     std::atomic<uint64_t> done_{0};
     std::chrono::steady_clock::time_point start_;

@@ -3,17 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/atomic_add.h"
 #include "imaging/image_io.h"
 
 namespace nave::render {
 namespace {
-
-template <typename T>
-void AtomicAdd(std::atomic<T>& a, T v) {
-    T old = a.load(std::memory_order_relaxed);
-    while (!a.compare_exchange_weak(old, old + v, std::memory_order_relaxed)) {
-    }
-}
 
 /// The white the image is balanced for: none keeps XYZ -> sRGB as is (equal-energy light looks slightly
 /// pink, as in pbrt-v4 without white balance); otherwise the named illuminant's chromaticity is mapped to
@@ -33,6 +27,8 @@ Film::Film(int width, int height, const OutputConfig& output)
     : width_(width), height_(height), output_(output) {
     xyz_.reset(new std::atomic<double>[pixel_count() * 3]);
     for (size_t i = 0; i < pixel_count() * 3; ++i) xyz_[i].store(0, std::memory_order_relaxed);
+    y_half_.reset(new std::atomic<double>[pixel_count() * 2]);
+    for (size_t i = 0; i < pixel_count() * 2; ++i) y_half_[i].store(0, std::memory_order_relaxed);
     if (output_.aov_albedo || output_.aov_normal || output_.aov_depth) {
         aov_.reset(new std::atomic<float>[pixel_count() * 7]);
         aov_count_.reset(new std::atomic<uint32_t>[pixel_count()]);
@@ -41,9 +37,20 @@ Film::Film(int width, int height, const OutputConfig& output)
     }
 }
 
-void Film::AddXYZ(uint32_t pixel, const Vec3d& xyz) {
+void Film::AddXYZ(uint32_t pixel, const Vec3d& xyz, int half) {
     if (!(std::isfinite(xyz.x) && std::isfinite(xyz.y) && std::isfinite(xyz.z))) return;
     for (int c = 0; c < 3; ++c) AtomicAdd(xyz_[3 * size_t(pixel) + c], xyz[c]);
+    if (half == 0 || half == 1) AtomicAdd(y_half_[2 * size_t(pixel) + size_t(half)], xyz.y);
+}
+
+std::vector<float> Film::HalfLuminance(int half, int samples) const {
+    const int n = half == 0 ? (samples + 1) / 2 : samples / 2;
+    if (n <= 0) return {};
+    std::vector<float> y(pixel_count());
+    for (size_t p = 0; p < y.size(); ++p) {
+        y[p] = float(y_half_[2 * p + size_t(half)].load(std::memory_order_relaxed) / n);
+    }
+    return y;
 }
 
 void Film::AddAov(uint32_t pixel, const Vec3f& albedo, const Vec3f& normal, float depth) {

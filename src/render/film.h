@@ -24,28 +24,39 @@ class Film {
   public:
     Film(int width, int height, const OutputConfig& output);
 
-    /// Bytes a film of width x height holds: 3 doubles of XYZ, 7 floats of AOVs and a counter per
-    /// pixel, plus what Write converts them into (linear RGB and AOVs in float, 8-bit PNG).
+    /// Bytes a film of width x height holds: 5 doubles of XYZ and the halves' luminance, 7 floats
+    /// of AOVs and a counter per pixel, plus what Write converts them into (linear RGB and AOVs in
+    /// float, 8-bit PNG).
     static uint64_t MemoryBytes(int width, int height) {
-        return uint64_t(width) * uint64_t(height) * ((3 * 8 + 7 * 4 + 4) + (3 + 10) * 4 + 3);
+        return uint64_t(width) * uint64_t(height) * ((5 * 8 + 7 * 4 + 4) + (3 + 10) * 4 + 3);
     }
 
     int width() const { return width_; }
     int height() const { return height_; }
     size_t pixel_count() const { return size_t(width_) * height_; }
 
-    /// Adds radiance `L` carried at `lambda` to pixel `pixel` (y * width + x). Thread-safe,
-    /// lock-free.
-    void AddSample(uint32_t pixel, const SampledSpectrum& L, const SampledWavelengths& lambda) {
-        Vec3d xyz = SampledToXYZ(L, lambda);
-        AddXYZ(pixel, xyz);
+    /// Adds radiance `L` carried at `lambda` to pixel `pixel` (y * width + x), from a sample of
+    /// half `half` of the render's samples (0 or 1, SampleHalf; kNoHalf for an estimate of the
+    /// whole render). The halves give the render's own noise estimate (NoiseEstimate).
+    /// Thread-safe, lock-free.
+    void AddSample(uint32_t pixel, const SampledSpectrum& L, const SampledWavelengths& lambda,
+                   int half) {
+        AddXYZ(pixel, SampledToXYZ(L, lambda), half);
     }
-    void AddXYZ(uint32_t pixel, const Vec3d& xyz);
+    void AddXYZ(uint32_t pixel, const Vec3d& xyz, int half);
+    static constexpr int kNoHalf = -1;
+    /// The half of the render's samples that sample (path mode: pass; photon mode: iteration)
+    /// `index` belongs to: even ones to 0, odd ones to 1.
+    static int SampleHalf(uint32_t index) { return int(index & 1u); }
     /// Adds to the auxiliary buffers (first-hit albedo, shading normal, depth). Thread-safe.
     void AddAov(uint32_t pixel, const Vec3f& albedo, const Vec3f& normal, float depth);
 
     /// The sum of XYZ added to `pixel`.
     Vec3d SumXYZ(uint32_t pixel) const;
+    /// Per pixel, the mean luminance (CIE Y) of the samples of half `half` (0 or 1) when
+    /// `samples` samples per pixel have been added: half 0 holds ceil(samples / 2) of them, half 1
+    /// floor(samples / 2). Empty when that half has none.
+    std::vector<float> HalfLuminance(int half, int samples) const;
     /// Divides every sum by `samples_per_pixel` for output.
     void SetSamplesPerPixel(double spp) { spp_ = spp; }
     double samples_per_pixel() const { return spp_; }
@@ -64,6 +75,7 @@ class Film {
     OutputConfig output_;
     double spp_ = 1;
     std::unique_ptr<std::atomic<double>[]> xyz_;
+    std::unique_ptr<std::atomic<double>[]> y_half_;  // per pixel, the luminance of each half
     std::unique_ptr<std::atomic<float>[]> aov_;  // albedo rgb, normal xyz, depth: 7 per pixel
     std::unique_ptr<std::atomic<uint32_t>[]> aov_count_;
 };

@@ -60,6 +60,10 @@ struct RenderStats {
     uint64_t spilled_rays = 0;
     uint64_t spill_bytes_written = 0;
     uint64_t spill_peak_disk_bytes = 0;
+    /// The render's own estimate of its image's relative mean squared error (luminance), from its
+    /// two halves of samples (docs/render.md, "Noise"); NaN with fewer than two passes or
+    /// iterations.
+    double noise_relmse = 0;
     int samples_per_pixel = 0;     ///< path mode: passes completed
     int iterations = 0;            ///< photon mode: SPPM iterations completed
 };

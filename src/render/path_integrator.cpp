@@ -8,11 +8,13 @@
 #include <cmath>
 #include <optional>
 
+#include "core/image_error.h"
 #include "core/progress.h"
 #include "core/sampling.h"
 #include "render/brick_walk.h"
 #include "render/rng.h"
 #include "render/sppm.h"
+#include "render/stopping_rule.h"
 #include "render/surface_hit.h"
 #include "render/transport_common.h"
 
@@ -41,13 +43,18 @@ Status PathIntegrator::Run(RenderStats* stats) {
         ProgressBar*& bar;
         ~Unset() { bar = nullptr; }
     } unset{progress_};  // before `progress` goes, whichever way Run returns
-    auto start = std::chrono::steady_clock::now();
+    StoppingRule stop(scene_.settings, &progress);
     int passes = 0;
     // Small images put several passes in one wave, so that the streams stay long enough to keep
     // every thread busy; large images split a pass into waves to bound the memory of the queues.
     const int passes_per_wave = int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
-    for (int s = 0; s < spp; s += passes_per_wave) {
-        const int s_end = std::min(spp, s + passes_per_wave);
+    // With a noise target or a time limit, a wave stops for a check at least every quarter of the
+    // passes done so far (2, 3, 4, 5, ... 8, 10, 12, 15...): at most ~25 % more passes than needed.
+    const bool checks = scene_.settings.noise_target > 0 || scene_.settings.time_limit_s > 0;
+    for (int s = 0; s < spp;) {
+        const int group =
+            checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
+        const int s_end = std::min(spp, s + group);
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
             for (int k = s; k < s_end; ++k)
@@ -55,16 +62,22 @@ Status PathIntegrator::Run(RenderStats* stats) {
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
         }
         passes = s_end;
-        double elapsed =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+        s = s_end;
+        // The last wave's tail may still be in flight: the estimate misses a little of the last
+        // pass, which the final estimate, after the last drain, does not.
+        if (stop.ShouldStop([&] { return NoiseEstimate(passes); })) break;
     }
     NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));  // the last wave's tail
     progress.Finish();
     stats->samples_per_pixel = passes;
+    stats->noise_relmse = NoiseEstimate(passes);
     stats->camera_paths = pixels * uint64_t(passes);
     film_->SetSamplesPerPixel(passes);
     return Status::Ok();
+}
+
+double PathIntegrator::NoiseEstimate(int passes) const {
+    return HalvesRelMse(film_->HalfLuminance(0, passes), film_->HalfLuminance(1, passes));
 }
 
 Status PathIntegrator::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,
@@ -116,7 +129,7 @@ void PathIntegrator::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& br
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
         if (next == store::kNoBrick) {
-            film_->AddSample(r.pixel, r.beta, r.lambda);  // unoccluded all the way
+            film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));  // unoccluded all the way
         } else {
             out.Send(next, b, r);
         }
@@ -158,7 +171,7 @@ void PathIntegrator::Escape(const RayRecord& r) {
             L += sun.spectrum.Sample(r.lambda) * w;
         }
     }
-    if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda);
+    if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda, Half(r));
 }
 
 bool PathIntegrator::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1,
@@ -188,7 +201,7 @@ void PathIntegrator::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, 
     uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
     if (next == store::kNoBrick) {
         if (r.kind == kShadowRay) {
-            film_->AddSample(r.pixel, r.beta, r.lambda);
+            film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));
         } else {
             Escape(r);
         }
@@ -213,7 +226,7 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
         // specular and glossy chains; light reaching diffuse vertices from emitters comes with the
         // photons.
         film_->AddSample(r.pixel, r.beta * mat.Emitted(h.has_uv ? &h.uv : nullptr, r.lambda),
-                         r.lambda);
+                         r.lambda, Half(r));
     }
     // A path at its last scattering still passes through thin glass (not a scattering event): cut
     // there, the light that next-event estimation left to BSDF sampling through a window would be
@@ -245,7 +258,7 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from
         // photons.
         visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, h.footprint,
-                             r.beta);
+                             r.beta, r.lambda);
         return false;
     }
     std::optional<BsdfSample> bs =

@@ -35,8 +35,9 @@ class PathIntegrator final : public RayProcessor {
     PathIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
                    const LightSampler& lights, VisiblePoints* visible_points = nullptr);
 
-    /// Path mode: renders scene.settings.spp passes (fewer if time_limit_s runs out) in waves of
-    /// wave_paths, and fills samples_per_pixel and camera_paths of `stats`.
+    /// Path mode: renders scene.settings.spp passes (fewer once time_limit_s runs out or the
+    /// noise estimate reaches noise_target) in waves of wave_paths, and fills samples_per_pixel,
+    /// camera_paths and noise_relmse of `stats`.
     Status Run(RenderStats* stats);
     /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or
     /// the iteration's when `lambda` is given), spilling queues beyond their cap as it goes.
@@ -51,9 +52,14 @@ class PathIntegrator final : public RayProcessor {
                       std::span<const RayRecord> rays, RayOutbox& out) override;
 
   private:
+    /// The image's estimated relMSE after `passes` passes, from the film's two halves.
+    double NoiseEstimate(int passes) const;
     void GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sample,
                              const SampledWavelengths* lambda);
     void ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, RayOutbox& out);
+    /// The half of the samples (Film::SampleHalf) path `r` belongs to: its pass in path mode, the
+    /// iteration in photon mode.
+    int Half(const RayRecord& r) const { return Film::SampleHalf(r.sample + iteration_); }
     /// Shades a camera-path hit: emission, next-event estimation, continuation. Returns false if
     /// the path ends.
     bool ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit,

@@ -131,7 +131,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
         emitters_.push_back(e);
         weights.push_back(w);
     }
-    if (scene_.sky && want_portals && !portal_triangles.empty()) {
+    if (want_portals && !portal_triangles.empty()) {
         NAVE_ASSIGN_OR_RETURN(sky_portals_, SkyPortals::Build(*scene_.source, portal_triangles));
     }
     if (scene_.sky) {
@@ -174,7 +174,6 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
 }
 
 void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
-                                 const SampledWavelengths& lambda,
                                  StreamScheduler& scheduler) const {
     const float kPiF = 3.14159265358979f;
     const float disk_area = kPiF * scene_radius_ * scene_radius_;
@@ -184,9 +183,11 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
             RayRecord r{};
             r.kind = kPhotonRay;
             r.pixel = uint32_t(i);
-            r.lambda = lambda;
             r.t_max = kInfinity;
             VertexRng rng(RayKey(scene_.settings.seed, r, iteration, kStreamEmit));
+            // Each photon its own wavelengths (sppm.h).
+            const SampledWavelengths lambda = SampledWavelengths::SampleVisible(rng.Uniform(7));
+            r.lambda = lambda;
             float u = rng.Uniform(0);
             size_t k =
                 size_t(std::upper_bound(emitter_cdf_.begin() + 1, emitter_cdf_.end(), double(u)) -
@@ -216,14 +217,23 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                                              .FromLocal(SampleUniformCone(u2, l.cos_sun))
                                        : l.to_light;
                         // Area density of the start point on the plane facing the light: 1/A on the
-                        // disc, count(x)/A_total on the portals' projections (photon_portals.h).
+                        // disc; aimed at windows, the mixture of the portals' projections,
+                        // count(x)/A_portals (photon_portals.h), and the disc.
                         float area = disk_area;
                         if (e.portal >= 0) {
                             const PortalProjection& portals = portals_[size_t(e.portal)];
-                            int coverage = 1;
-                            Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
-                            r.origin = p + to * (2 * scene_radius_);
-                            area = float(portals.total_area()) / float(coverage);
+                            if (rng.Uniform(8) < kPortalPhotonShare) {
+                                int coverage = 1;
+                                Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
+                                r.origin = p + to * (2 * scene_radius_);
+                            } else {
+                                r.origin = disc_origin(l.to_light);
+                            }
+                            const int count = sky_portals_->ForEachCrossing(
+                                r.origin, -to, 4 * scene_radius_, [](const BrickHit&) {});
+                            area = 1.f / (kPortalPhotonShare * float(count) /
+                                              float(portals.total_area()) +
+                                          (1 - kPortalPhotonShare) / disk_area);
                         } else {
                             r.origin = disc_origin(l.to_light);
                         }
@@ -251,28 +261,38 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                         break;
                     }
                 }
-            } else if (e.kind == Emitter::Kind::kSky && sky_portals_) {
-                // A point uniform on the portals' area, a cosine-weighted direction on a random
-                // side: the line's density is count / (2 pi A) in the measure dA_perp dw, count =
-                // portals the line crosses (Veach's balance heuristic over the portals), so the
-                // power is L 2 pi A / count.
-                size_t i = 0;
-                const Vec3f p = sky_portals_->SamplePoint(rng.Uniform(6), u1, &i);
-                const auto& t = sky_portals_->triangle(i);
-                Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
-                if (rng.Uniform(5) < 0.5f) n = -n;
-                Vec3f d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
-                r.origin = p - d * (2 * scene_radius_);
-                r.dir = d;
-                const int count = sky_portals_->ForEachCrossing(r.origin, d, 4 * scene_radius_,
-                                                                [](const BrickHit&) {});
-                r.beta = scene_.SkyRadiance(-d, lambda) *
-                         float(2 * kPiF * sky_portals_->area() / std::max(1, count));
             } else if (e.kind == Emitter::Kind::kSky) {
-                Vec3f to = SampleUniformSphere(u2);
-                r.origin = disc_origin(to);
-                r.dir = -to;
-                r.beta = scene_.SkyRadiance(to, lambda) * (4 * kPiF * disk_area);
+                Vec3f d;
+                if (sky_portals_ && rng.Uniform(8) < kPortalPhotonShare) {
+                    // A point uniform on the portals' area, a cosine-weighted direction on a random
+                    // side.
+                    size_t i = 0;
+                    const Vec3f p = sky_portals_->SamplePoint(rng.Uniform(6), u1, &i);
+                    const auto& t = sky_portals_->triangle(i);
+                    Vec3f n = Normalize(Cross(t[1] - t[0], t[2] - t[0]));
+                    if (rng.Uniform(5) < 0.5f) n = -n;
+                    d = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
+                    r.origin = p - d * (2 * scene_radius_);
+                } else {
+                    // A uniform direction, a point uniform on the disc facing it.
+                    const Vec3f to = SampleUniformSphere(u2);
+                    r.origin = disc_origin(to);
+                    d = -to;
+                }
+                r.dir = d;
+                // The line's density in the measure dA_perp dw: 1 / (4 pi A_disc) through the
+                // bounds; through the portals count / (2 pi A_portals), count = portals the line
+                // crosses (Veach's balance heuristic over the portals); aimed at windows, the
+                // mixture of the two.
+                float density = 1 / (4 * kPiF * disk_area);
+                if (sky_portals_) {
+                    const int count = sky_portals_->ForEachCrossing(r.origin, d, 4 * scene_radius_,
+                                                                    [](const BrickHit&) {});
+                    density =
+                        kPortalPhotonShare * float(count) / float(2 * kPiF * sky_portals_->area()) +
+                        (1 - kPortalPhotonShare) * density;
+                }
+                r.beta = scene_.SkyRadiance(-d, lambda) / density;
                 // Direct skylight is next-event estimated at the visible points: sky photons
                 // deposit only after a bounce.
             } else {

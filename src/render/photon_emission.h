@@ -1,8 +1,8 @@
 #pragma once
 // Where SPPM's photons come from: every emitter of the scene (sun, directional, point and spot
 // lights, the sky, emissive triangles) chosen in proportion to a rough power, and where photons
-// from distant sources start (a disc covering the model, or the windows with render.photon_target =
-// "portals").
+// from distant sources start (a disc covering the model, or with render.photon_target = "portals"
+// mostly the windows).
 
 #include <array>
 #include <cstdint>
@@ -30,10 +30,10 @@ class PhotonEmitters {
     static StatusOr<std::unique_ptr<PhotonEmitters>> Build(const RenderScene& scene,
                                                            StreamScheduler& scheduler);
 
-    /// Queues photons [first, last) of SPPM iteration `iteration` at wavelengths `lambda` through
-    /// `scheduler`, on all threads.
+    /// Queues photons [first, last) of SPPM iteration `iteration` through `scheduler`, on all
+    /// threads; each photon carries its own wavelengths.
     void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
-                     const SampledWavelengths& lambda, StreamScheduler& scheduler) const;
+                     StreamScheduler& scheduler) const;
 
     /// The windows sky photons are aimed through: null unless the scene has a sky and
     /// render.photon_target = "portals" found portal triangles.
@@ -55,6 +55,14 @@ class PhotonEmitters {
         int portal = -1;  // kLight (sun, directional): index in portals_ when aiming at windows
     };
     explicit PhotonEmitters(const RenderScene& scene) : scene_(scene) {}
+
+    // Aimed at windows, this share of the photons from distant sources (sun, directional, sky) goes
+    // through the portals, the rest through the disc covering the model; each photon's power is
+    // divided by the mixture of both densities (a one-sample balance heuristic, Veach 1997 §9.2).
+    // Unbiased for all the light: what enters elsewhere (gaps, doors) or is reflected into a
+    // window from outside (reveals, buttresses, roofs) comes with the disc's photons. In the
+    // abbey that is more than half of the light inside.
+    static constexpr float kPortalPhotonShare = 0.75f;
     /// Fills the emitters and their CDF (Build).
     Status Gather(StreamScheduler& scheduler);
 
@@ -62,8 +70,8 @@ class PhotonEmitters {
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     std::vector<PortalProjection> portals_;
-    // Sky photons aimed at the portals: every portal triangle in one Embree scene, to count the
-    // portals a photon's line crosses (the balance-heuristic weight), and the area CDF to pick
+    // Photons aimed at the portals: every portal triangle in one Embree scene, to count the portals
+    // a photon's line crosses (the balance-heuristic weight), and the area CDF to pick
     // start points.
     std::unique_ptr<SkyPortals> sky_portals_;
     Vec3f scene_center_;

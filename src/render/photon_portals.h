@@ -1,12 +1,14 @@
 #pragma once
-// Aiming photons from distant lights (sun, directional) at windows. Photons start on the projections of the
-// portal triangles onto the plane perpendicular to the light. Where projections overlap (the windows of the
-// north and the south walls seen along the sunlight), a point is reachable from several triangles: sampling a
-// triangle by projected area and a point on it gives the density count(x) / A_total over the plane, where
-// count(x) is the number of projections covering x (a one-sample balance-heuristic estimator over the
-// portals, Veach 1997 §9.2), so the photon's power is L Omega A_total / count(x) and the flux through the
-// union of the windows is unbiased. Light that enters elsewhere (open doors, gaps) is not sampled: that is
-// what the "bounds" target is for.
+// Aiming photons from distant lights (sun, directional) at windows. Photons start on the
+// projections of the portal triangles onto the plane perpendicular to the light. Where projections
+// overlap (the windows of the north and the south walls seen along the sunlight), a point is
+// reachable from several triangles: sampling a triangle by projected area and a point on it gives
+// the density count(x) / A_total over the plane, where count(x) is the number of projections
+// covering x (a one-sample balance-heuristic estimator over the portals, Veach 1997 §9.2), so the
+// photon's power is L Omega A_total / count(x) and the flux through the union of the windows is
+// unbiased. Light that enters elsewhere (open doors, gaps) or is reflected into a window from
+// outside is on lines that cross no window: PhotonEmitters mixes these photons with photons through
+// the whole model's disc (kPortalPhotonShare).
 
 #include <array>
 #include <cstdint>

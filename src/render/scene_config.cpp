@@ -482,6 +482,7 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     }
     NAVE_RETURN_IF_ERROR(r.Int("spp", &s->spp, 1, 1 << 20));
     NAVE_RETURN_IF_ERROR(r.Double("time_limit_s", &s->time_limit_s, 0, 1e7));
+    NAVE_RETURN_IF_ERROR(r.Double("noise_target", &s->noise_target, 0, 100));
     NAVE_RETURN_IF_ERROR(r.Int("iterations", &s->iterations, 1, 1 << 20));
     NAVE_RETURN_IF_ERROR(r.Int("photons_per_iteration", &s->photons_per_iteration, 1, int64_t(1) << 36));
     NAVE_RETURN_IF_ERROR(r.Float("initial_radius_m", &s->initial_radius_m, 0, 1e6));

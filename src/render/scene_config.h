@@ -104,6 +104,10 @@ struct RenderSettings {
     Mode mode = Mode::kPath;
     int spp = 16;                    ///< path mode: samples per pixel; photon mode: camera samples per iteration
     double time_limit_s = 0;         ///< 0: none
+    /// 0: none. Otherwise passes (path mode) or iterations (photon mode) stop once the render's own
+    /// estimate of its relative mean squared error (docs/render.md, "Noise") is at most this; spp
+    /// and iterations are then the most it does.
+    double noise_target = 0;
     int iterations = 16;             ///< photon mode
     uint64_t photons_per_iteration = 200000;
     float initial_radius_m = 0.f;    ///< 0: chosen from the model size

@@ -1,7 +1,10 @@
 #include "render/sppm.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
+#include "core/atomic_add.h"
 #include "core/color.h"
 #include "render/rng.h"
 #include "render/scene.h"
@@ -36,25 +39,64 @@ VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float ini
     }
 }
 
-void VisiblePoints::BeginIteration(const SampledWavelengths& lambda) {
-    lambda_ = lambda;
+void VisiblePoints::BeginIteration() {
     for (Point& p : points_) p.valid = false;
     for (BrickGrid& g : grids_) g.cells.clear();
 }
 
 void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
                         const SurfaceMaterial& material, const std::array<float, 2>* uv,
-                        const imaging::TextureFootprint& footprint, const SampledSpectrum& beta) {
-    points_[pixel].footprint = footprint;
+                        const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
+                        const SampledWavelengths& lambda) {
     Point& vp = points_[pixel];
+    vp.footprint = footprint;
     vp.has_uv = uv != nullptr;
     if (uv != nullptr) vp.uv = *uv;
     vp.p = p;
     vp.ns = ns;
     vp.wo = wo;
     vp.material = &material;
-    vp.beta = beta;
     vp.valid = true;
+    bool flat = true;
+    for (int i = 1; i < kNumWavelengths; ++i) flat = flat && beta[i] == beta[0];
+    if (lambda.SecondaryTerminated()) {
+        vp.throughput = Throughput::kHeroOnly;
+    } else if (flat) {
+        vp.throughput = Throughput::kFlat;
+        vp.beta_nm.fill(beta[0]);
+    } else {
+        vp.throughput = Throughput::kInterpolated;
+        std::array<int, kNumWavelengths> order;
+        std::iota(order.begin(), order.end(), 0);
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return lambda.lambda_nm(a) < lambda.lambda_nm(b); });
+        for (int i = 0; i < kNumWavelengths; ++i) {
+            vp.lambda_nm[i] = lambda.lambda_nm(order[i]);
+            vp.beta_nm[i] = beta[order[i]];
+        }
+    }
+}
+
+SampledSpectrum VisiblePoints::Point::ThroughputAt(const SampledWavelengths& lambda) const {
+    if (throughput == Throughput::kFlat) return SampledSpectrum(beta_nm[0]);
+    SampledSpectrum s;
+    for (int k = 0; k < kNumWavelengths; ++k) {
+        const float l = lambda.lambda_nm(k);
+        // Linear between the camera path's wavelengths, constant beyond the first and the last: an
+        // approximation for the smooth spectra of glass and metals (sppm.h).
+        if (l <= lambda_nm[0]) {
+            s[k] = beta_nm[0];
+        } else if (l >= lambda_nm[kNumWavelengths - 1]) {
+            s[k] = beta_nm[kNumWavelengths - 1];
+        } else {
+            int i = 1;
+            while (lambda_nm[i] < l) ++i;
+            const float t =
+                (l - lambda_nm[i - 1]) / std::max(1e-6f, lambda_nm[i] - lambda_nm[i - 1]);
+            s[k] = beta_nm[i - 1] + t * (beta_nm[i] - beta_nm[i - 1]);
+        }
+    }
+    return s;
 }
 
 uint64_t VisiblePoints::CellKey(const Vec3f& p, float cell) const {
@@ -94,7 +136,7 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
     }
 }
 
-void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
+void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& wi,
                             const SampledSpectrum& beta, const SampledWavelengths& lambda) {
     const BrickGrid& g = grids_[brick];
     auto it = g.cells.find(CellKey(p, g.cell));
@@ -104,21 +146,18 @@ void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, con
         PixelState& px = pixels_[i];
         Vec3f d = vp.p - p;
         if (Dot(d, d) > px.radius * px.radius) continue;
+        if (vp.throughput == Throughput::kHeroOnly) continue;
         SampledWavelengths l = lambda;
         SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint).Eval(vp.wo, wi, l);
         if (f.IsZero()) continue;
-        SampledSpectrum phi = beta * f;
-        for (int k = 0; k < kNumWavelengths; ++k) {
-            float old = px.phi[k].load(std::memory_order_relaxed);
-            while (!px.phi[k].compare_exchange_weak(old, old + phi[k], std::memory_order_relaxed)) {
-            }
-        }
+        const Vec3d xyz = SampledToXYZ(vp.ThroughputAt(l) * f * beta, l);
+        for (int c = 0; c < 3; ++c) AtomicAdd(px.phi[c], float(xyz[c]));
         px.m.fetch_add(1, std::memory_order_relaxed);
         deposits_.fetch_add(1, std::memory_order_relaxed);
     }
 }
 
-void VisiblePoints::EndIteration(float alpha) {
+void VisiblePoints::EndIteration(float alpha, int half) {
     for (size_t i = 0; i < pixel_count_; ++i) {
         PixelState& px = pixels_[i];
         uint32_t m = px.m.load(std::memory_order_relaxed);
@@ -126,11 +165,11 @@ void VisiblePoints::EndIteration(float alpha) {
             // Hachisuka & Jensen 2009: N' = N + alpha M, R' = R sqrt(N' / (N + M)), tau' = (tau + Phi) R'^2/R^2.
             double n_new = px.n + alpha * m;
             float r_new = px.radius * float(std::sqrt(n_new / (px.n + m)));
-            SampledSpectrum phi;
-            for (int k = 0; k < kNumWavelengths; ++k) phi[k] = px.phi[k].load(std::memory_order_relaxed);
-            Vec3d phi_xyz = SampledToXYZ(points_[i].beta * phi, lambda_);
+            Vec3d phi_xyz;
+            for (int c = 0; c < 3; ++c) phi_xyz[c] = px.phi[c].load(std::memory_order_relaxed);
             double shrink = double(r_new) * r_new / (double(px.radius) * px.radius);
             px.tau = (px.tau + phi_xyz) * shrink;
+            px.tau_y_half0 = (px.tau_y_half0 + (half == 0 ? phi_xyz.y : 0.0)) * shrink;
             px.n = n_new;
             px.radius = r_new;
         }
@@ -144,6 +183,14 @@ Vec3d VisiblePoints::IndirectXYZ(uint32_t pixel, double photons_emitted) const {
     double area = 3.14159265358979 * double(px.radius) * px.radius;
     if (photons_emitted <= 0 || area <= 0) return {};
     return px.tau * (1.0 / (photons_emitted * area));
+}
+
+double VisiblePoints::IndirectHalfY(uint32_t pixel, int half, double photons_emitted) const {
+    const PixelState& px = pixels_[pixel];
+    double area = 3.14159265358979 * double(px.radius) * px.radius;
+    if (photons_emitted <= 0 || area <= 0) return 0;
+    const double tau_y = half == 0 ? px.tau_y_half0 : px.tau.y - px.tau_y_half0;
+    return tau_y / (photons_emitted * area);
 }
 
 }  // namespace nave::render

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <optional>
 
+#include "core/image_error.h"
 #include "core/progress.h"
 #include "render/light_sampling.h"
 #include "render/path_integrator.h"
 #include "render/rng.h"
+#include "render/stopping_rule.h"
 #include "render/surface_hit.h"
 #include "render/transport_common.h"
 
@@ -32,36 +34,31 @@ Status SppmIntegrator::Run(RenderStats* stats) {
     visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius);
     PathIntegrator camera_paths(scene_, film_, scheduler_, *lights, visible_.get());
     ProgressBar progress("photon mapping", uint64_t(iterations), "iterations");
-    auto start = std::chrono::steady_clock::now();
+    StoppingRule stop(scene_.settings, &progress);
     int done = 0;
     for (int it = 0; it < iterations; ++it) {
         iteration_ = uint32_t(it);
         camera_paths.set_iteration(iteration_);
-        SampledWavelengths lambda = SampledWavelengths::SampleVisible(
-            VertexRng(RngKey{scene_.settings.seed, 0, 0, 0, iteration_, kStreamLambda}).Uniform(0));
-        visible_->BeginIteration(lambda);
+        visible_->BeginIteration();
         // Visible points must all be in place before photons arrive: waves overlap within each pass
         // only. So the queues hold camera paths and their shadow rays, then photons, never both,
         // and each pass is drained by its own processor.
         for (uint64_t first = 0; first < pixels; first += wave) {
             NAVE_RETURN_IF_ERROR(
-                camera_paths.GenerateCameraRays(first, std::min(pixels, first + wave), 0, &lambda));
+                camera_paths.GenerateCameraRays(first, std::min(pixels, first + wave), 0, nullptr));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(
                 camera_paths, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
         }
         visible_->BuildBrickGrids(scheduler_.tree());
         for (uint64_t first = 0; first < photons; first += wave) {
-            emitters->EmitPhotons(first, std::min(photons, first + wave), iteration_, lambda,
-                                  scheduler_);
+            emitters->EmitPhotons(first, std::min(photons, first + wave), iteration_, scheduler_);
             NAVE_RETURN_IF_ERROR(
                 scheduler_.Drain(*this, first + wave < photons ? scheduler_.WaveOverlap() : 0));
         }
-        visible_->EndIteration(scene_.settings.alpha);
+        visible_->EndIteration(scene_.settings.alpha, Film::SampleHalf(iteration_));
         done = it + 1;
         progress.Add(1);
-        double elapsed =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (scene_.settings.time_limit_s > 0 && elapsed >= scene_.settings.time_limit_s) break;
+        if (stop.ShouldStop([&] { return NoiseEstimate(done); })) break;
     }
     progress.Finish();
     // Direct light and specular chains were summed by the film over `done` iterations; the photon
@@ -70,13 +67,31 @@ Status SppmIntegrator::Run(RenderStats* stats) {
     film_->SetSamplesPerPixel(done);
     const double emitted = double(photons) * done;
     for (uint64_t p = 0; p < pixels; ++p) {
-        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done));
+        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done),
+                      Film::kNoHalf);
     }
+    stats->noise_relmse = NoiseEstimate(done);
     stats->iterations = done;
     stats->samples_per_pixel = done;
     stats->camera_paths = pixels * uint64_t(done);
     stats->photons = emitted;
     return Status::Ok();
+}
+
+double SppmIntegrator::NoiseEstimate(int iterations) const {
+    // Each half: the film's direct light and specular chains of its iterations (even or odd) plus
+    // the photon estimate of the same iterations.
+    std::vector<float> half[2] = {film_->HalfLuminance(0, iterations),
+                                  film_->HalfLuminance(1, iterations)};
+    if (half[0].empty() || half[1].empty()) return std::nan("");
+    const double photons = double(scene_.settings.photons_per_iteration);
+    const double emitted[2] = {photons * ((iterations + 1) / 2), photons * (iterations / 2)};
+    for (int h = 0; h < 2; ++h) {
+        for (size_t p = 0; p < half[h].size(); ++p) {
+            half[h][p] += float(visible_->IndirectHalfY(uint32_t(p), h, emitted[h]));
+        }
+    }
+    return HalvesRelMse(half[0], half[1]);
 }
 
 void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
@@ -103,7 +118,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     // visible points: deposit only photons that bounced, or that come from emitters no estimator
     // samples.
     if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
-        visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
+        visible_->Deposit(b, h.p, wo, r.beta, r.lambda);
     }
     // As for paths, a photon at its last bounce still passes through thin glass.
     const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);

@@ -28,7 +28,8 @@ class SppmIntegrator final : public RayProcessor {
     /// integrator).
     SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler);
 
-    /// Renders scene.settings.iterations SPPM iterations (fewer if time_limit_s runs out) and adds
+    /// Renders scene.settings.iterations SPPM iterations (fewer once time_limit_s runs out or the
+    /// noise estimate reaches noise_target) and adds
     /// the photon estimate to the film; fills iterations, samples_per_pixel, camera_paths and
     /// photons of `stats`. Errors: no emitter, portal settings without portals, a brick that cannot
     /// be pinned.
@@ -38,6 +39,9 @@ class SppmIntegrator final : public RayProcessor {
                       std::span<const RayRecord> rays, RayOutbox& out) override;
 
   private:
+    /// The image's estimated relMSE after `iterations` iterations, from the two halves of the
+    /// film's samples and of the photons (sppm.h).
+    double NoiseEstimate(int iterations) const;
     /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
     bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
 

@@ -42,7 +42,6 @@ enum RngStream : uint32_t {
     kStreamPhoton = 1,
     kStreamCamera = 2,
     kStreamEmit = 3,
-    kStreamLambda = 4,
 };
 
 /// The key of ray r's random numbers in `stream`: its path (or photon), its vertex and the SPPM

@@ -47,20 +47,14 @@ store::BrickMesh BallGrid() {
     return m;
 }
 const std::vector<std::string> kNames = {"floor", "ball", "lamp"};
-constexpr const char* kBallGrid = R"(
+const std::string kBallGrid = R"(
 [camera]
 position = [7, 6, 5]
 look_at = [0, 0, 0.5]
 fov_deg = 50
 resolution = [32, 24]
-[sun]
-direction = [0.4, -0.5, 0.75]
-[sky]
-radiance = 0.05
-[materials.floor]
-reflectance = 0.7
-[materials.ball]
-reflectance = {{ wavelengths_nm = [400, 550, 700], values = [0.1, 0.5, 0.9] }}
+)" + testing::SunSkyFloorAndBall() +
+                              R"(
 [materials.lamp]
 reflectance = 0.5
 emission = 2.0

@@ -12,6 +12,7 @@
 namespace nave::render {
 namespace {
 
+using testing::ClutterMesh;
 using testing::MaxRelativeDifference;
 using testing::MeanY;
 using testing::Render;
@@ -165,31 +166,7 @@ spp = 256
 }
 
 // The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
-store::BrickMesh ClutterMesh() {
-    store::BrickMesh m;
-    AppendQuad(&m, {0, 0, 0}, {4, 0, 0}, {0, 4, 0}, 6, 0);
-    AppendSphere(&m, {0.5f, 0.3f, 1.0f}, 0.8f, 16, 32, 1);
-    AppendSphere(&m, {-1.5f, -1.0f, 0.6f}, 0.6f, 12, 24, 2);
-    AppendBox(&m, Bounds3f({1.0f, -2.5f, 0.01f}, {2.5f, -1.2f, 1.8f}), 0);
-    return m;
-}
-constexpr const char* kClutter = R"(
-[camera]
-position = [6, 5, 3.5]
-look_at = [0, 0, 0.6]
-fov_deg = 45
-resolution = [32, 24]
-[sun]
-direction = [0.4, -0.5, 0.75]
-[sky]
-radiance = 0.05
-[materials.floor]
-reflectance = 0.7
-[materials.ball]
-reflectance = {{ wavelengths_nm = [400, 550, 700], values = [0.1, 0.5, 0.9] }}
-[materials.chrome]
-type = "conductor"
-roughness = 0.2
+const std::string kClutter = testing::ClutterScene(32, 24) + R"(
 [render]
 mode = "{}"
 spp = 4

@@ -73,6 +73,40 @@ inline double MaxRelativeDifference(const Film& a, const Film& b) {
     return worst;
 }
 
+/// The lights and two materials several test scenes share: sun and a faint uniform sky, a grey
+/// floor and a ball whose reflectance rises from blue to red. No braces, so the text may go through
+/// fmt.
+inline std::string SunSkyFloorAndBall() {
+    return R"(
+[sun]
+direction = [0.4, -0.5, 0.75]
+[sky]
+radiance = 0.05
+[materials.floor]
+reflectance = 0.7
+[materials.ball.reflectance]
+wavelengths_nm = [400, 550, 700]
+values = [0.1, 0.5, 0.9]
+)";
+}
+
+/// A floor, two balls and a box (materials "floor", "ball", "chrome").
+inline store::BrickMesh ClutterMesh() {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {4, 0, 0}, {0, 4, 0}, 6, 0);
+    AppendSphere(&m, {0.5f, 0.3f, 1.0f}, 0.8f, 16, 32, 1);
+    AppendSphere(&m, {-1.5f, -1.0f, 0.6f}, 0.6f, 12, 24, 2);
+    AppendBox(&m, Bounds3f({1.0f, -2.5f, 0.01f}, {2.5f, -1.2f, 1.8f}), 0);
+    return m;
+}
+
+/// ClutterMesh's camera (width x height), lights and materials, without a [render] table.
+inline std::string ClutterScene(int width, int height) {
+    return "[camera]\nposition = [6, 5, 3.5]\nlook_at = [0, 0, 0.6]\nfov_deg = 45\nresolution = [" +
+           std::to_string(width) + ", " + std::to_string(height) + "]\n" + SunSkyFloorAndBall() +
+           "[materials.chrome]\ntype = \"conductor\"\nroughness = 0.2\n";
+}
+
 inline double MeanY(const Film& film) {
     double sum = 0;
     for (size_t p = 0; p < film.pixel_count(); ++p) sum += film.PixelXYZ(uint32_t(p)).y;

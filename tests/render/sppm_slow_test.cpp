@@ -133,6 +133,8 @@ type = "thin_dielectric"
 eta = 1.5
 transmittance = 0.9
 portal = true
+[materials.reflector]
+reflectance = 0.9
 [render]
 mode = "photon"
 iterations = 8
@@ -142,15 +144,31 @@ initial_radius_m = 0.1
 max_depth = 6
 seed = 4
 )";
-    std::vector<std::string> names = {"floor", "wall", "window"};
+    std::vector<std::string> names = {"floor", "wall", "window", "reflector"};
+    // Light reflected into the window from outside: a bright wall standing on the roof beside the
+    // window, facing a low sun. No line through the window carries it from the light, so portal
+    // photons alone miss it; photons aimed at the bounds too find it.
+    store::BrickMesh with_reflector = m;
+    AppendQuad(&with_reflector, {-1.2f, 0, 4.5f}, {0, 1.5f, 0}, {0, 0, 1.5f}, 2, 3);
+    struct Case {
+        const store::BrickMesh* mesh;
+        const char* light;
+    };
     // The sun (portal projections) and a uniform sky (portal-area lines counted with Embree).
-    for (const char* light : {"[sun]\ndirection = [0.1, 0.05, 1]\nradiance = 1000.0", "[sky]\nradiance = 1.0"}) {
-        auto bounds = Render(m, names, fmt::format(fmt::runtime(kRoom), light, 400000, "bounds"), 2);
-        auto portals = Render(m, names, fmt::format(fmt::runtime(kRoom), light, 60000, "portals"), 2);
+    for (const Case& c :
+         {Case{&m, "[sun]\ndirection = [0.1, 0.05, 1]\nradiance = 1000.0"},
+          Case{&m, "[sky]\nradiance = 1.0"},
+          Case{&with_reflector, "[sun]\ndirection = [1, 0, 0.6]\nradiance = 1000.0"},
+          Case{&with_reflector, "[sky]\nradiance = 1.0"}}) {
+        auto bounds =
+            Render(*c.mesh, names, fmt::format(fmt::runtime(kRoom), c.light, 400000, "bounds"), 2);
+        auto portals =
+            Render(*c.mesh, names, fmt::format(fmt::runtime(kRoom), c.light, 100000, "portals"), 2);
         ASSERT_TRUE(bounds && portals);
         double b = MeanY(*bounds->film), p = MeanY(*portals->film);
         EXPECT_GT(b, 0);
-        EXPECT_NEAR(p, b, 0.03 * b) << light << ": bounds " << b << " portals " << p;
+        EXPECT_NEAR(p, b, 0.03 * b) << c.light << (c.mesh == &m ? "" : ", with the reflector")
+                                    << ": bounds " << b << " portals " << p;
     }
 }
 

@@ -1,0 +1,34 @@
+#pragma once
+// When a progressive render stops: after its last pass (path mode) or iteration (photon mode), once
+// render.time_limit_s has passed, or once its own noise estimate reaches render.noise_target.
+
+#include <chrono>
+#include <functional>
+
+#include "render/scene_config.h"
+
+namespace nave {
+class ProgressBar;
+}
+
+namespace nave::render {
+
+class StoppingRule {
+  public:
+    /// The rule of `settings`; `progress` (may be null) shows the noise estimate as it goes.
+    StoppingRule(const RenderSettings& settings, ProgressBar* progress);
+
+    /// Whether to stop after a pass or iteration. `noise()` gives the render's estimated relMSE now
+    /// (NaN while it cannot be estimated); it is called only when a noise target is set.
+    bool ShouldStop(const std::function<double()>& noise);
+
+  private:
+    double Elapsed() const;
+
+    double time_limit_s_;
+    double noise_target_;
+    ProgressBar* progress_;
+    std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace nave::render

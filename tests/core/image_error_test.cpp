@@ -1,0 +1,58 @@
+#include "core/image_error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace nave {
+namespace {
+
+TEST(ImageErrorTest, PairRelMseOfAKnownPair) {
+    // Two pixels: (1, 3) and (2, 2). m = (2, 2), mean(m) = 2, offset 0.04. Pixel 0: (a-b)^2/2 = 2
+    // over 4.04; pixel 1: 0.
+    const std::vector<float> a = {1, 2}, b = {3, 2};
+    EXPECT_NEAR(PairRelMse(a, b), (2.0 / 4.04 + 0.0) / 2, 1e-12);
+    EXPECT_NEAR(HalvesRelMse(a, b), (2.0 / 4.04) / 4, 1e-12);
+    EXPECT_EQ(PairRelMse(a, a), 0.0);
+}
+
+TEST(ImageErrorTest, SkipsNonFinitePixelsAndHandlesEmptyHalves) {
+    const std::vector<float> a = {1, NAN, 2}, b = {3, 1, 2};
+    EXPECT_NEAR(PairRelMse(a, b), (2.0 / 4.04) / 2, 1e-12);
+    EXPECT_TRUE(std::isnan(HalvesRelMse({}, b)));
+    EXPECT_EQ(FiniteMean(std::vector<float>{1, INFINITY, 3}), 2.0);
+}
+
+TEST(ImageErrorTest, RelMseAgainstAReference) {
+    const std::vector<float> image = {1.1f, 2}, reference = {1, 2};
+    // mean(reference) = 1.5, offset 0.0225: 0.01 / 1.0225 for pixel 0.
+    EXPECT_NEAR(RelMseAgainst(image, reference), (0.01 / 1.0225) / 2, 1e-6);
+}
+
+// The point of the estimators: from two independent noisy estimates alone, PairRelMse predicts the
+// error of one against the truth, and HalvesRelMse the error of their mean.
+TEST(ImageErrorTest, PairEstimatePredictsTheErrorAgainstTheTruth) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> level(0.1f, 10.f);
+    const size_t n = 200000;
+    std::vector<float> truth(n), a(n), b(n), mean(n);
+    for (size_t i = 0; i < n; ++i) {
+        truth[i] = level(rng);
+        // Noise with a standard deviation of 20 % of the pixel.
+        std::normal_distribution<float> noise(0.f, 0.2f * truth[i]);
+        a[i] = truth[i] + noise(rng);
+        b[i] = truth[i] + noise(rng);
+        mean[i] = 0.5f * (a[i] + b[i]);
+    }
+    const double actual_one = RelMseAgainst(a, truth);
+    const double actual_mean = RelMseAgainst(mean, truth);
+    EXPECT_NEAR(actual_one, 0.04, 0.004);  // about 0.2^2
+    // Within 10 %: the pair's denominator uses the noisy m, the truth's the exact value.
+    EXPECT_NEAR(PairRelMse(a, b) / actual_one, 1.0, 0.1);
+    EXPECT_NEAR(HalvesRelMse(a, b) / actual_mean, 1.0, 0.1);
+}
+
+}  // namespace
+}  // namespace nave
