@@ -13,7 +13,11 @@
 #   NAVE_BRICK_TRIANGLES=100000   target triangles per brick (detail 1 gives 16 bricks)
 #   NAVE_RENDER_MEMORY=620M       render memory budget (at 960x640: 35 MiB of it for bricks, a quarter of the
 #                                 132 MiB all bricks take; the rest is the film, ray queues, textures, process)
-#   NAVE_RESOLUTION=960x640, NAVE_SPP=16, NAVE_MODE=path (or photon)   render settings (configs/abbey.toml has the rest)
+#   NAVE_RESOLUTION=960x640   render size
+#   NAVE_MODE=photon          photon (progressive photon mapping, the best here; docs/render.md "The abbey's
+#                             noise") or path (path tracing, NAVE_SPP=16 samples per pixel)
+#   NAVE_TIME=120             photon mode: render this many seconds (configs/abbey.toml has the rest)
+#   NAVE_NOISE=0              photon mode: stop sooner once the estimated relMSE reaches this (0: off)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${NAVE_OUT:-out}
@@ -23,7 +27,9 @@ brick_triangles=${NAVE_BRICK_TRIANGLES:-100000}
 render_memory=${NAVE_RENDER_MEMORY:-620M}
 resolution=${NAVE_RESOLUTION:-960x640}
 spp=${NAVE_SPP:-16}
-mode=${NAVE_MODE:-path}
+mode=${NAVE_MODE:-photon}
+seconds=${NAVE_TIME:-120}
+noise=${NAVE_NOISE:-0}
 
 bash scripts/build.sh release
 nave=build/release/src/cli/nave
@@ -34,7 +40,13 @@ echo "== 1/3 generate the abbey (detail $detail) and preprocess it into bricks (
   -o "$out/abbey.nave"
 echo "== 2/3 verify every brick" >&2
 "$nave" verify "$out/abbey.nave"
-echo "== 3/3 render ($mode, $spp samples per pixel, $resolution, memory budget $render_memory)" >&2
-"$nave" render "$out/abbey.nave" --config configs/abbey.toml --mode "$mode" --spp "$spp" \
+if [ "$mode" = photon ]; then
+  echo "== 3/3 render (photon mapping for ${seconds} s, $resolution, memory budget $render_memory)" >&2
+  how=(--time-limit "$seconds" --noise "$noise")
+else
+  echo "== 3/3 render (path tracing, $spp samples per pixel, $resolution, memory budget $render_memory)" >&2
+  how=(--spp "$spp")
+fi
+"$nave" render "$out/abbey.nave" --config configs/abbey.toml --mode "$mode" "${how[@]}" \
   --resolution "$resolution" --memory "$render_memory" -o "$out/abbey.exr"
 echo "nave demo: wrote $out/abbey.png and $out/abbey.exr" >&2

@@ -248,7 +248,11 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
                 lights_.SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, !visible_point);
             if (shadow) Spawn(*shadow, b, &brick, out);
         }
-        if (scene_.sky) {
+        // With render.sky_direct = "photons", the sky's photons bring its direct light to the
+        // visible points.
+        const bool sky_from_photons =
+            visible_point && scene_.settings.sky_direct == RenderSettings::SkyDirect::kPhotons;
+        if (scene_.sky && !sky_from_photons) {
             std::optional<RayRecord> shadow =
                 lights_.SampleSky(h, bsdf, wo, r, rng, !visible_point);
             if (shadow) Spawn(*shadow, b, &brick, out);

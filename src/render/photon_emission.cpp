@@ -128,8 +128,17 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
                 w *= 4 * kPiF;
                 break;
         }
+        if (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional) {
+            e.guide = int(guides_.size());
+            guides_.emplace_back(kGuideCells, scene_radius_);
+        }
         emitters_.push_back(e);
         weights.push_back(w);
+    }
+    if (!guides_.empty()) {
+        photon_cells_.assign(
+            std::min<uint64_t>(scene_.settings.photons_per_iteration, kMaxLearnedPhotons),
+            kNoGuideCell);
     }
     if (want_portals && !portal_triangles.empty()) {
         NAVE_ASSIGN_OR_RETURN(sky_portals_, SkyPortals::Build(*scene_.source, portal_triangles));
@@ -173,8 +182,68 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
     return Status::Ok();
 }
 
+float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, const VertexRng& rng,
+                                         RayRecord* r) {
+    const Light& l = *e.light;
+    const Frame frame = Frame::FromZ(l.to_light);
+    const Vec3f plane_centre = scene_center_ + l.to_light * (2 * scene_radius_);
+    const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
+    const PortalProjection* portals = e.portal >= 0 ? &portals_[size_t(e.portal)] : nullptr;
+    PhotonGuide& guide = guides_[size_t(e.guide)];
+    // The strategies' shares: portals and guide when they exist, the disc for the rest.
+    float guide_share = guide.trained() ? kGuidePhotonShare : 0.f;
+    float portal_share = portals != nullptr ? kPortalPhotonShare * (1 - guide_share) : 0.f;
+    const float disc_share = 1 - guide_share - portal_share;
+    const float u = rng.Uniform(8);
+    Vec3f on_line;
+    if (u < portal_share) {
+        int coverage = 1;
+        on_line = portals->Sample(rng.Uniform(6), rng.Uniform(1), rng.Uniform(2), &coverage);
+    } else if (u < portal_share + guide_share) {
+        const Point2f q = guide.Sample(rng.Uniform(6), Point2f(rng.Uniform(1), rng.Uniform(2)));
+        on_line = plane_centre + frame.x * q.x + frame.y * q.y;
+    } else {
+        const Point2f d = SampleUniformDiskConcentric(Point2f(rng.Uniform(1), rng.Uniform(2)));
+        on_line = plane_centre + frame.x * (d.x * scene_radius_) + frame.y * (d.y * scene_radius_);
+    }
+    // Where the photon's line (through on_line along -to) crosses the plane facing the light: the
+    // coordinates every strategy's density is measured in.
+    const float t = Dot(plane_centre - on_line, l.to_light) / Dot(to, l.to_light);
+    r->origin = on_line + to * t;
+    const float x = Dot(r->origin - scene_center_, frame.x),
+                y = Dot(r->origin - scene_center_, frame.y);
+    float density = 0;
+    if (x * x + y * y <= scene_radius_ * scene_radius_) density += disc_share / disk_area;
+    if (guide_share > 0) density += guide_share * guide.Pdf(x, y);
+    if (portals != nullptr) {
+        const int count = sky_portals_->ForEachCrossing(r->origin, -to, 4 * scene_radius_,
+                                                        [](const BrickHit&) {});
+        density += portal_share * float(count) / float(portals->total_area());
+    }
+    if (r->pixel < photon_cells_.size()) {
+        const uint16_t cell = guide.Cell(x, y);
+        photon_cells_[r->pixel] =
+            cell == PhotonGuide::kNoCell ? kNoGuideCell : (uint32_t(e.guide) << 16) | cell;
+    }
+    return density > 0 ? 1 / density : 0.f;
+}
+
+void PhotonEmitters::Learn(std::span<const float> deposited) {
+    const size_t n = std::min(deposited.size(), photon_cells_.size());
+    std::vector<uint16_t> cells(n);
+    for (size_t g = 0; g < guides_.size(); ++g) {
+        for (size_t k = 0; k < n; ++k) {
+            const uint32_t c = photon_cells_[k];
+            cells[k] =
+                c != kNoGuideCell && (c >> 16) == g ? uint16_t(c & 0xffff) : PhotonGuide::kNoCell;
+        }
+        guides_[g].Learn(cells, deposited.subspan(0, n));
+    }
+    std::fill(photon_cells_.begin(), photon_cells_.end(), kNoGuideCell);
+}
+
 void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
-                                 StreamScheduler& scheduler) const {
+                                 StreamScheduler& scheduler) {
     const float kPiF = 3.14159265358979f;
     const float disk_area = kPiF * scene_radius_ * scene_radius_;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
@@ -216,27 +285,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                         Vec3f to = sun ? Frame::FromZ(l.to_light)
                                              .FromLocal(SampleUniformCone(u2, l.cos_sun))
                                        : l.to_light;
-                        // Area density of the start point on the plane facing the light: 1/A on the
-                        // disc; aimed at windows, the mixture of the portals' projections,
-                        // count(x)/A_portals (photon_portals.h), and the disc.
-                        float area = disk_area;
-                        if (e.portal >= 0) {
-                            const PortalProjection& portals = portals_[size_t(e.portal)];
-                            if (rng.Uniform(8) < kPortalPhotonShare) {
-                                int coverage = 1;
-                                Vec3f p = portals.Sample(rng.Uniform(6), u1.x, u1.y, &coverage);
-                                r.origin = p + to * (2 * scene_radius_);
-                            } else {
-                                r.origin = disc_origin(l.to_light);
-                            }
-                            const int count = sky_portals_->ForEachCrossing(
-                                r.origin, -to, 4 * scene_radius_, [](const BrickHit&) {});
-                            area = 1.f / (kPortalPhotonShare * float(count) /
-                                              float(portals.total_area()) +
-                                          (1 - kPortalPhotonShare) / disk_area);
-                        } else {
-                            r.origin = disc_origin(l.to_light);
-                        }
+                        const float area = StartDistantPhoton(e, to, rng, &r);
                         r.dir = -to;
                         // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E /
                         // p_area.
@@ -293,8 +342,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                         (1 - kPortalPhotonShare) * density;
                 }
                 r.beta = scene_.SkyRadiance(-d, lambda) / density;
-                // Direct skylight is next-event estimated at the visible points: sky photons
-                // deposit only after a bounce.
+                r.flags = kFromSky;
             } else {
                 // Uniform point on the triangle (Turk 1990 square-root parameterisation),
                 // cosine-weighted direction on a side chosen with probability 1/2.

@@ -7,12 +7,14 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/spectrum.h"
 #include "core/status.h"
 #include "core/vecmath.h"
 #include "render/light_sampling.h"
+#include "render/photon_guide.h"
 #include "render/photon_portals.h"
 #include "render/scene.h"
 
@@ -32,11 +34,16 @@ class PhotonEmitters {
 
     /// Queues photons [first, last) of SPPM iteration `iteration` through `scheduler`, on all
     /// threads; each photon carries its own wavelengths.
-    void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
-                     StreamScheduler& scheduler) const;
+    void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, StreamScheduler& scheduler);
+    /// After a photon pass: learns where the sun's photons are worth starting (photon_guide.h) from
+    /// deposited[k], the luminance photon k brought to the visible points, for the first
+    /// learned_photons() photons of the pass.
+    void Learn(std::span<const float> deposited);
+    /// How many photons of a pass Learn looks at (the first ones): a cap on its memory.
+    uint64_t learned_photons() const { return photon_cells_.size(); }
 
-    /// The windows sky photons are aimed through: null unless the scene has a sky and
-    /// render.photon_target = "portals" found portal triangles.
+    /// The windows photons are aimed through: null unless render.photon_target = "portals" found
+    /// portal triangles.
     const SkyPortals* sky_portals() const { return sky_portals_.get(); }
     /// The model's bounding sphere, on which photons from distant sources start.
     const Vec3f& scene_center() const { return scene_center_; }
@@ -53,6 +60,7 @@ class PhotonEmitters {
         std::array<std::array<float, 2>, 3> uv{};   // kTriangle: texture coordinates of v0, v1, v2
         bool has_uv = false;
         int portal = -1;  // kLight (sun, directional): index in portals_ when aiming at windows
+        int guide = -1;   // kLight (sun, directional): index in guides_
     };
     explicit PhotonEmitters(const RenderScene& scene) : scene_(scene) {}
 
@@ -63,6 +71,16 @@ class PhotonEmitters {
     // window from outside (reveals, buttresses, roofs) comes with the disc's photons. In the
     // abbey that is more than half of the light inside.
     static constexpr float kPortalPhotonShare = 0.75f;
+    // Once a guide has learned (photon_guide.h), the sun's photons are drawn from it with this
+    // share, the portals' share is scaled to the rest, and the disc keeps what remains.
+    static constexpr float kGuidePhotonShare = 0.6f;
+    // Cells per side of a guide's grid, and the most photons of a pass it learns from.
+    static constexpr int kGuideCells = 128;
+    static constexpr uint64_t kMaxLearnedPhotons = uint64_t(1) << 22;
+    /// Starts photon `r` of distant light `e` (sun or directional) toward -to: on the portals, the
+    /// guide or the disc, with the mixture's area density; returns 1 / density (m^2) and records
+    /// the photon's start cell for Learn.
+    float StartDistantPhoton(const Emitter& e, const Vec3f& to, const VertexRng& rng, RayRecord* r);
     /// Fills the emitters and their CDF (Build).
     Status Gather(StreamScheduler& scheduler);
 
@@ -70,6 +88,11 @@ class PhotonEmitters {
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     std::vector<PortalProjection> portals_;
+    std::vector<PhotonGuide> guides_;
+    // Per photon of a pass (the first kMaxLearnedPhotons): guide index << 16 | start cell, or
+    // kNoGuideCell.
+    std::vector<uint32_t> photon_cells_;
+    static constexpr uint32_t kNoGuideCell = 0xffffffffu;
     // Photons aimed at the portals: every portal triangle in one Embree scene, to count the portals
     // a photon's line crosses (the balance-heuristic weight), and the area CDF to pick
     // start points.

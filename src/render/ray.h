@@ -17,8 +17,11 @@ enum RayKind : uint8_t {
 };
 
 enum RayFlags : uint8_t {
-    kSpecularBounce = 1 << 0,  ///< the last scattering was specular (no light sampling possible there)
-    kFromAreaLight = 1 << 1,   ///< photon emitted by a surface (its direct light is not next-event estimated)
+    kSpecularBounce =
+        1 << 0,  ///< the last scattering was specular (no light sampling possible there)
+    kFromAreaLight =
+        1 << 1,  ///< photon emitted by a surface (its direct light is not next-event estimated)
+    kFromSky = 1 << 2,  ///< photon from the sky
 };
 
 struct RayRecord {

@@ -498,6 +498,10 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Choice("sky_sampling", {{"uniform", RenderSettings::SkySampling::kUniform},
                                                    {"portals", RenderSettings::SkySampling::kPortals}},
                                   &s->sky_sampling));
+    NAVE_RETURN_IF_ERROR(r.Choice("sky_direct",
+                                  {{"sampled", RenderSettings::SkyDirect::kSampled},
+                                   {"photons", RenderSettings::SkyDirect::kPhotons}},
+                                  &s->sky_direct));
     return r.Finish();
 }
 

@@ -111,7 +111,7 @@ struct RenderSettings {
     int iterations = 16;             ///< photon mode
     uint64_t photons_per_iteration = 200000;
     float initial_radius_m = 0.f;    ///< 0: chosen from the model size
-    float alpha = 2.f / 3.f;         ///< SPPM radius reduction (Hachisuka & Jensen 2009)
+    float alpha = 2.f / 3.f;         ///< photon mode radius reduction (Knaus & Zwicker 2011 eq. 16)
     int max_depth = 8;
     uint64_t seed = 1;
     int threads = 0;                 ///< 0: all cores
@@ -127,6 +127,13 @@ struct RenderSettings {
     /// triangles of `portal` materials (windows), which an interior sees the sky through.
     enum class SkySampling { kUniform, kPortals };
     SkySampling sky_sampling = SkySampling::kUniform;
+    /// Photon mode: where the sky's direct light at the visible points comes from: next-event
+    /// estimation ("sampled", as sky_sampling says), or the sky's photons, deposited from their
+    /// first hit on ("photons": smooth where a few windows among many let the sky in, which
+    /// next-event estimation finds by chance; blurred over the gather radius like all photon
+    /// light).
+    enum class SkyDirect { kSampled, kPhotons };
+    SkyDirect sky_direct = SkyDirect::kSampled;
 };
 
 struct OutputConfig {

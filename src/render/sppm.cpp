@@ -31,10 +31,15 @@ void BricksOverlapping(const store::BrickTree& tree, const Bounds3f& box, std::v
     }
 }
 
-VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius)
-    : points_(pixel_count), pixels_(new PixelState[pixel_count]), pixel_count_(pixel_count), grids_(brick_count) {
+VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius,
+                             float alpha)
+    : points_(pixel_count),
+      pixels_(new PixelState[pixel_count]),
+      pixel_count_(pixel_count),
+      radius_(initial_radius),
+      alpha_(alpha),
+      grids_(brick_count) {
     for (size_t i = 0; i < pixel_count; ++i) {
-        pixels_[i].radius = initial_radius;
         for (auto& f : pixels_[i].phi) f.store(0, std::memory_order_relaxed);
     }
 }
@@ -106,17 +111,13 @@ uint64_t VisiblePoints::CellKey(const Vec3f& p, float cell) const {
 }
 
 void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
-    float max_radius = 0;
-    for (size_t i = 0; i < pixel_count_; ++i) {
-        if (points_[i].valid) max_radius = std::max(max_radius, pixels_[i].radius);
-    }
-    if (max_radius <= 0) return;
-    for (BrickGrid& g : grids_) g.cell = 2 * max_radius;
+    if (radius_ <= 0) return;
+    for (BrickGrid& g : grids_) g.cell = 2 * radius_;
     std::vector<uint32_t> bricks;
     for (size_t i = 0; i < pixel_count_; ++i) {
         const Point& vp = points_[i];
         if (!vp.valid) continue;
-        float r = pixels_[i].radius;
+        const float r = radius_;
         Bounds3f box(vp.p - Vec3f(r, r, r), vp.p + Vec3f(r, r, r));
         BricksOverlapping(tree, box, &bricks);
         for (uint32_t b : bricks) {
@@ -136,61 +137,58 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
     }
 }
 
-void VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& wi,
-                            const SampledSpectrum& beta, const SampledWavelengths& lambda) {
+float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
+                             const SampledSpectrum& beta, const SampledWavelengths& lambda) {
     const BrickGrid& g = grids_[brick];
     auto it = g.cells.find(CellKey(p, g.cell));
-    if (it == g.cells.end()) return;
+    if (it == g.cells.end()) return 0;
+    float added = 0;
     for (uint32_t i : it->second) {
         const Point& vp = points_[i];
         PixelState& px = pixels_[i];
         Vec3f d = vp.p - p;
-        if (Dot(d, d) > px.radius * px.radius) continue;
+        if (Dot(d, d) > radius_ * radius_) continue;
         if (vp.throughput == Throughput::kHeroOnly) continue;
+        if (std::abs(Dot(ng, vp.ns)) < kSameSurfaceCos) continue;
         SampledWavelengths l = lambda;
         SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint).Eval(vp.wo, wi, l);
         if (f.IsZero()) continue;
         const Vec3d xyz = SampledToXYZ(vp.ThroughputAt(l) * f * beta, l);
         for (int c = 0; c < 3; ++c) AtomicAdd(px.phi[c], float(xyz[c]));
-        px.m.fetch_add(1, std::memory_order_relaxed);
+        added += float(xyz.y);
         deposits_.fetch_add(1, std::memory_order_relaxed);
     }
+    return added;
 }
 
-void VisiblePoints::EndIteration(float alpha, int half) {
+void VisiblePoints::EndIteration(int half) {
+    const double area = 3.14159265358979 * double(radius_) * radius_;
     for (size_t i = 0; i < pixel_count_; ++i) {
         PixelState& px = pixels_[i];
-        uint32_t m = px.m.load(std::memory_order_relaxed);
-        if (m > 0 && points_[i].valid) {
-            // Hachisuka & Jensen 2009: N' = N + alpha M, R' = R sqrt(N' / (N + M)), tau' = (tau + Phi) R'^2/R^2.
-            double n_new = px.n + alpha * m;
-            float r_new = px.radius * float(std::sqrt(n_new / (px.n + m)));
-            Vec3d phi_xyz;
-            for (int c = 0; c < 3; ++c) phi_xyz[c] = px.phi[c].load(std::memory_order_relaxed);
-            double shrink = double(r_new) * r_new / (double(px.radius) * px.radius);
-            px.tau = (px.tau + phi_xyz) * shrink;
-            px.tau_y_half0 = (px.tau_y_half0 + (half == 0 ? phi_xyz.y : 0.0)) * shrink;
-            px.n = n_new;
-            px.radius = r_new;
+        if (points_[i].valid) {
+            Vec3d density;
+            for (int c = 0; c < 3; ++c)
+                density[c] = px.phi[c].load(std::memory_order_relaxed) / area;
+            px.density_sum += density;
+            if (half == 0) px.density_sum_y_half0 += density.y;
         }
-        px.m.store(0, std::memory_order_relaxed);
         for (auto& f : px.phi) f.store(0, std::memory_order_relaxed);
     }
+    // Knaus & Zwicker 2011 eq. 16: r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1).
+    radius_ *= float(std::sqrt((iteration_ + double(alpha_)) / (iteration_ + 1.0)));
+    ++iteration_;
 }
 
 Vec3d VisiblePoints::IndirectXYZ(uint32_t pixel, double photons_emitted) const {
-    const PixelState& px = pixels_[pixel];
-    double area = 3.14159265358979 * double(px.radius) * px.radius;
-    if (photons_emitted <= 0 || area <= 0) return {};
-    return px.tau * (1.0 / (photons_emitted * area));
+    if (photons_emitted <= 0) return {};
+    return pixels_[pixel].density_sum * (1.0 / photons_emitted);
 }
 
 double VisiblePoints::IndirectHalfY(uint32_t pixel, int half, double photons_emitted) const {
+    if (photons_emitted <= 0) return 0;
     const PixelState& px = pixels_[pixel];
-    double area = 3.14159265358979 * double(px.radius) * px.radius;
-    if (photons_emitted <= 0 || area <= 0) return 0;
-    const double tau_y = half == 0 ? px.tau_y_half0 : px.tau.y - px.tau_y_half0;
-    return tau_y / (photons_emitted * area);
+    const double y = half == 0 ? px.density_sum_y_half0 : px.density_sum.y - px.density_sum_y_half0;
+    return y / photons_emitted;
 }
 
 }  // namespace nave::render

@@ -17,7 +17,10 @@
 namespace nave::render {
 
 SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler)
-    : scene_(scene), film_(film), scheduler_(scheduler) {}
+    : scene_(scene),
+      film_(film),
+      scheduler_(scheduler),
+      sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
 
 Status SppmIntegrator::Run(RenderStats* stats) {
     const Camera& camera = *scene_.camera;
@@ -31,7 +34,8 @@ Status SppmIntegrator::Run(RenderStats* stats) {
                           LightSampler::Create(scene_, scheduler_, emitters->sky_portals()));
     float radius = scene_.settings.initial_radius_m > 0 ? scene_.settings.initial_radius_m
                                                         : 0.01f * 2 * emitters->scene_radius();
-    visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius);
+    visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius,
+                                               scene_.settings.alpha);
     PathIntegrator camera_paths(scene_, film_, scheduler_, *lights, visible_.get());
     ProgressBar progress("photon mapping", uint64_t(iterations), "iterations");
     StoppingRule stop(scene_.settings, &progress);
@@ -50,12 +54,14 @@ Status SppmIntegrator::Run(RenderStats* stats) {
                 camera_paths, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
         }
         visible_->BuildBrickGrids(scheduler_.tree());
+        deposited_.assign(emitters->learned_photons(), 0.f);
         for (uint64_t first = 0; first < photons; first += wave) {
             emitters->EmitPhotons(first, std::min(photons, first + wave), iteration_, scheduler_);
             NAVE_RETURN_IF_ERROR(
                 scheduler_.Drain(*this, first + wave < photons ? scheduler_.WaveOverlap() : 0));
         }
-        visible_->EndIteration(scene_.settings.alpha, Film::SampleHalf(iteration_));
+        emitters->Learn(deposited_);
+        visible_->EndIteration(Film::SampleHalf(iteration_));
         done = it + 1;
         progress.Add(1);
         if (stop.ShouldStop([&] { return NoiseEstimate(done); })) break;
@@ -116,9 +122,13 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     if (flags == kBxdfUnset) return false;
     // Direct light from the sun and the other delta or disc lights is next-event estimated at the
     // visible points: deposit only photons that bounced, or that come from emitters no estimator
-    // samples.
-    if ((r.depth > 0 || (r.flags & kFromAreaLight)) && (flags & kBxdfDiffuse)) {
-        visible_->Deposit(b, h.p, wo, r.beta, r.lambda);
+    // samples (emissive surfaces; the sky with render.sky_direct = "photons").
+    if ((r.depth > 0 || (r.flags & kFromAreaLight) ||
+         ((r.flags & kFromSky) && sky_direct_photons_)) &&
+        (flags & kBxdfDiffuse)) {
+        const float added = visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
+        // One writer per photon: a photon is traced by one thread at a time.
+        if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
     }
     // As for paths, a photon at its last bounce still passes through thin glass.
     const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);

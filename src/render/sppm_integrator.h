@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "core/status.h"
 #include "render/brick_source.h"
@@ -49,7 +50,11 @@ class SppmIntegrator final : public RayProcessor {
     Film* film_;
     StreamScheduler& scheduler_;
     std::unique_ptr<VisiblePoints> visible_;
+    // Per photon of the pass (the first PhotonEmitters::learned_photons()), the luminance it
+    // brought to the visible points, for the emitters to learn from.
+    std::vector<float> deposited_;
     uint32_t iteration_ = 0;
+    const bool sky_direct_photons_;  // render.sky_direct = "photons"
 };
 
 }  // namespace nave::render
