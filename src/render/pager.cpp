@@ -10,8 +10,10 @@
 #include "core/memory.h"
 #include "core/trace.h"
 #include "render/film.h"
+#include "render/photon_emission.h"
 #include "render/ray.h"
 #include "render/scene_config.h"
+#include "render/sppm.h"
 
 namespace nave::render {
 
@@ -204,9 +206,11 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
         queues = std::min(
             queues, queue_memory_bytes + 3 * MaxBatchRays(queue_memory_bytes) * sizeof(RayRecord));
     }
-    // Photon mode's visible points: a point and a pixel state (~100 bytes each) per pixel, and
-    // references to the points in the brick grids.
-    const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton ? pixels * 256 : 0;
+    // Photon mode's visible points and what its emitters learn from.
+    const uint64_t sppm = settings.mode == RenderSettings::Mode::kPhoton
+                              ? VisiblePoints::MemoryBytes(pixels) +
+                                    PhotonEmitters::LearningBytes(settings.photons_per_iteration)
+                              : 0;
     return kProcess + film + queues + sppm;
 }
 

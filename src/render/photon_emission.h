@@ -4,6 +4,7 @@
 // from distant sources start (a disc covering the model, or with render.photon_target = "portals"
 // mostly the windows).
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -41,6 +42,12 @@ class PhotonEmitters {
     void Learn(std::span<const float> deposited);
     /// How many photons of a pass Learn looks at (the first ones): a cap on its memory.
     uint64_t learned_photons() const { return photon_cells_.size(); }
+    /// The bytes learning takes with `photons_per_iteration`: per learned photon its start cell
+    /// here and what it deposited (SppmIntegrator).
+    static uint64_t LearningBytes(uint64_t photons_per_iteration) {
+        return std::min(photons_per_iteration, kMaxLearnedPhotons) *
+               (sizeof(uint32_t) + sizeof(float));
+    }
 
     /// The windows photons are aimed through: null unless render.photon_target = "portals" found
     /// portal triangles.

@@ -50,6 +50,13 @@ class VisiblePoints {
     /// `initial_radius`: r_1 in metres; `alpha`: the schedule's alpha in (0, 1].
     VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius, float alpha);
 
+    /// The bytes the visible points of `pixel_count` pixels take: a point and a pixel state each,
+    /// and their references in the brick grids (a gather sphere overlaps up to 8 cells of the
+    /// grid, whose vectors grow by doubling).
+    static uint64_t MemoryBytes(uint64_t pixel_count) {
+        return pixel_count * (sizeof(Point) + sizeof(PixelState) + 2 * 8 * sizeof(uint32_t) + 32);
+    }
+
     /// Starts an iteration: forgets the previous visible points.
     void BeginIteration();
     /// Records pixel's visible point, with its texture coordinates `uv` (null when the mesh has
