@@ -17,32 +17,42 @@ double FiniteMean(std::span<const float> values) {
     return n > 0 ? sum / double(n) : 0.0;
 }
 
-double PairRelMse(std::span<const float> a, std::span<const float> b) {
-    NAVE_CHECK_EQ(a.size(), b.size());
+double PairRelMse(size_t count, const std::function<std::array<double, 2>(size_t)>& pixel) {
     double mean = 0;
     size_t n = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-        if (!std::isfinite(a[i]) || !std::isfinite(b[i])) continue;
-        mean += 0.5 * (double(a[i]) + b[i]);
+    for (size_t i = 0; i < count; ++i) {
+        const std::array<double, 2> ab = pixel(i);
+        if (!std::isfinite(ab[0]) || !std::isfinite(ab[1])) continue;
+        mean += 0.5 * (ab[0] + ab[1]);
         ++n;
     }
     if (n == 0) return 0;
     mean /= double(n);
     const double offset = 0.01 * mean * mean;
     double sum = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-        if (!std::isfinite(a[i]) || !std::isfinite(b[i])) continue;
-        const double m = 0.5 * (double(a[i]) + b[i]);
-        const double d = double(a[i]) - b[i];
+    for (size_t i = 0; i < count; ++i) {
+        const std::array<double, 2> ab = pixel(i);
+        if (!std::isfinite(ab[0]) || !std::isfinite(ab[1])) continue;
+        const double m = 0.5 * (ab[0] + ab[1]);
+        const double d = ab[0] - ab[1];
         const double denominator = m * m + offset;
         if (denominator > 0) sum += 0.5 * d * d / denominator;
     }
     return sum / double(n);
 }
 
+double PairRelMse(std::span<const float> a, std::span<const float> b) {
+    NAVE_CHECK_EQ(a.size(), b.size());
+    return PairRelMse(a.size(), [&](size_t i) { return std::array<double, 2>{a[i], b[i]}; });
+}
+
 double HalvesRelMse(std::span<const float> half0, std::span<const float> half1) {
     if (half0.empty() || half1.empty()) return std::nan("");
     return 0.5 * PairRelMse(half0, half1);
+}
+
+double HalvesRelMse(size_t count, const std::function<std::array<double, 2>(size_t)>& pixel) {
+    return 0.5 * PairRelMse(count, pixel);
 }
 
 double RelMseAgainst(std::span<const float> image, std::span<const float> reference) {

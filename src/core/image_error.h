@@ -4,7 +4,9 @@
 // samples) give an unbiased estimate of the variance of each pixel from their difference, with no
 // reference image needed.
 
+#include <array>
 #include <cstddef>
+#include <functional>
 #include <span>
 
 namespace nave {
@@ -28,6 +30,8 @@ double PairRelMse(std::span<const float> a, std::span<const float> b);
 /// two halves (each the mean of half of its independent samples): PairRelMse(half0, half1) / 2,
 /// since the whole render's variance is half of one half's. NaN if a half is empty.
 double HalvesRelMse(std::span<const float> half0, std::span<const float> half1);
+/// The same over `count` pixels whose halves `pixel(i)` gives.
+double HalvesRelMse(size_t count, const std::function<std::array<double, 2>(size_t)>& pixel);
 
 /// The relative mean squared error of `image` against `reference` (luminance, same size): the mean
 /// over pixels of (image - reference)^2 / (reference^2 + 0.01 mean(reference)^2). Non-finite pixels

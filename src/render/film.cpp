@@ -43,16 +43,6 @@ void Film::AddXYZ(uint32_t pixel, const Vec3d& xyz, int half) {
     if (half == 0 || half == 1) AtomicAdd(y_half_[2 * size_t(pixel) + size_t(half)], xyz.y);
 }
 
-std::vector<float> Film::HalfLuminance(int half, int samples) const {
-    const int n = half == 0 ? (samples + 1) / 2 : samples / 2;
-    if (n <= 0) return {};
-    std::vector<float> y(pixel_count());
-    for (size_t p = 0; p < y.size(); ++p) {
-        y[p] = float(y_half_[2 * p + size_t(half)].load(std::memory_order_relaxed) / n);
-    }
-    return y;
-}
-
 void Film::AddAov(uint32_t pixel, const Vec3f& albedo, const Vec3f& normal, float depth) {
     if (!aov_) return;
     const float v[7] = {albedo.x, albedo.y, albedo.z, normal.x, normal.y, normal.z, depth};

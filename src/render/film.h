@@ -5,6 +5,7 @@
 // float of the output.
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -53,10 +54,14 @@ class Film {
 
     /// The sum of XYZ added to `pixel`.
     Vec3d SumXYZ(uint32_t pixel) const;
-    /// Per pixel, the mean luminance (CIE Y) of the samples of half `half` (0 or 1) when
-    /// `samples` samples per pixel have been added: half 0 holds ceil(samples / 2) of them, half 1
-    /// floor(samples / 2). Empty when that half has none.
-    std::vector<float> HalfLuminance(int half, int samples) const;
+    /// The mean luminance (CIE Y) of `pixel`'s samples of half `half` (0 or 1) when `samples`
+    /// samples per pixel have been added: half 0 holds ceil(samples / 2) of them, half 1
+    /// floor(samples / 2). NaN when that half has none.
+    double HalfLuminance(uint32_t pixel, int half, int samples) const {
+        const int n = half == 0 ? (samples + 1) / 2 : samples / 2;
+        if (n <= 0) return std::nan("");
+        return y_half_[2 * size_t(pixel) + size_t(half)].load(std::memory_order_relaxed) / n;
+    }
     /// Divides every sum by `samples_per_pixel` for output.
     void SetSamplesPerPixel(double spp) { spp_ = spp; }
     double samples_per_pixel() const { return spp_; }

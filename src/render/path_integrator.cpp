@@ -77,7 +77,11 @@ Status PathIntegrator::Run(RenderStats* stats) {
 }
 
 double PathIntegrator::NoiseEstimate(int passes) const {
-    return HalvesRelMse(film_->HalfLuminance(0, passes), film_->HalfLuminance(1, passes));
+    if (passes < 2) return std::nan("");
+    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
+        return std::array<double, 2>{film_->HalfLuminance(uint32_t(p), 0, passes),
+                                     film_->HalfLuminance(uint32_t(p), 1, passes)};
+    });
 }
 
 Status PathIntegrator::GenerateCameraRays(uint64_t first, uint64_t last, uint32_t sample,

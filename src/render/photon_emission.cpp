@@ -230,15 +230,11 @@ float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, cons
 
 void PhotonEmitters::Learn(std::span<const float> deposited) {
     const size_t n = std::min(deposited.size(), photon_cells_.size());
-    std::vector<uint16_t> cells(n);
-    for (size_t g = 0; g < guides_.size(); ++g) {
-        for (size_t k = 0; k < n; ++k) {
-            const uint32_t c = photon_cells_[k];
-            cells[k] =
-                c != kNoGuideCell && (c >> 16) == g ? uint16_t(c & 0xffff) : PhotonGuide::kNoCell;
-        }
-        guides_[g].Learn(cells, deposited.subspan(0, n));
+    for (size_t k = 0; k < n; ++k) {
+        const uint32_t c = photon_cells_[k];
+        if (c != kNoGuideCell) guides_[c >> 16].Add(uint16_t(c & 0xffff), deposited[k]);
     }
+    for (PhotonGuide& guide : guides_) guide.Update();
     std::fill(photon_cells_.begin(), photon_cells_.end(), kNoGuideCell);
 }
 
@@ -312,7 +308,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 }
             } else if (e.kind == Emitter::Kind::kSky) {
                 Vec3f d;
-                if (sky_portals_ && rng.Uniform(8) < kPortalPhotonShare) {
+                if (sky_portals_ && rng.Uniform(8) < kSkyPortalPhotonShare) {
                     // A point uniform on the portals' area, a cosine-weighted direction on a random
                     // side.
                     size_t i = 0;
@@ -337,9 +333,9 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 if (sky_portals_) {
                     const int count = sky_portals_->ForEachCrossing(r.origin, d, 4 * scene_radius_,
                                                                     [](const BrickHit&) {});
-                    density =
-                        kPortalPhotonShare * float(count) / float(2 * kPiF * sky_portals_->area()) +
-                        (1 - kPortalPhotonShare) * density;
+                    density = kSkyPortalPhotonShare * float(count) /
+                                  float(2 * kPiF * sky_portals_->area()) +
+                              (1 - kSkyPortalPhotonShare) * density;
                 }
                 r.beta = scene_.SkyRadiance(-d, lambda) / density;
                 r.flags = kFromSky;

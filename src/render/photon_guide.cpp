@@ -43,10 +43,11 @@ float PhotonGuide::Pdf(float x, float y) const {
 
 void PhotonGuide::Learn(std::span<const uint16_t> cells, std::span<const float> deposited) {
     NAVE_CHECK_EQ(cells.size(), deposited.size());
-    for (size_t k = 0; k < cells.size(); ++k) {
-        if (cells[k] != kNoCell && deposited[k] > 0 && std::isfinite(deposited[k]))
-            learned_[cells[k]] += deposited[k];
-    }
+    for (size_t k = 0; k < cells.size(); ++k) Add(cells[k], deposited[k]);
+    Update();
+}
+
+void PhotonGuide::Update() {
     total_ = 0;
     cdf_.assign(1, 0.0);
     for (double v : learned_) {

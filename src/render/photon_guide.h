@@ -40,6 +40,11 @@ class PhotonGuide {
     /// its start cell cells[k] (kNoCell: not a photon of this light). The spans have one entry per
     /// photon of the pass, in photon order, so the result does not depend on the thread count.
     void Learn(std::span<const uint16_t> cells, std::span<const float> deposited);
+    /// Learn one photon at a time: Add each, then Update once.
+    void Add(uint16_t cell, float deposited) {
+        if (cell != kNoCell && deposited > 0 && deposited < 1e30f) learned_[cell] += deposited;
+    }
+    void Update();
 
   private:
     int cells_;

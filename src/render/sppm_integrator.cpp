@@ -85,19 +85,19 @@ Status SppmIntegrator::Run(RenderStats* stats) {
 }
 
 double SppmIntegrator::NoiseEstimate(int iterations) const {
+    if (iterations < 2) return std::nan("");
     // Each half: the film's direct light and specular chains of its iterations (even or odd) plus
-    // the photon estimate of the same iterations.
-    std::vector<float> half[2] = {film_->HalfLuminance(0, iterations),
-                                  film_->HalfLuminance(1, iterations)};
-    if (half[0].empty() || half[1].empty()) return std::nan("");
+    // the photon estimate of the same iterations. Pixel by pixel: no image is held.
     const double photons = double(scene_.settings.photons_per_iteration);
     const double emitted[2] = {photons * ((iterations + 1) / 2), photons * (iterations / 2)};
-    for (int h = 0; h < 2; ++h) {
-        for (size_t p = 0; p < half[h].size(); ++p) {
-            half[h][p] += float(visible_->IndirectHalfY(uint32_t(p), h, emitted[h]));
+    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
+        std::array<double, 2> half;
+        for (int h = 0; h < 2; ++h) {
+            half[h] = film_->HalfLuminance(uint32_t(p), h, iterations) +
+                      visible_->IndirectHalfY(uint32_t(p), h, emitted[h]);
         }
-    }
-    return HalvesRelMse(half[0], half[1]);
+        return half;
+    });
 }
 
 void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
