@@ -187,7 +187,7 @@ float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, cons
     const Light& l = *e.light;
     const Frame frame = Frame::FromZ(l.to_light);
     const Vec3f plane_centre = scene_center_ + l.to_light * (2 * scene_radius_);
-    const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
+    const float disk_area = kPi * scene_radius_ * scene_radius_;
     const PortalProjection* portals = e.portal >= 0 ? &portals_[size_t(e.portal)] : nullptr;
     PhotonGuide& guide = guides_[size_t(e.guide)];
     // The strategies' shares: portals and guide when they exist, the disc for the rest.
@@ -197,8 +197,7 @@ float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, cons
     const float u = rng.Uniform(8);
     Vec3f on_line;
     if (u < portal_share) {
-        int coverage = 1;
-        on_line = portals->Sample(rng.Uniform(6), rng.Uniform(1), rng.Uniform(2), &coverage);
+        on_line = portals->Sample(rng.Uniform(6), rng.Uniform(1), rng.Uniform(2));
     } else if (u < portal_share + guide_share) {
         const Point2f q = guide.Sample(rng.Uniform(6), Point2f(rng.Uniform(1), rng.Uniform(2)));
         on_line = plane_centre + frame.x * q.x + frame.y * q.y;

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "core/vecmath.h"
-#include "render/materials/frame.h"
 
 namespace nave::render {
 
@@ -29,25 +28,14 @@ class PortalProjection {
     /// Sum of the projected areas (m^2), overlaps counted as many times as they overlap.
     double total_area() const { return total_area_; }
     size_t triangle_count() const { return tris_.size(); }
-    /// A point on a portal triangle chosen in proportion to projected area; `coverage` receives the number of
-    /// projections covering its projection (>= 1).
-    Vec3f Sample(float u_choice, float u0, float u1, int* coverage) const;
-    /// Number of projected triangles that contain the projection of `p`.
-    int Coverage(const Vec3f& p) const;
+    /// A point on a portal triangle chosen in proportion to projected area. (How many portals the
+    /// photon's line crosses, count(x), PhotonEmitters counts with the portals' Embree scene.)
+    Vec3f Sample(float u_choice, float u0, float u1) const;
 
   private:
-    struct Tri2 {
-        float ax, ay, bx, by, cx, cy;
-        Vec3f v0, v1, v2;
-    };
-    bool Contains(const Tri2& t, float x, float y) const;
-    Frame frame_;
-    std::vector<Tri2> tris_;
+    std::vector<std::array<Vec3f, 3>> tris_;
     std::vector<double> cdf_;
     double total_area_ = 0;
-    float min_x_ = 0, min_y_ = 0, cell_ = 1;
-    int nx_ = 0, ny_ = 0;
-    std::vector<std::vector<uint32_t>> grid_;
 };
 
 }  // namespace nave::render

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 #include "core/atomic_add.h"
@@ -162,7 +163,7 @@ float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, co
 }
 
 void VisiblePoints::EndIteration(int half) {
-    const double area = 3.14159265358979 * double(radius_) * radius_;
+    const double area = std::numbers::pi * double(radius_) * radius_;
     for (size_t i = 0; i < pixel_count_; ++i) {
         PixelState& px = pixels_[i];
         if (points_[i].valid) {
