@@ -46,32 +46,6 @@ StatusOr<std::vector<float>> ReadLuminance(const std::string& path, int* width, 
     return y;
 }
 
-/// A box blur of `radius` pixels (a square of 2 radius + 1 pixels a side, cut at the borders):
-/// compares what is left once the noise is averaged away, as in "the images agree on a blurred
-/// version".
-std::vector<float> BoxBlur(const std::vector<float>& y, int width, int height, int radius) {
-    if (radius <= 0) return y;
-    std::vector<float> rows(y.size()), out(y.size());
-    for (int pass = 0; pass < 2; ++pass) {
-        const std::vector<float>& in = pass == 0 ? y : rows;
-        std::vector<float>& to = pass == 0 ? rows : out;
-        for (int j = 0; j < height; ++j) {
-            for (int i = 0; i < width; ++i) {
-                double sum = 0;
-                int n = 0;
-                for (int k = -radius; k <= radius; ++k) {
-                    const int x = pass == 0 ? i + k : i, yy = pass == 0 ? j : j + k;
-                    if (x < 0 || x >= width || yy < 0 || yy >= height) continue;
-                    sum += in[size_t(yy) * width + x];
-                    ++n;
-                }
-                to[size_t(j) * width + i] = float(sum / n);
-            }
-        }
-    }
-    return out;
-}
-
 Status RunCompare(const CompareOptions& o) {
     int wa = 0, ha = 0, wb = 0, hb = 0;
     NAVE_ASSIGN_OR_RETURN(std::vector<float> a, ReadLuminance(o.a, &wa, &ha));

@@ -55,6 +55,31 @@ double HalvesRelMse(size_t count, const std::function<std::array<double, 2>(size
     return 0.5 * PairRelMse(count, pixel);
 }
 
+std::vector<float> BoxBlur(std::span<const float> values, int width, int height, int radius) {
+    NAVE_CHECK_EQ(values.size(), size_t(width) * size_t(height));
+    if (radius <= 0) return std::vector<float>(values.begin(), values.end());
+    // Separable: along rows, then along columns.
+    std::vector<float> rows(values.size()), out(values.size());
+    for (int pass = 0; pass < 2; ++pass) {
+        std::span<const float> in = pass == 0 ? values : std::span<const float>(rows);
+        std::vector<float>& to = pass == 0 ? rows : out;
+        for (int j = 0; j < height; ++j) {
+            for (int i = 0; i < width; ++i) {
+                double sum = 0;
+                int n = 0;
+                for (int k = -radius; k <= radius; ++k) {
+                    const int x = pass == 0 ? i + k : i, y = pass == 0 ? j : j + k;
+                    if (x < 0 || x >= width || y < 0 || y >= height) continue;
+                    sum += in[size_t(y) * width + x];
+                    ++n;
+                }
+                to[size_t(j) * width + i] = float(sum / n);
+            }
+        }
+    }
+    return out;
+}
+
 double RelMseAgainst(std::span<const float> image, std::span<const float> reference) {
     NAVE_CHECK_EQ(image.size(), reference.size());
     const double mean = FiniteMean(reference);

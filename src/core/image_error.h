@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <functional>
 #include <span>
+#include <vector>
 
 namespace nave {
 
@@ -37,6 +38,11 @@ double HalvesRelMse(size_t count, const std::function<std::array<double, 2>(size
 /// over pixels of (image - reference)^2 / (reference^2 + 0.01 mean(reference)^2). Non-finite pixels
 /// are skipped.
 double RelMseAgainst(std::span<const float> image, std::span<const float> reference);
+
+/// `values` (width x height, row-major) box-blurred over `radius` pixels around each pixel (a
+/// square of 2 radius + 1 pixels a side, cut at the borders): what is left of an image once its
+/// noise is averaged away.
+std::vector<float> BoxBlur(std::span<const float> values, int width, int height, int radius);
 
 /// The mean of the finite values of `values` (0 if there are none).
 double FiniteMean(std::span<const float> values);

@@ -31,6 +31,16 @@ TEST(ImageErrorTest, RelMseAgainstAReference) {
     EXPECT_NEAR(RelMseAgainst(image, reference), (0.01 / 1.0225) / 2, 1e-6);
 }
 
+TEST(ImageErrorTest, BoxBlurAveragesTheSquareCutAtTheBorders) {
+    // 3 x 2, radius 1: every pixel averages the pixels of its 3 x 3 square that exist.
+    const std::vector<float> image = {0, 6, 0, 0, 0, 0};
+    const std::vector<float> blurred = BoxBlur(image, 3, 2, 1);
+    EXPECT_FLOAT_EQ(blurred[0], 6.f / 4);  // corner: 2 x 2 pixels
+    EXPECT_FLOAT_EQ(blurred[1], 6.f / 6);  // edge: 3 x 2 pixels
+    EXPECT_FLOAT_EQ(blurred[5], 6.f / 4);
+    EXPECT_EQ(BoxBlur(image, 3, 2, 0), image);
+}
+
 // The point of the estimators: from two independent noisy estimates alone, PairRelMse predicts the
 // error of one against the truth, and HalvesRelMse the error of their mean.
 TEST(ImageErrorTest, PairEstimatePredictsTheErrorAgainstTheTruth) {

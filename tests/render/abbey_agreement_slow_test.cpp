@@ -30,27 +30,12 @@ std::vector<float> BlurredLuminance(const std::filesystem::path& path, int radiu
     if (!image.ok()) return {};
     const int w = image->width, h = image->height;
     const size_t nc = image->channels.size();
-    std::vector<float> y(size_t(w) * h), out(y.size());
+    std::vector<float> y(size_t(w) * h);
     for (size_t p = 0; p < y.size(); ++p) {
         const float* px = &image->pixels[p * nc];
         y[p] = float(LuminanceOfLinearSrgb(px[0], px[1], px[2]));
     }
-    for (int j = 0; j < h; ++j) {
-        for (int i = 0; i < w; ++i) {
-            double sum = 0;
-            int n = 0;
-            for (int dj = -radius; dj <= radius; ++dj) {
-                for (int di = -radius; di <= radius; ++di) {
-                    const int x = i + di, yy = j + dj;
-                    if (x < 0 || yy < 0 || x >= w || yy >= h) continue;
-                    sum += y[size_t(yy) * w + x];
-                    ++n;
-                }
-            }
-            out[size_t(j) * w + i] = float(sum / n);
-        }
-    }
-    return out;
+    return BoxBlur(y, w, h, radius);
 }
 
 TEST(AbbeyAgreementSlow, PathAndPhotonModeConvergeToTheSameImage) {
