@@ -80,6 +80,10 @@ std::string NoiseLine(const render::RenderSettings& settings, const render::Rend
                     : fmt::format(", target {:.3g} not reached (raise --{} or render.time_limit_s)",
                                   settings.noise_target, photon ? "iterations" : "spp");
     }
+    if (settings.path_guiding && !photon) {
+        line += fmt::format("; path guide: {} cells learning, {} guiding", stats.guide_cells,
+                            stats.guide_cells_guiding);
+    }
     return line;
 }
 

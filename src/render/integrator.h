@@ -45,7 +45,7 @@ struct RenderStats {
     uint64_t prefetch_loads = 0;       ///< loads done by the background loader
     uint64_t prefetch_hits = 0;        ///< bricks already resident when the scheduler asked for them
     uint64_t brick_acquires = 0;
-    uint64_t memory_returns = 0;  ///< times the allocator gave its free pages back before a load
+    uint64_t memory_returns = 0;  ///< times the allocator gave its free pages back near --memory
     double stall_seconds = 0;          ///< time the workers idled while the scheduler waited for a load
     uint64_t peak_rss_bytes = 0;
     uint64_t peak_queue_bytes = 0;
@@ -66,6 +66,9 @@ struct RenderStats {
     double noise_relmse = 0;
     int samples_per_pixel = 0;     ///< path mode: passes completed
     int iterations = 0;            ///< photon mode: SPPM iterations completed
+    /// Path mode with render.path_guiding: the guide's cells with histograms, and those guiding.
+    uint32_t guide_cells = 0;
+    uint32_t guide_cells_guiding = 0;
 };
 
 /// The scheduling policy: which brick to process next, given the rays waiting in every brick's queue

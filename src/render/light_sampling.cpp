@@ -84,7 +84,8 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
 std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index,
                                                    const SurfaceHit& h, const Bsdf& bsdf,
                                                    const Vec3f& wo, const RayRecord& r,
-                                                   const VertexRng& rng, bool mis) const {
+                                                   const VertexRng& rng,
+                                                   const GuidedBsdf* continuation) const {
     Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
     Vec3f wi;
     SampledSpectrum Li;
@@ -130,7 +131,8 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
     float w = 1;
-    if (light_pdf > 0 && mis) w = PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda));
+    if (light_pdf > 0 && continuation != nullptr)
+        w = PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = OffsetOrigin(h.p, h.ng, wi);
@@ -142,7 +144,8 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
 
 std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf& bsdf,
                                                  const Vec3f& wo, const RayRecord& r,
-                                                 const VertexRng& rng, bool mis) const {
+                                                 const VertexRng& rng,
+                                                 const GuidedBsdf* continuation) const {
     const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
     Vec3f wi;
     if (portals_ != nullptr && rng.Uniform(dim + 2) < kPortalSkyShare) {
@@ -158,7 +161,9 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
     if (f.IsZero()) return std::nullopt;
     const float light_pdf = SkyPdf(h.p, wi);
     if (!(light_pdf > 0)) return std::nullopt;
-    float w = mis ? PowerHeuristic(light_pdf, bsdf.Pdf(wo, wi, r.lambda)) : 1.f;
+    float w = continuation != nullptr
+                  ? PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda))
+                  : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = OffsetOrigin(h.p, h.ng, wi);

@@ -13,6 +13,7 @@
 #include "core/vecmath.h"
 #include "render/brick_source.h"
 #include "render/materials/bxdf.h"
+#include "render/path_guide.h"
 #include "render/ray.h"
 #include "render/rng.h"
 #include "render/scene.h"
@@ -74,16 +75,21 @@ class LightSampler {
 
     /// Next-event estimation of `light` (index `index` in scene.lights) at hit `h` with BSDF
     /// `bsdf`, seen from `wo`, for the path of `r`: the shadow ray toward the light carrying its
-    /// contribution (added if nothing occludes it), or nothing when it contributes nothing. `mis`:
-    /// weight against BSDF sampling (power heuristic) where the light can be hit by it.
+    /// contribution (added if nothing occludes it), or nothing when it contributes nothing.
+    /// `continuation`: how the path goes on from here (its BSDF, maybe guided), to weigh the light
+    /// sample against (power heuristic) where the continuation can hit the light; null: no
+    /// continuation will look for it, full weight.
     std::optional<RayRecord> SampleLight(const Light& light, int index, const SurfaceHit& h,
                                          const Bsdf& bsdf, const Vec3f& wo, const RayRecord& r,
-                                         const VertexRng& rng, bool mis) const;
+                                         const VertexRng& rng,
+                                         const GuidedBsdf* continuation) const;
     /// Next-event estimation of the sky: a uniform direction on the sphere, or with
     /// render.sky_sampling = "portals" mostly a direction toward a point on a window (SkyPdf),
-    /// power heuristic with the BSDF. Returns the shadow ray as SampleLight does.
+    /// weighted against `continuation` as SampleLight does. Returns the shadow ray as SampleLight
+    /// does.
     std::optional<RayRecord> SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
-                                       const RayRecord& r, const VertexRng& rng, bool mis) const;
+                                       const RayRecord& r, const VertexRng& rng,
+                                       const GuidedBsdf* continuation) const;
     /// The solid-angle pdf with which SampleSky picks direction `w` at point `p`: the mixture of
     /// uniform directions and portal sampling, whose pdf sums d² / (|cos θ| A_portals) over every
     /// portal triangle the ray from p crosses (each crossing could have been the sampled point;

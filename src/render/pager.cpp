@@ -10,6 +10,7 @@
 #include "core/memory.h"
 #include "core/trace.h"
 #include "render/film.h"
+#include "render/path_guide.h"
 #include "render/photon_emission.h"
 #include "render/ray.h"
 #include "render/scene_config.h"
@@ -211,7 +212,11 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
                               ? VisiblePoints::MemoryBytes(pixels) +
                                     PhotonEmitters::LearningBytes(settings.photons_per_iteration)
                               : 0;
-    return kProcess + film + queues + sppm;
+    // Path mode's guide.
+    const uint64_t guide = settings.mode == RenderSettings::Mode::kPath && settings.path_guiding
+                               ? PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells)
+                               : 0;
+    return kProcess + film + queues + sppm + guide;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -489,6 +494,10 @@ void Pager::BatchDone() {
         ++batch_epoch_;
     }
     loader_cv_.notify_all();
+    // Between loads too: the queues and spills of a render whose bricks all fit free and allocate
+    // all the time, and the allocator's free pages would otherwise pile up past --memory with no
+    // load to return them. A sixteenth of the limit is room for the next batch's new rays.
+    resident_guard_.MakeRoom(options_.process_memory_bytes / 16);
 }
 
 void Pager::Stalled(uint32_t id, std::chrono::steady_clock::time_point start) {

@@ -149,8 +149,7 @@ struct PagerStats {
     uint64_t acquires = 0;         ///< bricks pinned for a batch (or for the emitters' pass)
     uint64_t prefetch_hits = 0;    ///< of which were already resident when asked for
     uint64_t estimate_misses = 0;  ///< loads whose real size exceeded the estimate (should stay 0)
-    uint64_t memory_returns =
-        0;  ///< times the allocator's free pages were given back before a load
+    uint64_t memory_returns = 0;   ///< times the allocator's free pages went back near --memory
     double stall_seconds = 0;      ///< time the scheduler waited for a load while the workers idled
 };
 
@@ -186,7 +185,8 @@ class Pager {
     /// if none is). `batch_rays`: rays taken from `current`'s queue for this batch (its traffic,
     /// for eviction choices).
     void Prefetch(const std::vector<size_t>& waiting, uint32_t current, size_t batch_rays);
-    /// The scheduler released its pin on the batch's brick: a loader waiting for room may retry.
+    /// The scheduler released its pin on the batch's brick: a loader waiting for room may retry;
+    /// the allocator's free pages go back if the process nears process_memory_bytes.
     void BatchDone();
     PagerStats stats() const;
     const PagerOptions& options() const { return options_; }
@@ -214,7 +214,8 @@ class Pager {
     const PagerOptions options_;
     const WaitingFn waiting_;
     std::vector<uint64_t> estimate_;  // by brick: estimated resident bytes
-    ResidentSizeGuard resident_guard_;  // process_memory_bytes, checked before each load
+    ResidentSizeGuard
+        resident_guard_;  // process_memory_bytes, checked before each load and batch end
 
     mutable std::mutex mutex_;
     std::condition_variable loader_cv_;  // the loader waits here for requests and batch ends

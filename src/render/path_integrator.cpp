@@ -4,11 +4,13 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <optional>
 
 #include "core/image_error.h"
+#include "core/log.h"
 #include "core/progress.h"
 #include "core/sampling.h"
 #include "render/brick_walk.h"
@@ -29,7 +31,31 @@ PathIntegrator::PathIntegrator(const RenderScene& scene, Film* film, StreamSched
       visible_points_(visible_points),
       has_thin_glass_(
           std::any_of(scene.materials.begin(), scene.materials.end(),
-                      [](const SurfaceMaterial& m) { return m.thin_glass() != nullptr; })) {}
+                      [](const SurfaceMaterial& m) { return m.thin_glass() != nullptr; })) {
+    if (visible_points == nullptr && scene.settings.path_guiding &&
+        !scene.source->bounds().Empty()) {
+        guide_ = std::make_unique<PathGuide>(scene.source->bounds(), kGuideCoarseCellsLongAxis,
+                                             kGuideMaxCells, GuideRadianceScale());
+    }
+}
+
+double PathIntegrator::GuideRadianceScale() const {
+    // The radiance of a white surface in full sun (or, without a sun, the sky's brightest axis):
+    // the order of the light that surfaces reflect toward the paths' vertices.
+    const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
+    double scale = 0;
+    if (scene_.sun >= 0) {
+        const Light& sun = scene_.lights[size_t(scene_.sun)];
+        const double solid_angle = 2 * kPi * (1 - double(sun.cos_sun));
+        scale = double(sun.spectrum.Sample(green).Average()) * solid_angle * kInvPi;
+    }
+    if (scene_.sky) {
+        for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
+                               Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
+            scale = std::max(scale, double(scene_.SkyRadiance(w, green).Average()));
+    }
+    return scale > 0 ? scale : 1.0;
+}
 
 Status PathIntegrator::Run(RenderStats* stats) {
     const Camera& camera = *scene_.camera;
@@ -54,12 +80,24 @@ Status PathIntegrator::Run(RenderStats* stats) {
     for (int s = 0; s < spp;) {
         const int group =
             checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
-        const int s_end = std::min(spp, s + group);
+        int s_end = std::min(spp, s + group);
+        // The guide learns from every pass and updates its distributions after passes 1, 2, 4,
+        // 8...: each update follows a complete drain, so that what it learned from does not depend
+        // on the waves, the memory budget or the threads.
+        const int next_update = guide_ ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
+        const bool update = guide_ && s_end >= next_update;
+        if (update) s_end = next_update;
         for (uint64_t first = 0; first < pixels; first += wave) {
             const uint64_t last = std::min(pixels, first + wave);
             for (int k = s; k < s_end; ++k)
                 NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k), nullptr));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
+        }
+        if (update) {
+            NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
+            guide_->Update();
+            log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
+                       guide_->cells_used(), guide_->cells_guiding());
         }
         passes = s_end;
         s = s_end;
@@ -71,6 +109,10 @@ Status PathIntegrator::Run(RenderStats* stats) {
     progress.Finish();
     stats->samples_per_pixel = passes;
     stats->noise_relmse = NoiseEstimate(passes);
+    if (guide_) {
+        stats->guide_cells = guide_->cells_used();
+        stats->guide_cells_guiding = guide_->cells_guiding();
+    }
     stats->camera_paths = pixels * uint64_t(passes);
     film_->SetSamplesPerPixel(passes);
     return Status::Ok();
@@ -133,7 +175,7 @@ void PathIntegrator::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& br
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
         if (next == store::kNoBrick) {
-            film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));  // unoccluded all the way
+            AddShadowContribution(r);  // unoccluded all the way
         } else {
             out.Send(next, b, r);
         }
@@ -160,7 +202,15 @@ void PathIntegrator::Escape(const RayRecord& r) {
             w = PowerHeuristic(r.prev_pdf,
                                lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.dir));
         }
-        L += scene_.SkyRadiance(r.dir, r.lambda) * w;
+        const SampledSpectrum sky = scene_.SkyRadiance(r.dir, r.lambda);
+        L += sky * w;
+        // The sky seen through a window from the last vertex: the guide learns where windows are
+        // open to it, which next-event estimation, aiming at all windows alike, does not know.
+        if (guide_ && r.depth > 0 && !(r.flags & kSpecularBounce) && r.prev_pdf > 0) {
+            guide_->Credit(
+                guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir),
+                double(sky.Average()) / double(r.prev_pdf));
+        }
     }
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
@@ -176,6 +226,12 @@ void PathIntegrator::Escape(const RayRecord& r) {
         }
     }
     if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda, Half(r));
+}
+
+void PathIntegrator::AddShadowContribution(const RayRecord& r) {
+    film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));
+    if (guide_ && r.guide_credit != PathGuide::kNoCredit)
+        guide_->Credit(r.guide_credit, double(r.beta.Average()) * double(r.guide_scale));
 }
 
 bool PathIntegrator::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1,
@@ -205,7 +261,7 @@ void PathIntegrator::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, 
     uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
     if (next == store::kNoBrick) {
         if (r.kind == kShadowRay) {
-            film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));
+            AddShadowContribution(r);
         } else {
             Escape(r);
         }
@@ -246,21 +302,37 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
     // find the lights from here, so next-event estimation takes the full weight.
     const bool visible_point =
         scene_.settings.mode == RenderSettings::Mode::kPhoton && (flags & kBxdfDiffuse);
+    // The side the path sees of the surface, which keeps the guide's histograms of a floor and
+    // of the wall above it apart.
+    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const GuidedBsdf continuation(bsdf, guide_.get(), h.p, side);
     if (non_specular) {
+        // What next-event estimation finds here, reflected once more, is light arriving at the
+        // path's previous vertex from this one: its shadow rays credit the guide there.
+        uint32_t credit = PathGuide::kNoCredit;
+        float credit_scale = 0;
+        const float beta = r.beta.Average();
+        if (guide_ && r.depth > 0 && !(r.flags & kSpecularBounce) && beta > 0 && r.prev_pdf > 0) {
+            credit = guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir);
+            credit_scale = 1 / (beta * r.prev_pdf);
+        }
+        const GuidedBsdf* mis_against = visible_point ? nullptr : &continuation;
+        auto spawn_shadow = [&](std::optional<RayRecord> shadow) {
+            if (!shadow) return;
+            shadow->guide_credit = credit;
+            shadow->guide_scale = credit_scale;
+            Spawn(*shadow, b, &brick, out);
+        };
         for (size_t i = 0; i < scene_.lights.size(); ++i) {
-            std::optional<RayRecord> shadow =
-                lights_.SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, !visible_point);
-            if (shadow) Spawn(*shadow, b, &brick, out);
+            spawn_shadow(
+                lights_.SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, mis_against));
         }
         // With render.sky_direct = "photons", the sky's photons bring its direct light to the
         // visible points.
         const bool sky_from_photons =
             visible_point && scene_.settings.sky_direct == RenderSettings::SkyDirect::kPhotons;
-        if (scene_.sky && !sky_from_photons) {
-            std::optional<RayRecord> shadow =
-                lights_.SampleSky(h, bsdf, wo, r, rng, !visible_point);
-            if (shadow) Spawn(*shadow, b, &brick, out);
-        }
+        if (scene_.sky && !sky_from_photons)
+            spawn_shadow(lights_.SampleSky(h, bsdf, wo, r, rng, mis_against));
     }
     if (visible_point) {
         // SPPM: the path stops at its first diffuse vertex; indirect light there comes from
@@ -269,9 +341,10 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
                              r.beta, r.lambda);
         return false;
     }
-    std::optional<BsdfSample> bs =
-        bsdf.Sample(wo, rng.Uniform(kDimBsdfChoice),
-                    Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)), r.lambda);
+    std::optional<BsdfSample> bs = continuation.Sample(
+        wo, rng.Uniform(kDimGuideChoice), rng.Uniform(kDimBsdfChoice),
+        Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),
+        {rng.Uniform(kDimGuideBin), rng.Uniform(kDimGuide0), rng.Uniform(kDimGuide1)}, r.lambda);
     if (!bs) return false;
     r.beta *= bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
     r.vertex += 1;
@@ -284,6 +357,7 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
     }
     if (last) return false;
     r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
+    r.guide_side = uint8_t(side);
     r.prev_pdf = bs->pdf;
     if (r.depth >= 2) {
         // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1.

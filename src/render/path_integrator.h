@@ -5,6 +5,7 @@
 // find the visible points.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include "core/spectrum.h"
@@ -13,6 +14,7 @@
 #include "render/film.h"
 #include "render/integrator.h"
 #include "render/light_sampling.h"
+#include "render/path_guide.h"
 #include "render/ray.h"
 #include "render/scene.h"
 #include "render/stream_scheduler.h"
@@ -52,6 +54,8 @@ class PathIntegrator final : public RayProcessor {
                       std::span<const RayRecord> rays, RayOutbox& out) override;
 
   private:
+    /// The radiance the guide's fixed point is scaled to (PathGuide).
+    double GuideRadianceScale() const;
     /// The image's estimated relMSE after `passes` passes, from the film's two halves.
     double NoiseEstimate(int passes) const;
     void GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sample,
@@ -67,6 +71,9 @@ class PathIntegrator final : public RayProcessor {
     /// A path leaving the model: the sky and the sun it finds, weighted against their next-event
     /// estimation.
     void Escape(const RayRecord& r);
+    /// A shadow ray that reached its light: its contribution to the film and, for a guided path,
+    /// to the guide.
+    void AddShadowContribution(const RayRecord& r);
     /// Traces a shadow ray's segment in `brick` up to t1: false if something opaque blocks it. Thin
     /// glass (windows) lets it through, scaled by the pane's transmittance at that angle: panes do
     /// not bend rays.
@@ -80,7 +87,8 @@ class PathIntegrator final : public RayProcessor {
     Film* film_;
     StreamScheduler& scheduler_;
     const LightSampler& lights_;
-    VisiblePoints* visible_points_;  // photon mode
+    VisiblePoints* visible_points_;     // photon mode
+    std::unique_ptr<PathGuide> guide_;  // path mode with render.path_guiding
     uint32_t iteration_ = 0;
     const bool has_thin_glass_;
     ProgressBar* progress_ = nullptr;  // during Run: counts the paths that end

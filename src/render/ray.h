@@ -36,9 +36,16 @@ struct RayRecord {
     uint8_t kind = kPathRay;
     uint8_t flags = 0;
     uint16_t vertex = 0;   ///< surfaces met so far, passes through thin glass included (keys the random numbers)
+    uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's surface
     float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
     float since_vertex = 0;  ///< distance from the last scattering vertex to `origin` (passes through thin
                              ///< glass move the origin along the ray; the sky's MIS needs the vertex)
+    uint32_t guide_credit =
+        0xffffffffu;  ///< shadow rays of guided paths: PathGuide::CreditKey of the path's
+                      ///< previous vertex and direction (PathGuide::kNoCredit: none)
+    float guide_scale =
+        0;  ///< shadow rays of guided paths: the contribution's luminance times this is the
+            ///< credit (1 / (throughput at the vertex * pdf of the direction from the previous))
     SampledSpectrum beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };

@@ -502,6 +502,7 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
                                   {{"sampled", RenderSettings::SkyDirect::kSampled},
                                    {"photons", RenderSettings::SkyDirect::kPhotons}},
                                   &s->sky_direct));
+    NAVE_RETURN_IF_ERROR(r.Bool("path_guiding", &s->path_guiding));
     return r.Finish();
 }
 

@@ -134,6 +134,9 @@ struct RenderSettings {
     /// light).
     enum class SkyDirect { kSampled, kPhotons };
     SkyDirect sky_direct = SkyDirect::kSampled;
+    /// Path mode: paths learn where the light reflected toward each part of the model comes from
+    /// and draw half of their continuations from it (PathGuide).
+    bool path_guiding = false;
 };
 
 struct OutputConfig {

@@ -33,6 +33,11 @@ enum RngDim : uint32_t {
     kDimBsdf0,
     kDimBsdf1,
     kDimRoulette,
+    // Path guiding: the guide or the BSDF, then the guide's bin and the direction in it.
+    kDimGuideChoice,
+    kDimGuideBin,
+    kDimGuide0,
+    kDimGuide1,
     kDimLight0 = 16,  // next-event estimation: two per light, then the sky's
 };
 

@@ -193,6 +193,17 @@ TEST_F(PagerTest, InCoreBudgetLoadsEveryBrickOnceAndEvictsNothing) {
     EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
 }
 
+TEST_F(PagerTest, FreePagesGoBackAtBatchEndsNearTheProcessLimitAlsoWithoutLoads) {
+    // Every brick fits, so the loads end early; a process limit below the resident size makes
+    // every check return pages: more returns than loads means batch ends check too.
+    PagerOptions options;
+    options.process_memory_bytes = 1;
+    Rendered paged = RenderBallGrid("path", &options);
+    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
+    EXPECT_EQ(paged.stats.brick_evictions, 0u);
+    EXPECT_GT(paged.stats.memory_returns, paged.stats.brick_loads);
+}
+
 TEST_F(PagerTest, CustomPickerWithPagingRendersTheSameImage) {
     // Emptiest brick first: the worst order for paging, still the same image within budget.
     Rendered in_core = RenderBallGrid("path", nullptr);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "render/brick_source.h"
 #include "render/film.h"
@@ -105,6 +106,42 @@ inline std::string ClutterScene(int width, int height) {
     return "[camera]\nposition = [6, 5, 3.5]\nlook_at = [0, 0, 0.6]\nfov_deg = 45\nresolution = [" +
            std::to_string(width) + ", " + std::to_string(height) + "]\n" + SunSkyFloorAndBall() +
            "[materials.chrome]\ntype = \"conductor\"\nroughness = 0.2\n";
+}
+
+/// Two renders that differ only in the seed: the mean luminance of both, the noise of one (the RMS
+/// of their per-pixel difference over √2) and the second's statistics.
+struct SeedPair {
+    double mean = 0;
+    double noise = 0;
+    size_t pixels = 0;
+    RenderStats stats;
+};
+
+/// Renders `config_text` (which must end inside its [render] table) with seeds 1 and 2, as Render
+/// does with `n_split`.
+inline SeedPair RenderSeedPair(const store::BrickMesh& mesh,
+                               const std::vector<std::string>& material_names,
+                               const std::string& config_text, int n_split) {
+    std::vector<double> y[2];
+    SeedPair pair;
+    for (int seed = 0; seed < 2; ++seed) {
+        auto t = Render(mesh, material_names,
+                        config_text + "\nseed = " + std::to_string(seed + 1) + "\n", n_split);
+        EXPECT_TRUE(t != nullptr);
+        if (t == nullptr) return {};
+        for (uint32_t p = 0; p < uint32_t(t->film->pixel_count()); ++p)
+            y[seed].push_back(t->film->PixelXYZ(p).y);
+        pair.stats = t->stats;
+    }
+    pair.pixels = y[0].size();
+    double diff2 = 0;
+    for (size_t p = 0; p < y[0].size(); ++p) {
+        pair.mean += (y[0][p] + y[1][p]) / 2;
+        diff2 += (y[0][p] - y[1][p]) * (y[0][p] - y[1][p]);
+    }
+    pair.mean /= double(pair.pixels);
+    pair.noise = std::sqrt(diff2 / double(pair.pixels) / 2);
+    return pair;
 }
 
 inline double MeanY(const Film& film) {

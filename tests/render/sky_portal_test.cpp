@@ -38,36 +38,14 @@ spp = 32
 max_depth = 1
 )";
 
-struct Result {
-    double mean = 0;   ///< mean luminance over the image
-    double noise = 0;  ///< RMS of the per-pixel difference between two seeds, over sqrt(2)
-    size_t pixels = 0;
-};
-
-Result RenderRoom(const std::string& sky_sampling) {
-    std::vector<double> y[2];
-    for (int seed = 0; seed < 2; ++seed) {
-        const std::string config = std::string(kConfig) + "sky_sampling = \"" + sky_sampling + "\"\nseed = " +
-                                   std::to_string(seed + 1) + "\n";
-        auto t = testing::Render(testing::RoomWithRoofWindow(), kMaterials, config, 2);
-        EXPECT_TRUE(t != nullptr);
-        if (t == nullptr) return {};
-        for (uint32_t p = 0; p < uint32_t(t->film->pixel_count()); ++p) y[seed].push_back(t->film->PixelXYZ(p).y);
-    }
-    Result r;
-    r.pixels = y[0].size();
-    double diff2 = 0;
-    for (size_t p = 0; p < y[0].size(); ++p) {
-        r.mean += (y[0][p] + y[1][p]) / 2;
-        diff2 += (y[0][p] - y[1][p]) * (y[0][p] - y[1][p]);
-    }
-    r.mean /= double(r.pixels);
-    r.noise = std::sqrt(diff2 / double(r.pixels) / 2);
-    return r;
+testing::SeedPair RenderRoom(const std::string& sky_sampling) {
+    return testing::RenderSeedPair(testing::RoomWithRoofWindow(), kMaterials,
+                                   std::string(kConfig) + "sky_sampling = \"" + sky_sampling + "\"",
+                                   2);
 }
 
 TEST(SkyPortals, SameImageInExpectationWithLessNoise) {
-    const Result uniform = RenderRoom("uniform"), portals = RenderRoom("portals");
+    const testing::SeedPair uniform = RenderRoom("uniform"), portals = RenderRoom("portals");
     ASSERT_GT(uniform.mean, 0);
     // Each mean averages 2 x pixels x 32 paths; their difference stays within a few standard errors.
     const double tolerance = 4 * std::hypot(uniform.noise, portals.noise) / std::sqrt(2.0 * double(uniform.pixels));

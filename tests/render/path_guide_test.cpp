@@ -1,0 +1,261 @@
+// Path guiding (render.path_guiding): the guide's histograms as distributions (their samples follow
+// their pdf, the pdf integrates to one, credits in any order give the same distribution), and
+// guided path tracing in a room lit by the sun and sky through a window in its roof: the same image
+// in expectation as BSDF sampling alone, and the same image whatever the bricks and threads.
+
+#include "render/path_guide.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/sampling.h"
+#include "render/materials/bxdf.h"
+#include "render_test_util.h"
+
+namespace nave::render {
+namespace {
+
+const Bounds3f kBox(Vec3f(0, 0, 0), Vec3f(4, 4, 4));
+const int kSide = PathGuide::SideOf(Vec3f(0, 0, 1));  // the unit tests' surfaces face up
+
+Vec3f UniformDirection(std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    return SampleUniformSphere(Point2f(u(rng), u(rng)));
+}
+
+/// A guide whose cell at (1, 1, 1) learned light mostly from +x and some from -z.
+std::unique_ptr<PathGuide> LearnedGuide() {
+    auto guide = std::make_unique<PathGuide>(kBox, 4, 16, 1.0);
+    const Vec3f p(1, 1, 1);
+    // Cells get their histograms at an update, and learn from the credits after it.
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int i = 0; i < 300; ++i)
+            guide->Credit(guide->CreditKey(p, kSide, Normalize(Vec3f(1, 0.1f, 0.05f))), 2.0);
+        for (int i = 0; i < 100; ++i)
+            guide->Credit(guide->CreditKey(p, kSide, Vec3f(0, 0, -1)), 1.0);
+        guide->Update();
+    }
+    return guide;
+}
+
+TEST(PathGuide, SamplesFollowThePdfThatIntegratesToOne) {
+    const std::unique_ptr<PathGuide> learned = LearnedGuide();
+    const PathGuide& guide = *learned;
+    const Vec3f p(1.2f, 1.3f, 1.4f);  // same cell
+    ASSERT_TRUE(guide.Guides(p, kSide));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    // The bins have equal solid angles: uniform directions fall in them equally (chi² with 255
+    // degrees of freedom, far tail).
+    std::vector<double> uniform(PathGuide::kBins, 0);
+    constexpr int kUniform = 256000;
+    for (int i = 0; i < kUniform; ++i)
+        uniform[size_t(PathGuide::BinOf(UniformDirection(rng)))] += 1;
+    double uniform_chi2 = 0;
+    for (double c : uniform) uniform_chi2 += (c - 1000) * (c - 1000) / 1000;
+    EXPECT_LT(uniform_chi2, 255 + 5 * std::sqrt(2.0 * 255));
+    // So the pdf over the sphere, constant in each bin, integrates to one.
+    double integral = 0;
+    for (int b = 0; b < PathGuide::kBins; ++b) {
+        const float z = -1 + 2 * (float(b / PathGuide::kPhiBins) + 0.5f) / PathGuide::kZBins;
+        const float phi = 2 * kPi * (float(b % PathGuide::kPhiBins) + 0.5f) / PathGuide::kPhiBins;
+        const Vec3f w(std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi),
+                      z);
+        ASSERT_EQ(PathGuide::BinOf(w), b);
+        integral += guide.Pdf(p, kSide, w) * 4 * kPi / PathGuide::kBins;
+    }
+    EXPECT_NEAR(integral, 1.0, 1e-5);
+    // Sampled directions land in the bins in proportion to pdf x the bin's solid angle, and each
+    // sample's pdf is Pdf's.
+    std::vector<double> counts(PathGuide::kBins, 0), expected(PathGuide::kBins, 0);
+    constexpr int kSamples = 100000;
+    for (int i = 0; i < kSamples; ++i) {
+        std::optional<GuideSample> s = guide.Sample(p, kSide, u(rng), u(rng), u(rng));
+        ASSERT_TRUE(s);
+        ASSERT_NEAR(Length(s->wi), 1.f, 1e-5f);
+        ASSERT_FLOAT_EQ(s->pdf, guide.Pdf(p, kSide, s->wi));
+        counts[size_t(PathGuide::BinOf(s->wi))] += 1;
+        expected[size_t(PathGuide::BinOf(s->wi))] = s->pdf * 4 * kPi / PathGuide::kBins * kSamples;
+    }
+    double chi2 = 0;
+    int dof = 0;
+    for (int b = 0; b < PathGuide::kBins; ++b) {
+        if (expected[size_t(b)] < 5) continue;
+        chi2 += (counts[size_t(b)] - expected[size_t(b)]) *
+                (counts[size_t(b)] - expected[size_t(b)]) / expected[size_t(b)];
+        ++dof;
+    }
+    // The guide learned +x three times as strongly per credit count (600 against 100): its bin
+    // holds most of the 90 % that is learned.
+    EXPECT_GT(dof, 10);
+    EXPECT_LT(chi2, dof + 5 * std::sqrt(2.0 * dof)) << "dof " << dof;
+    const int bright = PathGuide::BinOf(Normalize(Vec3f(1, 0.1f, 0.05f)));
+    EXPECT_NEAR(counts[size_t(bright)] / kSamples, 0.9 * 600 / 700 + 0.1 / PathGuide::kBins, 0.01);
+}
+
+TEST(PathGuide, SidesAreTheNormalsLargestAxisAndItsSign) {
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(0.9f, 0.3f, -0.3f)), 0);
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(-0.9f, 0.3f, -0.3f)), 1);
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(0.2f, 0.7f, 0.6f)), 2);
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(0.2f, -0.7f, 0.6f)), 3);
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(0, 0, 1)), 4);
+    EXPECT_EQ(PathGuide::SideOf(Vec3f(0.1f, 0.1f, -0.99f)), 5);
+}
+
+TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
+    std::mt19937 rng(3);
+    std::vector<std::pair<Vec3f, double>> credits;
+    for (int i = 0; i < 5000; ++i)
+        credits.push_back(
+            {UniformDirection(rng), std::exp(std::uniform_real_distribution<double>(-8, 3)(rng))});
+    PathGuide a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
+    const Vec3f p(3.5f, 0.5f, 2.5f);
+    for (int pass = 0; pass < 2; ++pass) {
+        for (const auto& [w, v] : credits) a.Credit(a.CreditKey(p, kSide, w), v);
+        std::shuffle(credits.begin(), credits.end(), rng);
+        for (const auto& [w, v] : credits) b.Credit(b.CreditKey(p, kSide, w), v);
+        a.Update();
+        b.Update();
+    }
+    ASSERT_TRUE(a.Guides(p, kSide));
+    for (int i = 0; i < 1000; ++i) {
+        const Vec3f w = UniformDirection(rng);
+        ASSERT_EQ(a.Pdf(p, kSide, w), b.Pdf(p, kSide, w));  // bit for bit
+    }
+}
+
+TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {
+    PathGuide guide(kBox, 4, 1, 1.0);  // one cell with a histogram at most
+    const Vec3f first(0.5f, 0.5f, 0.5f), second(3.5f, 3.5f, 3.5f), outside(5, 5, 5);
+    const Vec3f up(0, 0, 1);
+    EXPECT_EQ(guide.CreditKey(outside, kSide, up), PathGuide::kNoCredit);
+    auto credit = [&](const Vec3f& p, int n) {
+        for (int i = 0; i < n; ++i) guide.Credit(guide.CreditKey(p, kSide, up), 1.0);
+    };
+    // Counted, not learned: the cell with most credits gets the one histogram at the update.
+    credit(first, 20);
+    credit(second, 19);
+    guide.Update();
+    EXPECT_EQ(guide.cells_used(), 1u);
+    EXPECT_FALSE(guide.Guides(first, kSide)) << "no credits since its histogram came";
+    credit(first, 63);
+    credit(second, 100);
+    guide.Update();
+    EXPECT_FALSE(guide.Guides(first, kSide)) << "63 credits are fewer than Update's 64";
+    credit(first, 1);
+    guide.Update();
+    EXPECT_TRUE(guide.Guides(first, kSide));
+    EXPECT_FALSE(guide.Guides(first, PathGuide::SideOf(Vec3f(0.1f, -0.9f, 0.3f))))
+        << "a wall in the same cell keeps its own histogram";
+    EXPECT_FALSE(guide.Guides(second, kSide)) << "beyond the cap";
+    EXPECT_FALSE(guide.Guides(outside, kSide));
+    EXPECT_EQ(guide.cells_used(), 1u);
+    EXPECT_EQ(guide.cells_guiding(), 1u);
+    EXPECT_EQ(guide.Pdf(second, kSide, up), 0.f);
+    EXPECT_FALSE(guide.Sample(second, kSide, 0.5f, 0.5f, 0.5f));
+}
+
+TEST(GuidedBsdf, MixtureSamplesFollowTheMixturePdf) {
+    const std::unique_ptr<PathGuide> learned = LearnedGuide();
+    const PathGuide& guide = *learned;
+    const Vec3f p(1, 1, 1);
+    DiffuseBxdf diffuse(SampledSpectrum(0.8f));
+    const Bsdf bsdf(Vec3f(0, 0, 1), Vec3f(1, 0, 0), Bxdf(diffuse));
+    const GuidedBsdf continuation(bsdf, &guide, p, kSide);
+    ASSERT_TRUE(continuation.guided());
+    const SampledWavelengths lambda = SampledWavelengths::SampleVisible(0.3f);
+    const Vec3f wo = Normalize(Vec3f(0.3f, -0.2f, 1));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    // Over the sphere the mixture pdf integrates to one (the guide's part reaches below the
+    // surface, where the diffuse BSDF reflects nothing).
+    double below = 0, integral = 0;
+    constexpr int kN = 200000;
+    for (int i = 0; i < kN; ++i) {
+        const Vec3f w = UniformDirection(rng);
+        integral += continuation.Pdf(wo, w, lambda) * 4 * kPi;
+        if (w.z < 0) below += guide.Pdf(p, kSide, w) * 4 * kPi;
+    }
+    EXPECT_NEAR(integral / kN, 1.0, 0.01);
+    // Samples: pdf as Pdf says, f as the BSDF's, and a guide sample below the surface ends the
+    // path.
+    int ended = 0;
+    for (int i = 0; i < 20000; ++i) {
+        std::optional<BsdfSample> s = continuation.Sample(
+            wo, u(rng), u(rng), Point2f(u(rng), u(rng)), {u(rng), u(rng), u(rng)}, lambda);
+        if (!s) {
+            ++ended;
+            continue;
+        }
+        ASSERT_NEAR(s->pdf, continuation.Pdf(wo, s->wi, lambda), 1e-4f * s->pdf);
+        ASSERT_GT(s->wi.z, 0);
+        ASSERT_EQ(s->f[0], bsdf.Eval(wo, s->wi, lambda)[0]);
+    }
+    EXPECT_NEAR(ended / 20000.0, GuidedBsdf::kGuideShare * below / kN, 0.015);
+}
+
+// The room of render_test_util.h with the sun through the hole in its roof: a sunlit patch on the
+// floor lights the walls, which the camera sees.
+const std::vector<std::string> kMaterials = {"floor", "wall", "window"};
+constexpr const char* kRoom = R"(
+[camera]
+position = [1.6, -1.7, 2.2]
+look_at = [-2.0, 1.0, 1.2]
+up = [0, 0, 1]
+fov_deg = 60
+resolution = [24, 24]
+[sun]
+direction = [0.25, 0.2, 1.0]
+[sky]
+radiance = 0.2
+[materials.floor]
+reflectance = 0.7
+[materials.wall]
+reflectance = 0.6
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+[render]
+spp = 128
+max_depth = 3
+)";
+
+testing::SeedPair RenderRoom(bool guiding) {
+    return testing::RenderSeedPair(
+        testing::RoomWithRoofWindow(), kMaterials,
+        std::string(kRoom) + "path_guiding = " + (guiding ? "true" : "false"), 2);
+}
+
+// Guiding changes how paths are sampled, not what they estimate. (How much noise it saves is
+// measured on the abbey, docs/render.md; in this small room it learns late and saves little.)
+TEST(PathGuiding, SameImageInExpectation) {
+    const testing::SeedPair plain = RenderRoom(false), guided = RenderRoom(true);
+    ASSERT_GT(plain.mean, 0);
+    EXPECT_EQ(plain.stats.guide_cells_guiding, 0u);
+    EXPECT_GT(guided.stats.guide_cells_guiding, 20u)
+        << "the guide learned too little to test anything";
+    const double tolerance =
+        4 * std::hypot(plain.noise, guided.noise) / std::sqrt(2.0 * double(plain.pixels));
+    EXPECT_NEAR(guided.mean, plain.mean, tolerance)
+        << "plain noise " << plain.noise << ", guided " << guided.noise;
+}
+
+TEST(PathGuiding, TheImageDoesNotDependOnBricksOrThreads) {
+    const std::string config = std::string(kRoom) + "path_guiding = true\n";
+    auto one = testing::Render(testing::RoomWithRoofWindow(), kMaterials, config, 1, 1);
+    auto many = testing::Render(testing::RoomWithRoofWindow(), kMaterials, config, 3, 2);
+    ASSERT_TRUE(one != nullptr && many != nullptr);
+    // Equal but for the order of the film's double additions (render_test.cpp's determinism
+    // tests): a guide that learned differently would change every guided path.
+    EXPECT_LT(testing::MaxRelativeDifference(*one->film, *many->film), 1e-12);
+}
+
+}  // namespace
+}  // namespace nave::render
