@@ -75,4 +75,31 @@ inline float UniformConePdf(float cos_theta_max) {
     return 1.f / (2.f * kPi * (1.f - cos_theta_max));
 }
 
+/// 1 - cos θ for a narrow cone, without cancellation: 2 sin²(θ/2).
+inline double OneMinusCos(double theta) {
+    const double s = std::sin(0.5 * theta);
+    return 2 * s * s;
+}
+/// Uniform direction in the cone of half-angle `theta_max` (radians) around +z, for narrow cones
+/// such as the sun's 0.27°, where cos θmax in float takes only ~180 values over the disc: 1 - cos θ
+/// is drawn in double and sin θ computed from it. Pdf: UniformNarrowConePdf.
+inline Vec3f SampleUniformNarrowCone(Point2f u, double theta_max) {
+    const double one_minus_cos = double(u.x) * OneMinusCos(theta_max);
+    const double sin_theta = std::sqrt(std::max(0.0, one_minus_cos * (2 - one_minus_cos)));
+    const double phi = double(u.y) * 2 * std::numbers::pi;
+    return {float(std::cos(phi) * sin_theta), float(std::sin(phi) * sin_theta),
+            float(1 - one_minus_cos)};
+}
+/// The solid angle of a cone of half-angle `theta_max`, 2π(1 - cos θmax), in double.
+inline double ConeSolidAngle(double theta_max) {
+    return 2 * std::numbers::pi * OneMinusCos(theta_max);
+}
+/// Whether unit direction `w` lies within `theta_max` of unit `axis`, from sin² of their angle
+/// (|w × axis|²), which keeps its precision for narrow cones where their cosine does not.
+inline bool InNarrowCone(const Vec3f& w, const Vec3f& axis, double theta_max) {
+    const Vec3f c = Cross(w, axis);
+    const double s = std::sin(theta_max);
+    return Dot(w, axis) > 0 && double(Dot(c, c)) <= s * s;
+}
+
 }  // namespace nave

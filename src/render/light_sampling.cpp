@@ -95,8 +95,8 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
         case Light::Kind::kSun: {
             // Uniform over the solar disc's cone (radiance constant over the disc: no limb
             // darkening).
-            wi = Frame::FromZ(light.to_light).FromLocal(SampleUniformCone(u, light.cos_sun));
-            light_pdf = UniformConePdf(light.cos_sun);
+            wi = light.SampleSun(u);
+            light_pdf = light.SunPdf();
             Li = light.spectrum.Sample(r.lambda) / light_pdf;
             break;
         }

@@ -46,7 +46,7 @@ double PathIntegrator::GuideRadianceScale() const {
     double scale = 0;
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
-        const double solid_angle = 2 * kPi * (1 - double(sun.cos_sun));
+        const double solid_angle = sun.SunSolidAngle();
         scale = double(sun.spectrum.Sample(green).Average()) * solid_angle * kInvPi;
     }
     if (scene_.sky) {
@@ -214,13 +214,13 @@ void PathIntegrator::Escape(const RayRecord& r) {
     }
     if (scene_.sun >= 0) {
         const Light& sun = scene_.lights[size_t(scene_.sun)];
-        if (Dot(r.dir, sun.to_light) >= sun.cos_sun) {
+        if (sun.SeesSun(r.dir)) {
             // A BSDF-sampled direction that found the sun: weighted against next-event estimation
             // of the sun (power heuristic). Camera rays and specular bounces cannot be
             // light-sampled: weight 1.
             float w = 1;
             if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
-                w = PowerHeuristic(r.prev_pdf, UniformConePdf(sun.cos_sun));
+                w = PowerHeuristic(r.prev_pdf, sun.SunPdf());
             }
             L += sun.spectrum.Sample(r.lambda) * w;
         }

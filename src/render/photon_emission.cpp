@@ -277,15 +277,13 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                     case Light::Kind::kSun:
                     case Light::Kind::kDirectional: {
                         const bool sun = l.kind == Light::Kind::kSun;
-                        Vec3f to = sun ? Frame::FromZ(l.to_light)
-                                             .FromLocal(SampleUniformCone(u2, l.cos_sun))
-                                       : l.to_light;
+                        Vec3f to = sun ? l.SampleSun(u2) : l.to_light;
                         const float area = StartDistantPhoton(e, to, rng, &r);
                         r.dir = -to;
                         // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E /
                         // p_area.
                         r.beta = sun ? l.spectrum.Sample(lambda) *
-                                           (Dot(to, l.to_light) * area * l.SunSolidAngle())
+                                           (Dot(to, l.to_light) * area * float(l.SunSolidAngle()))
                                      : l.spectrum.Sample(lambda) * area;
                         break;
                     }

@@ -1,6 +1,7 @@
 #include "render/scene.h"
 
 #include <cmath>
+#include <numbers>
 
 #include "core/log.h"
 #include "core/rgb_to_spectrum.h"
@@ -57,7 +58,7 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
     SunState s;
     if (sun.direction) {
         s.to_sun = *sun.direction;
-        s.cos_max = std::cos(sun.angular_radius_deg * 3.14159265358979f / 180.f);
+        s.angular_radius_rad = double(sun.angular_radius_deg) * std::numbers::pi / 180;
         s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / 3.14159265358979;
         s.azimuth_deg = std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / 3.14159265358979 + 360.0, 360.0);
         if (sun.radiance) {
@@ -66,7 +67,7 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
             // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for that
             // zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490) spread over the
             // disc, i.e. the sun without an atmosphere.
-            double omega = 2 * 3.14159265358979 * (1 - double(s.cos_max));
+            const double omega = ConeSolidAngle(s.angular_radius_rad);
             s.radiance = ExtraterrestrialSolarSpectrum() * float(1.0 / omega);
         }
     } else {
@@ -84,7 +85,7 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
         s.to_sun = model->direction;
         s.zenith_deg = model->position.zenith_deg;
         s.azimuth_deg = model->position.azimuth_deg;
-        s.cos_max = model->CosThetaMax();
+        s.angular_radius_rad = model->angular_radius_rad;
         s.radiance = sun.radiance ? ToSpectrum(*sun.radiance) : model->radiance;
         s.above_horizon = model->AboveHorizon();
     }
@@ -184,7 +185,7 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         Light l;
         l.kind = Light::Kind::kSun;
         l.to_light = sun.to_sun;
-        l.cos_sun = sun.cos_max;
+        l.sun_radius_rad = sun.angular_radius_rad;
         l.spectrum = sun.radiance;
         scene.sun = int(scene.lights.size());
         scene.lights.push_back(std::move(l));

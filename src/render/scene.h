@@ -9,12 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "core/sampling.h"
 #include "core/spectrum.h"
 #include "core/status.h"
 #include "core/vecmath.h"
 #include "render/brick_source.h"
 #include "render/camera.h"
 #include "render/materials/bxdf.h"
+#include "render/materials/frame.h"
 #include "render/materials/materials.h"
 #include "render/scene_config.h"
 #include "render/sun/sky.h"
@@ -83,9 +85,19 @@ struct Light {
     Vec3f position;              ///< point and spot
     Vec3f spot_axis{0, 0, -1};   ///< spot: direction light travels
     float cos_cone = 1, cos_falloff = 1;  ///< spot
-    float cos_sun = 1;           ///< sun: cosine of the disc's angular radius
+    double sun_radius_rad = 0;            ///< sun: the disc's angular radius
     Spectrum spectrum;           ///< sun: radiance; directional: irradiance (normal incidence); point/spot: intensity
-    float SunSolidAngle() const { return 2 * 3.14159265358979f * (1 - cos_sun); }
+    /// Sun: the disc's solid angle (sr) and the pdf of SampleSun, in double where it matters (the
+    /// disc spans 1 - cos θ ≈ 1.1e-5).
+    double SunSolidAngle() const { return ConeSolidAngle(sun_radius_rad); }
+    float SunPdf() const { return float(1 / SunSolidAngle()); }
+    /// Sun: a direction uniform over the disc.
+    Vec3f SampleSun(Point2f u) const {
+        return Normalize(
+            Frame::FromZ(to_light).FromLocal(SampleUniformNarrowCone(u, sun_radius_rad)));
+    }
+    /// Sun: whether direction `w` (unit) is within the disc.
+    bool SeesSun(const Vec3f& w) const { return InNarrowCone(w, to_light, sun_radius_rad); }
 };
 
 struct RenderScene {
@@ -127,7 +139,7 @@ Spectrum ToSpectrum(const SpectrumSpec& spec);
 struct SunState {
     Vec3f to_sun;            ///< unit vector, world frame (+X east, +Y north, +Z up)
     double zenith_deg = 0, azimuth_deg = 0;
-    float cos_max = 1;       ///< cosine of the disc's angular radius
+    double angular_radius_rad = 0;  ///< the disc's angular radius
     Spectrum radiance;       ///< disc radiance at the ground, W m^-2 sr^-1 nm^-1
     bool above_horizon = true;
 };

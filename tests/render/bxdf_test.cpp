@@ -310,6 +310,43 @@ TEST(BxdfTest, ThinDielectricSumsInterreflections) {
     for (int i = 0; i < kNumWavelengths; ++i) EXPECT_NEAR(sum[i] / n, rr[i] + tt[i], 0.01f);
 }
 
+// A pane at oblique incidence: each polarisation has its own series of internal reflections
+// (Hecht, Optics, 4th ed., §4.6.1 eqs. (4.42)-(4.43) for R_s = sin²(θi-θt)/sin²(θi+θt) and R_p =
+// tan²(θi-θt)/tan²(θi+θt); §9.7 for the slab's series T_x = (1-R_x)² τ / (1 - R_x² τ²), τ the
+// internal transmittance along the refracted path), unpolarised light their mean. Written here from
+// the angles, independently of FrDielectricPolarized's cosine form. Summing one series of the mean
+// R instead is -0.4 % at 45°, -1.5 % at 60° and -3.9 % at 76° for η = 1.52 (τ = 1): the tolerance,
+// 1e-5, is float rounding.
+TEST(BxdfTest, ThinPaneSumsEachPolarisationOnItsOwn) {
+    const double eta = 1.52;
+    for (double tau0 : {1.0, 0.85}) {
+        const ThinDielectricBxdf pane{SampledSpectrum(float(eta)), SampledSpectrum(float(tau0))};
+        for (double deg : {0.0, 45.0, 60.0, 76.0}) {
+            const double ti = deg * M_PI / 180, tt = std::asin(std::sin(ti) / eta);
+            double rs, rp;
+            if (deg == 0.0) {
+                rs = rp = std::pow((eta - 1) / (eta + 1), 2);
+            } else {
+                rs = std::pow(std::sin(ti - tt) / std::sin(ti + tt), 2);
+                rp = std::pow(std::tan(ti - tt) / std::tan(ti + tt), 2);
+            }
+            const double tau = std::pow(tau0, 1 / std::cos(tt));
+            auto series = [&](double r) {
+                return (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
+            };
+            const double expected_t = 0.5 * (series(rs) + series(rp));
+            auto reflected = [&](double r) {
+                return r + (1 - r) * (1 - r) * r * tau * tau / (1 - r * r * tau * tau);
+            };
+            const double expected_r = 0.5 * (reflected(rs) + reflected(rp));
+            SampledSpectrum r, t;
+            pane.ReflectanceTransmittance(float(std::cos(ti)), &r, &t);
+            EXPECT_NEAR(t[0], expected_t, 1e-5) << deg << "° τ " << tau0;
+            EXPECT_NEAR(r[0], expected_r, 1e-5) << deg << "° τ " << tau0;
+        }
+    }
+}
+
 TEST(BsdfTest, WorldFrameRoundTrip) {
     Vec3f n = Normalize(Vec3f(0.3f, -0.2f, 0.9f));
     Bsdf bsdf(n, Vec3f(0, 0, 0), DiffuseBxdf(SampledSpectrum(0.8f)));

@@ -4,9 +4,10 @@
 #include <gtest/gtest.h>
 
 #include "core/color.h"
-#include "render/sun/sky.h"
 #include "core/progress.h"
+#include "core/sampling.h"
 #include "render/procedural_meshes.h"
+#include "render/sun/sky.h"
 #include "render_test_util.h"
 
 namespace nave::render {
@@ -85,8 +86,9 @@ spp = 4
                                          std::cos(e), std::sin(e));
         auto t = Render(m, {"plane"}, config, 1);
         ASSERT_TRUE(t);
-        float cos_sun = std::cos(0.2666f * 3.14159265f / 180.f);
-        double omega = 2 * 3.14159265 * (1 - cos_sun);
+        // The disc's solid angle in double: 2π(1 - cos θ) with cos θ in float is off by up to 0.3
+        // %.
+        double omega = ConeSolidAngle(0.2666 * M_PI / 180);
         double expected = 0.6 / 3.14159265 * 1000.0 * omega * std::sin(e);
         // Y of a constant spectrum equals its value; the estimate is exact up to the 4 wavelengths' pdf
         // weighting of a flat spectrum, which is exact.
@@ -361,8 +363,7 @@ photons_per_iteration = 1000
 photon_target = "{}"
 max_depth = 1
 )";
-    float cos_sun = std::cos(0.2666f * 3.14159265f / 180.f);
-    double omega = 2 * 3.14159265 * (1 - cos_sun);
+    double omega = ConeSolidAngle(0.2666 * M_PI / 180);
     double r = 0.04, tau = 0.8;
     double t_tot = (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
     double expected = 0.5 / 3.14159265 * 1000.0 * omega * t_tot;

@@ -4,9 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/color.h"
+#include "core/sampling.h"
 #include "render/sun/spa.h"
 
 namespace nave {
@@ -121,6 +124,93 @@ TEST(AtmosphereTest, BodhaineRayleighOpticalDepth) {
     EXPECT_NEAR(RayleighOpticalDepth(550.0, 506.625) / RayleighOpticalDepth(550.0), 0.5, 1e-12);
 }
 
+// ASTM G173-03 direct normal (+ circumsolar) spectrum at air mass 1.5 (apparent zenith 48.236°),
+// from SMARTS 2.9.2 with the U.S. Standard Atmosphere 1976 at 1013.25 hPa, 1.4164 cm of water,
+// 0.3438 atm-cm of ozone and rural aerosol of optical depth 0.084 at 500 nm. The bands' ratio of
+// direct to extraterrestrial irradiance (both columns of the standard's table, 1 nm steps, band
+// means computed from it) is the atmosphere's transmittance, independent of the extraterrestrial
+// spectrum each model starts from. nave's model, given the same atmosphere (β for the same 500-nm
+// depth with α = 1.3), measures 0.993, 1.001, 1.008, 1.026, 1.021 and 1.012 of the standard's
+// bands: within 1 % below 550 nm, where Rayleigh scattering and aerosols dominate, and up to 2.6 %
+// too clear in 550-650 nm, where SMARTS also has absorbers nave's model leaves out (NO2, the O2-O2
+// collision bands at 577 and 630 nm, weak water-vapour bands) and a newer ozone cross-section than
+// the Vigroux table (about 0.017 of optical depth in all). So the bound is 1.5 % below 550 nm and
+// 3 % above, not 2 % everywhere; an error in the Rayleigh depth of the size the audit found (τ_R
+// off by 17 % at Denver's pressure) moves the 400-450 nm band by 6 %. At 1013.25 hPa that pressure
+// error vanishes, so the test after this one checks the pressure scaling on its own.
+TEST(SunTest, DirectBeamTransmittanceMatchesAstmG173) {
+    struct Band {
+        double from_nm, to_nm, g173_ratio;
+    };
+    const Band bands[] = {{400, 450, 0.5635}, {450, 500, 0.6622}, {500, 550, 0.7162},
+                          {550, 600, 0.7322}, {600, 650, 0.7760}, {650, 686, 0.8270}};
+    Atmosphere atm;
+    atm.pressure_hpa = 1013.25;
+    atm.water_vapour_cm = 1.4164;
+    atm.ozone_atm_cm = 0.3438;
+    atm.angstrom_alpha = 1.3;
+    // Turbidity whose β gives τ_a(500 nm) = β 0.5^-1.3 = 0.084 (Preetham's β = 0.04608 T -
+    // 0.04586).
+    atm.turbidity = (0.084 * std::pow(0.5, 1.3) + 0.04586025928522) / 0.04608365822050;
+    ASSERT_NEAR(AngstromBetaFromTurbidity(atm.turbidity) * std::pow(0.5, -1.3), 0.084, 1e-9);
+    const Spectrum direct = DirectNormalIrradiance(48.236, atm, 1.0);
+    const Spectrum& top = ExtraterrestrialSolarSpectrum();
+    for (const Band& b : bands) {
+        double d = 0, e = 0;
+        for (double l = b.from_nm; l < b.to_nm; l += 1) {
+            d += direct(float(l));
+            e += top(float(l));
+        }
+        EXPECT_NEAR(d / e / b.g173_ratio, 1.0, b.to_nm <= 550 ? 0.015 : 0.03)
+            << b.from_nm << "-" << b.to_nm << " nm";
+    }
+}
+
+// Rayleigh scattering removes exp(-m τ_R(λ) p/p0) of the beam (Bodhaine et al. 1999 eq. 30, depth
+// proportional to the station pressure; Beer-Lambert with the relative air mass m). Between two
+// pressures at a wavelength clear of gas bands, the direct beam's ratio is that alone: at 400 nm,
+// zenith 50°, 820 against 1013.25 hPa, exp(m τ_R0 (1 - 820/1013.25)) = 1.114, where applying the
+// pressure twice (to τ_R and to m) gave 1.221.
+TEST(SunTest, RayleighDepthFollowsPressureOnce) {
+    Atmosphere sea, denver;
+    denver.pressure_hpa = 820;
+    const double zenith = 50, m = RelativeAirMassKastenYoung(zenith);
+    const double ratio = DirectNormalIrradiance(zenith, denver, 1.0)(400.f) /
+                         DirectNormalIrradiance(zenith, sea, 1.0)(400.f);
+    const double expected = std::exp(m * RayleighOpticalDepth(400.0) * (1 - 820 / 1013.25));
+    EXPECT_NEAR(ratio, expected, 1e-4 * expected);
+}
+
+// The disc is 1 - cos θ ≈ 1.1e-5 wide: in float its cosine takes ~180 values. The solid angle and
+// the samples must keep their precision (Ω = 2π(1 - cos θ) = 4π sin²(θ/2)).
+TEST(SunTest, TheNarrowDiscKeepsItsPrecision) {
+    const double radius = 0.2666 * M_PI / 180;
+    EXPECT_NEAR(ConeSolidAngle(radius), 4 * M_PI * std::pow(std::sin(radius / 2), 2), 1e-15);
+    EXPECT_NEAR(ConeSolidAngle(radius) / 6.80180e-5, 1.0, 1e-5);
+    // Samples: 1 - cos θ uniform on [0, 1 - cos θmax] (uniform over the disc); many distinct
+    // angles.
+    const Vec3f axis(0, 0, 1);
+    const double max_one_minus_cos = OneMinusCos(radius);
+    int inner = 0;
+    std::vector<float> sines;
+    constexpr int kN = 20000;
+    for (int i = 0; i < kN; ++i) {
+        const Point2f u((float(i) + 0.5f) / kN, std::fmod(float(i) * 0.618034f, 1.f));
+        const Vec3f w = SampleUniformNarrowCone(u, radius);
+        ASSERT_TRUE(InNarrowCone(w, axis, radius * (1 + 1e-6))) << i;
+        const double sin2 = double(w.x) * w.x + double(w.y) * w.y;
+        if (sin2 / 2 < 0.5 * max_one_minus_cos) ++inner;  // 1 - cos θ ≈ sin²θ / 2 here
+        sines.push_back(float(std::sqrt(sin2)));
+    }
+    EXPECT_NEAR(double(inner) / kN, 0.5, 0.005);
+    std::sort(sines.begin(), sines.end());
+    EXPECT_GT(std::unique(sines.begin(), sines.end()) - sines.begin(), 10000);
+    EXPECT_FALSE(InNarrowCone(
+        Vec3f(std::sin(float(radius) * 1.01f), 0, std::cos(float(radius) * 1.01f)), axis, radius));
+    EXPECT_TRUE(InNarrowCone(
+        Vec3f(std::sin(float(radius) * 0.99f), 0, std::cos(float(radius) * 0.99f)), axis, radius));
+}
+
 SunInput DenverNoon() {
     SunInput in;
     in.time = {2003, 10, 17, 12, 30, 30.0, -7.0};
@@ -189,12 +279,11 @@ TEST(SunTest, NightHasNoDirectLight) {
 TEST(SunTest, DiscSamplingStaysInTheCone) {
     StatusOr<Sun> sun = ComputeSun(DenverNoon());
     ASSERT_TRUE(sun.ok());
-    float cos_max = sun->CosThetaMax();
     for (int i = 0; i < 1000; ++i) {
         Point2f u((i + 0.5f) / 1000.f, std::fmod(i * 0.618034f, 1.f));
         Vec3f w = sun->SampleDirection(u);
         EXPECT_NEAR(Length(w), 1.f, 1e-5f);
-        EXPECT_GE(Dot(w, sun->direction), cos_max - 1e-6f);
+        EXPECT_TRUE(InNarrowCone(w, sun->direction, sun->angular_radius_rad * 1.001)) << i;
     }
     EXPECT_NEAR(sun->Pdf(sun->direction) * sun->SolidAngle(), 1.0, 1e-3);
     EXPECT_EQ(sun->Pdf(Vec3f(0, 0, -1)), 0.f);

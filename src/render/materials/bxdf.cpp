@@ -305,20 +305,27 @@ void ThinDielectricBxdf::ReflectanceTransmittance(float cos_theta, SampledSpectr
     float sin2 = 1.f - cos_theta * cos_theta;
     for (int i = 0; i < kNumWavelengths; ++i) {
         float eta = eta_[i];
-        float r = FrDielectric(cos_theta, eta);
-        float t = 1.f - r;
         // Path length in the pane grows as 1/cosθt (Snell: sin²θt = sin²θi / η²).
         float cos_t = std::sqrt(std::max(1e-6f, 1.f - sin2 / (eta * eta)));
         float tau = tau_[i] >= 1.f ? 1.f : std::pow(std::max(tau_[i], 0.f), 1.f / cos_t);
-        float denom = 1.f - r * r * tau * tau;
-        if (denom <= 0.f) {
-            (*r_tot)[i] = 1.f;
-            (*t_tot)[i] = 0.f;
-            continue;
+        // The geometric series of internal reflections (Hecht §9.7, Stokes relations) sums each
+        // polarisation on its own, since reflection keeps s and p apart; unpolarised light is their
+        // mean. (Averaging R first and summing one series underestimates the pane's transmittance
+        // at oblique incidence: -1.5 % at 60°, -3.9 % at 76° for η = 1.52.)
+        const FresnelPolarized fresnel = FrDielectricPolarized(cos_theta, eta);
+        float reflected = 0.f, transmitted = 0.f;
+        for (float r : {fresnel.rs, fresnel.rp}) {
+            const float t = 1.f - r;
+            const float denom = 1.f - r * r * tau * tau;
+            if (denom <= 0.f) {
+                reflected += 0.5f;
+                continue;
+            }
+            reflected += 0.5f * (r + t * t * r * tau * tau / denom);
+            transmitted += 0.5f * (t * t * tau / denom);
         }
-        // Sum of the geometric series of internal reflections (Hecht §9.7 / Stokes relations).
-        (*r_tot)[i] = r + t * t * r * tau * tau / denom;
-        (*t_tot)[i] = t * t * tau / denom;
+        (*r_tot)[i] = reflected;
+        (*t_tot)[i] = transmitted;
     }
 }
 

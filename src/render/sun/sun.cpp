@@ -49,19 +49,15 @@ double IlluminanceLux(const Spectrum& irradiance) {
     return 683.002 * sum;
 }
 
-double Sun::SolidAngle() const {
-    // 2π(1 - cos θ) written as 4π sin²(θ/2): no cancellation for the sun's 0.27° radius.
-    double s = std::sin(0.5 * angular_radius_rad);
-    return 4.0 * kPiD * s * s;
-}
+double Sun::SolidAngle() const { return ConeSolidAngle(angular_radius_rad); }
 
 Vec3f Sun::SampleDirection(Point2f u) const {
-    Vec3f local = SampleUniformCone(u, CosThetaMax());
+    Vec3f local = SampleUniformNarrowCone(u, angular_radius_rad);
     return Normalize(Frame::FromZ(direction).FromLocal(local));
 }
 
 float Sun::Pdf(const Vec3f& w) const {
-    if (Dot(w, direction) < CosThetaMax()) return 0.f;
+    if (!InNarrowCone(w, direction, angular_radius_rad)) return 0.f;
     return float(1.0 / SolidAngle());
 }
 
@@ -99,36 +95,42 @@ StatusOr<Sun> ComputeSun(const SunInput& in) {
     sun.extraterrestrial_irradiance = ExtraterrestrialSolarSpectrum() * float(inv_r2);
 
     if (sun.AboveHorizon() && pos.zenith_deg < 90.0) {
-        double m = RelativeAirMassKastenYoung(pos.zenith_deg);
-        sun.air_mass = m;
-        double m_p = m * atm.pressure_hpa / 1013.25;
-        // Ozone sits at ~22 km: its air mass differs from the total near the horizon (Iqbal 1983
-        // eq. 5.3.3 after Robinson 1966: m_oz = (1 + h/R) / sqrt(cos²z + 2h/R), h/R = 22/6370).
-        double cz = std::cos(Rad(pos.zenith_deg));
-        double m_oz = (1.0 + 22.0 / 6370.0) / std::sqrt(cz * cz + 2.0 * 22.0 / 6370.0);
-        double beta = AngstromBetaFromTurbidity(atm.turbidity);
-        const SpectraTable& oz = EmbeddedSpectraTable("atmosphere_ozone_k.csv");
-        const SpectraTable& gas = EmbeddedSpectraTable("atmosphere_gases_k.csv");
-        static const Spectrum k_o = oz.ToSpectrum(0);
-        static const Spectrum k_g = gas.ToSpectrum(0);
-        static const Spectrum k_w = gas.ToSpectrum(1);
-        const Spectrum& e0 = sun.extraterrestrial_irradiance;
-        double w = atm.water_vapour_cm;
-        sun.direct_normal_irradiance = Spectrum::FromFunction([&](double l) {
-            int i = int(l - kLambdaMinNm);
-            double tau_r = RayleighOpticalDepth(l, atm.pressure_hpa);
-            double tau_a = beta * std::pow(l / 1000.0, -atm.angstrom_alpha);
-            double tau_o = k_o.sample(i) * atm.ozone_atm_cm;
-            // Leckner (1978) eqs. (2.36)-(2.37) for the O2 A band and water vapour (Iqbal 1983
-            // eq. 6.12.7-8).
-            double kg = k_g.sample(i), kw = k_w.sample(i);
-            double t_g = std::exp(-1.41 * kg * m_p / std::pow(1.0 + 118.93 * kg * m_p, 0.45));
-            double t_w = std::exp(-0.2385 * kw * w * m / std::pow(1.0 + 20.07 * kw * w * m, 0.45));
-            return e0.sample(i) * std::exp(-m_p * tau_r - m_oz * tau_o - m * tau_a) * t_g * t_w;
-        });
+        sun.air_mass = RelativeAirMassKastenYoung(pos.zenith_deg);
+        sun.direct_normal_irradiance = DirectNormalIrradiance(pos.zenith_deg, atm, pos.r_au);
     }
     sun.radiance = sun.direct_normal_irradiance * float(1.0 / sun.SolidAngle());
     return sun;
+}
+
+Spectrum DirectNormalIrradiance(double zenith_deg, const Atmosphere& atm, double distance_au) {
+    const double m = RelativeAirMassKastenYoung(zenith_deg);
+    // The pressure-corrected air mass, for the uniformly mixed gases (Leckner 1978). Rayleigh
+    // scattering is already scaled by p / p0 in its optical depth: it takes m.
+    const double m_p = m * atm.pressure_hpa / 1013.25;
+    // Ozone sits at ~22 km: its air mass differs from the total near the horizon (Iqbal 1983
+    // eq. 5.3.3 after Robinson 1966: m_oz = (1 + h/R) / sqrt(cos²z + 2h/R), h/R = 22/6370).
+    double cz = std::cos(Rad(zenith_deg));
+    double m_oz = (1.0 + 22.0 / 6370.0) / std::sqrt(cz * cz + 2.0 * 22.0 / 6370.0);
+    double beta = AngstromBetaFromTurbidity(atm.turbidity);
+    const SpectraTable& oz = EmbeddedSpectraTable("atmosphere_ozone_k.csv");
+    const SpectraTable& gas = EmbeddedSpectraTable("atmosphere_gases_k.csv");
+    static const Spectrum k_o = oz.ToSpectrum(0);
+    static const Spectrum k_g = gas.ToSpectrum(0);
+    static const Spectrum k_w = gas.ToSpectrum(1);
+    const Spectrum e0 = ExtraterrestrialSolarSpectrum() * float(1 / (distance_au * distance_au));
+    double w = atm.water_vapour_cm;
+    return Spectrum::FromFunction([&](double l) {
+        int i = int(l - kLambdaMinNm);
+        double tau_r = RayleighOpticalDepth(l, atm.pressure_hpa);
+        double tau_a = beta * std::pow(l / 1000.0, -atm.angstrom_alpha);
+        double tau_o = k_o.sample(i) * atm.ozone_atm_cm;
+        // Leckner (1978) eqs. (2.36)-(2.37) for the O2 A band and water vapour (Iqbal 1983
+        // eq. 6.12.7-8).
+        double kg = k_g.sample(i), kw = k_w.sample(i);
+        double t_g = std::exp(-1.41 * kg * m_p / std::pow(1.0 + 118.93 * kg * m_p, 0.45));
+        double t_w = std::exp(-0.2385 * kw * w * m / std::pow(1.0 + 20.07 * kw * w * m, 0.45));
+        return e0.sample(i) * std::exp(-m * (tau_r + tau_a) - m_oz * tau_o) * t_g * t_w;
+    });
 }
 
 }  // namespace nave

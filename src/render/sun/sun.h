@@ -4,10 +4,11 @@
 //
 // Direct normal spectral irradiance (Iqbal 1983, ch. 6; the same transmittances as Preetham,
 // Shirley & Smits 1999, Appendix):
-//   E(λ) = E0(λ) / r² · exp(-m_p τ_R(λ) - m_oz τ_oz(λ) - m τ_a(λ)) · T_g(λ) · T_w(λ)
+//   E(λ) = E0(λ) / r² · exp(-m τ_R(λ, p) - m_oz τ_oz(λ) - m τ_a(λ)) · T_g(λ, m_p) · T_w(λ)
 // E0: ASTM E-490-00a extraterrestrial spectrum at 1 AU; r: Earth-Sun distance (AU) of the date from
-// the SPA; m: relative air mass (Kasten & Young 1989), m_p = m p/1013.25; τ_R: Rayleigh optical
-// depth (Bodhaine et al. 1999 eq. 30); τ_oz = k_o(λ) · ozone column (Iqbal/Vigroux table); τ_a = β
+// the SPA; m: relative air mass (Kasten & Young 1989); τ_R: Rayleigh optical depth at the station
+// pressure p (Bodhaine et al. 1999 eq. 30 times p/1013.25, so with m, not with m_p = m p/1013.25,
+// which the mixed gases' T_g takes); τ_oz = k_o(λ) · ozone column (Iqbal/Vigroux table); τ_a = β
 // λ^-α (Ångström 1929, β from the turbidity as in Preetham et al. 1999); T_g, T_w: O2 and
 // water-vapour bands (Leckner 1978).
 
@@ -69,8 +70,6 @@ struct Sun {
     Spectrum extraterrestrial_irradiance;
 
     bool AboveHorizon() const { return position.elevation_deg > -0.8333; }
-    /// cos of the disc's angular radius.
-    float CosThetaMax() const { return float(std::cos(angular_radius_rad)); }
     /// Solid angle of the disc (sr).
     double SolidAngle() const;
     /// A direction uniformly distributed over the disc (cone around `direction`), world frame.
@@ -81,6 +80,10 @@ struct Sun {
 
 /// Computes position (SPA with refraction) and spectrum. InvalidArgument for out-of-range inputs.
 StatusOr<Sun> ComputeSun(const SunInput& in);
+/// The direct normal spectral irradiance (W m⁻² nm⁻¹) through `atm` of a sun at apparent zenith
+/// angle `zenith_deg` (in [0, 90)) and `distance_au` (the formula at the top of this file).
+/// Expects an atmosphere ComputeSun accepts.
+Spectrum DirectNormalIrradiance(double zenith_deg, const Atmosphere& atm, double distance_au);
 
 /// Direct normal illuminance (lux) of a spectral irradiance in W m⁻² nm⁻¹: 683.002 lm/W · Σ E ȳ
 /// over 1 nm (Km = 683 lm/W from the SI definition of the candela; V(λ) = CIE 1931 ȳ).
