@@ -155,10 +155,10 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
             for (int i = 0; i < n; ++i) {
                 float z = 1 - 2 * (float(i) + 0.5f) / float(n), phi = 2.39996323f * float(i);
                 float rxy = std::sqrt(std::max(0.f, 1 - z * z));
-                mean += MeanVisible(scene_.preetham->RadianceSpectrum(
-                    Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
+                mean += MeanVisible(
+                    scene_.SkySpectrum(Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
             }
-            mean = mean / n * scene_.sky_scale;
+            mean = mean / n;  // with the ground below the horizon
         } else {
             mean = MeanVisible(scene_.sky_radiance);
         }

@@ -20,6 +20,31 @@ float SurfaceMaterial::AlbedoForAov() const {
     return 1;
 }
 
+Spectrum GroundRadiance(const Spectrum& albedo, const PreethamSky& sky, float sky_scale,
+                        const Spectrum& sun_radiance, double sun_solid_angle, const Vec3f& to_sun) {
+    // Horizontal irradiance of the sky: ∫ L cos θ dω = ∫∫ L(μ, φ) μ dμ dφ over μ in (0, 1].
+    constexpr int kMu = 64, kPhi = 128;
+    std::vector<double> sky_e(Spectrum::kNumSamples, 0.0);
+    const double cell = (1.0 / kMu) * (2 * std::numbers::pi / kPhi);
+    for (int i = 0; i < kMu; ++i) {
+        const double mu = (i + 0.5) / kMu, r = std::sqrt(1 - mu * mu);
+        for (int j = 0; j < kPhi; ++j) {
+            const double phi = (j + 0.5) * 2 * std::numbers::pi / kPhi;
+            const Spectrum l = sky.RadianceSpectrum(
+                Vec3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(mu)));
+            for (int k = 0; k < Spectrum::kNumSamples; ++k)
+                sky_e[size_t(k)] += double(l.sample(k)) * mu * cell;
+        }
+    }
+    const double sun_e = sun_solid_angle * std::max(0.0, double(to_sun.z));
+    // Lambertian: L = ρ E / π.
+    return Spectrum::FromFunction([&](double lambda) {
+        const int k = int(lambda - kLambdaMinNm);
+        const double e = sky_e[size_t(k)] * sky_scale + sun_e * sun_radiance.sample(k);
+        return albedo.sample(k) * e / std::numbers::pi;
+    });
+}
+
 namespace {
 
 /// The physics material a config table describes.
@@ -220,8 +245,15 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
     } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
         scene.sky = true;
         double turbidity = std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
-        scene.preetham = std::make_shared<PreethamSky>(scene.lights[size_t(scene.sun)].to_light, float(turbidity));
+        const Light& sun = scene.lights[size_t(scene.sun)];
+        scene.preetham = std::make_shared<PreethamSky>(sun.to_light, float(turbidity));
         scene.sky_scale = config.sky.scale;
+        if (config.sky.ground_albedo) {
+            // The parser checked the albedo is within [0, 1].
+            const Spectrum albedo = ToSpectrum(*config.sky.ground_albedo);
+            scene.ground_radiance = GroundRadiance(albedo, *scene.preetham, scene.sky_scale,
+                                                   sun.spectrum, sun.SunSolidAngle(), sun.to_light);
+        }
     }
     return scene;
 }

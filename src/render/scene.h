@@ -110,10 +110,22 @@ struct RenderScene {
     Spectrum sky_radiance;                   ///< uniform sky
     std::shared_ptr<const PreethamSky> preetham;  ///< physical sky (physics: render/sun/sky.h), or null
     float sky_scale = 1;
-    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths.
+    /// With a physical sky and [sky] ground_albedo: the radiance of the ground below the horizon
+    /// (GroundRadiance); otherwise zero there.
+    Spectrum ground_radiance;
+    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths: below the
+    /// horizon of a physical sky, the ground's.
     SampledSpectrum SkyRadiance(const Vec3f& w, const SampledWavelengths& lambda) const {
-        if (preetham) return preetham->Radiance(w, lambda) * sky_scale;
+        if (preetham) {
+            return w.z > 0 ? preetham->Radiance(w, lambda) * sky_scale
+                           : ground_radiance.Sample(lambda);
+        }
         return sky_radiance.Sample(lambda);
+    }
+    /// The same as a full spectrum (for tools and the photon emitters' power).
+    Spectrum SkySpectrum(const Vec3f& w) const {
+        if (preetham) return w.z > 0 ? preetham->RadianceSpectrum(w) * sky_scale : ground_radiance;
+        return sky_radiance;
     }
     RenderSettings settings;
     OutputConfig output;
@@ -144,5 +156,13 @@ struct SunState {
     bool above_horizon = true;
 };
 StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file);
+
+/// The radiance of a Lambertian ground of `albedo` under `sky` (times `sky_scale`) and a sun of
+/// disc radiance `sun_radiance` and solid angle `sun_solid_angle` in direction `to_sun`: albedo/π
+/// times the horizontal irradiance of the sun (L Ω cos z) and of the sky (∫ L cos θ dω over the
+/// upper hemisphere, a 64 x 128 midpoint quadrature in cos θ and φ). An infinite, unshadowed plane:
+/// the model's own shadow on the ground is not seen.
+Spectrum GroundRadiance(const Spectrum& albedo, const PreethamSky& sky, float sky_scale,
+                        const Spectrum& sun_radiance, double sun_solid_angle, const Vec3f& to_sun);
 
 }  // namespace nave::render

@@ -357,6 +357,17 @@ Status ParseSky(TableReader& r, SkyConfig* s) {
             s->turbidity = t;
         }
         NAVE_RETURN_IF_ERROR(r.Float("scale", &s->scale, 0, 1e9));
+        NAVE_ASSIGN_OR_RETURN(s->ground_albedo, r.OptionalSpectrum("ground_albedo"));
+        if (s->ground_albedo) {
+            for (float l = kLambdaMinNm; l <= kLambdaMaxNm; l += 1) {
+                const float a = s->ground_albedo->Evaluate(l);
+                if (!(a >= 0 && a <= 1)) {
+                    return InvalidArgumentError(
+                        "{}: {}: {} at {} nm, expected an albedo within [0, 1]", r.WhereTable(),
+                        r.Name("ground_albedo"), a, l);
+                }
+            }
+        }
     } else if (type == "none") {
         s->kind = SkyConfig::Kind::kNone;
     } else {

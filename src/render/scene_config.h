@@ -67,6 +67,9 @@ struct SkyConfig {
     SpectrumSpec radiance;           ///< kUniform: radiance of every direction above and below
     std::optional<double> turbidity; ///< kPreetham: default the sun's turbidity
     float scale = 1.f;               ///< kPreetham: multiplies the model's radiance
+    /// kPreetham: the albedo of the ground below the horizon, a Lambertian plane lit by the sun and
+    /// the sky (none: the sky below the horizon is black).
+    std::optional<SpectrumSpec> ground_albedo;
 };
 
 struct LightConfig {

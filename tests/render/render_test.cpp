@@ -8,6 +8,7 @@
 #include "core/sampling.h"
 #include "render/procedural_meshes.h"
 #include "render/sun/sky.h"
+#include "render/sun/sun.h"
 #include "render_test_util.h"
 
 namespace nave::render {
@@ -136,26 +137,29 @@ photons_per_iteration = {}
     }
 }
 
-// The Preetham sky (physics) on a diffuse plane: L = R/pi * integral of L_sky cos over the hemisphere,
-// integrated here by a midpoint rule in (cos theta, phi) on the sky's own spectra.
-TEST_F(RenderTest, PreethamSkyOnDiffusePlane) {
-    store::BrickMesh m;
-    AppendQuad(&m, {0, 0, 0}, {500, 0, 0}, {0, 500, 0}, 4, 0);
-    const Vec3f to_sun = Normalize(Vec3f(0.5f, 0.2f, 0.6f));
-    PreethamSky sky(to_sun, 3.0f);
+/// The luminance-weighted horizontal irradiance of `sky`, ∫ Y(L) cos θ dω over the upper
+/// hemisphere, by a 48 x 96 midpoint rule in (cos θ, φ) on the sky's own spectra.
+double SkyHorizontalY(const PreethamSky& sky) {
     double integral = 0;
     const int nu = 48, nphi = 96;
     for (int i = 0; i < nu; ++i) {
-        double mu = (i + 0.5) / nu;  // cos theta
+        const double mu = (i + 0.5) / nu, st = std::sqrt(1 - mu * mu);
         for (int j = 0; j < nphi; ++j) {
-            double phi = 2 * 3.14159265358979 * (j + 0.5) / nphi;
-            double st = std::sqrt(1 - mu * mu);
+            const double phi = 2 * M_PI * (j + 0.5) / nphi;
             Vec3f w(float(st * std::cos(phi)), float(st * std::sin(phi)), float(mu));
             integral += SpectrumToXYZ(sky.RadianceSpectrum(w)).y * mu;
         }
     }
-    integral *= (1.0 / nu) * (2 * 3.14159265358979 / nphi);
-    const double expected = 0.6 / 3.14159265358979 * integral;
+    return integral * (1.0 / nu) * (2 * M_PI / nphi);
+}
+
+// The Preetham sky (physics) on a diffuse plane: L = R/pi * integral of L_sky cos over the
+// hemisphere.
+TEST_F(RenderTest, PreethamSkyOnDiffusePlane) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {500, 0, 0}, {0, 500, 0}, 4, 0);
+    const Vec3f to_sun = Normalize(Vec3f(0.5f, 0.2f, 0.6f));
+    const double expected = 0.6 / M_PI * SkyHorizontalY(PreethamSky(to_sun, 3.0f));
     std::string config = fmt::format(R"(
 [camera]
 position = [0, 0, 5]
@@ -176,6 +180,67 @@ spp = 256
     auto t = Render(m, {"plane"}, config, 1);
     ASSERT_TRUE(t);
     EXPECT_NEAR(MeanY(*t->film), expected, 0.03 * expected);
+}
+
+// The ground below a physical sky: a Lambertian plane of albedo a lit by the sun and the sky has
+// radiance a/π (E_sun cos z + ∫ L_sky cos θ dω) (Lambert's law). A ceiling facing down sees only
+// the ground, so its radiance is ρ L_ground; without ground_albedo it sees black. The sky's
+// horizontal irradiance is integrated here on a grid of the test's own (SkyHorizontalY); the sun
+// given by direction alone has the extraterrestrial spectrum E0 over its disc, so E_sun = E0 at
+// normal incidence.
+TEST_F(RenderTest, GroundBelowTheSkyLightsACeiling) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 5}, {0, 500, 0}, {500, 0, 0}, 4, 0);  // facing down
+    const Vec3f to_sun = Normalize(Vec3f(0.5f, 0.2f, 0.6f));
+    const double sky_e = SkyHorizontalY(PreethamSky(to_sun, 3.0f));
+    const double sun_e = SpectrumToXYZ(ExtraterrestrialSolarSpectrum()).y * to_sun.z;
+    const double albedo = 0.3, ceiling = 0.6;
+    const double expected = ceiling * albedo / M_PI * (sky_e + sun_e);
+    const std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 0]
+look_at = [0.01, 0, 5]
+fov_deg = 20
+resolution = [8, 8]
+[sun]
+direction = [{}, {}, {}]
+turbidity = 3
+[sky]
+type = "preetham"
+{}
+[materials.plane]
+reflectance = 0.6
+[render]
+spp = 64
+)",
+                                           to_sun.x, to_sun.y, to_sun.z, "{}");
+    auto ground = Render(m, {"plane"}, fmt::format(fmt::runtime(config), "ground_albedo = 0.3"), 1);
+    ASSERT_TRUE(ground);
+    EXPECT_NEAR(MeanY(*ground->film), expected, 0.02 * expected);
+    auto black = Render(m, {"plane"}, fmt::format(fmt::runtime(config), ""), 1);
+    ASSERT_TRUE(black);
+    EXPECT_EQ(MeanY(*black->film), 0.0);
+}
+
+TEST(SceneConfigGround, GroundAlbedoIsCheckedAndOnlyForThePhysicalSky) {
+    constexpr const char* kCamera =
+        "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 1, 5]\n[sun]\ndirection = [0, 0.5, 1]\n";
+    auto uniform = ParseSceneConfig(
+        std::string(kCamera) + "[sky]\ntype = \"uniform\"\nground_albedo = 0.2\n", "g.toml");
+    ASSERT_FALSE(uniform.ok());
+    EXPECT_NE(uniform.status().message().find("ground_albedo"), std::string::npos)
+        << uniform.status().ToString();
+    auto bright = ParseSceneConfig(
+        std::string(kCamera) + "[sky]\ntype = \"preetham\"\nground_albedo = 1.5\n", "g.toml");
+    ASSERT_FALSE(bright.ok());
+    EXPECT_NE(bright.status().message().find("g.toml:"), std::string::npos)
+        << bright.status().ToString();
+    EXPECT_NE(bright.status().message().find("within [0, 1]"), std::string::npos)
+        << bright.status().ToString();
+    EXPECT_TRUE(
+        ParseSceneConfig(std::string(kCamera) + "[sky]\ntype = \"preetham\"\nground_albedo = 0.2\n",
+                         "g.toml")
+            .ok());
 }
 
 // The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
