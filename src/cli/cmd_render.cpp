@@ -226,7 +226,7 @@ Status RunRender(const RenderOptions& o) {
                                              : std::string());
     }
 
-    render::Film film(config.camera.width, config.camera.height, config.output);
+    render::Film film(config.camera.width, config.camera.height, scene.output);
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, &options));
     // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),

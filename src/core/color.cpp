@@ -220,11 +220,33 @@ Mat3d ConeMatrix(AdaptationMethod method) {
         case AdaptationMethod::kXyzScaling:
             m = Mat3d::Identity();
             break;
+        case AdaptationMethod::kCat02:
+            // CIE 159:2004, "A colour appearance model for colour management systems: CIECAM02",
+            // eq. 7 (M_CAT02; each row sums to 1: equal-energy white gives equal responses).
+            m.m = {
+                {{0.7328, 0.4296, -0.1624}, {-0.7036, 1.6975, 0.0061}, {0.0030, 0.0136, 0.9834}}};
+            break;
+        case AdaptationMethod::kCat16:
+            // Li, Li, Wang, Zu, Luo, Cui, Melgosa, Brill & Pointer 2017, "Comprehensive color
+            // solutions: CAM16, CAT16, and CAM16-UCS", Color Res. Appl. 42(6), eq. 1 (M16).
+            m.m = {{{0.401288, 0.650173, -0.051461},
+                    {-0.250268, 1.204414, 0.045854},
+                    {-0.002079, 0.048952, 0.953127}}};
+            break;
     }
     return m;
 }
 
 }  // namespace
+
+std::optional<AdaptationMethod> ParseAdaptationMethod(std::string_view name) {
+    if (name == "bradford") return AdaptationMethod::kBradford;
+    if (name == "von_kries") return AdaptationMethod::kVonKries;
+    if (name == "xyz_scaling") return AdaptationMethod::kXyzScaling;
+    if (name == "cat02") return AdaptationMethod::kCat02;
+    if (name == "cat16") return AdaptationMethod::kCat16;
+    return std::nullopt;
+}
 
 Mat3d ChromaticAdaptationMatrix(const Chromaticity& src, const Chromaticity& dst,
                                 AdaptationMethod method) {

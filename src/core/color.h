@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -99,10 +100,14 @@ class RgbColorSpace {
 
 /// Chromatic adaptation transforms (von Kries-type: scale cone-like responses, Lam 1985 / CIE 160).
 enum class AdaptationMethod {
-    kBradford,   ///< Lam (1985), the ICC's and Lindbloom's Bradford matrix.
-    kVonKries,   ///< Hunt-Pointer-Estévez cone fundamentals (normalised to D65).
-    kXyzScaling  ///< plain XYZ scaling (for comparison only).
+    kBradford,    ///< Lam (1985), the ICC's and Lindbloom's Bradford matrix.
+    kVonKries,    ///< Hunt-Pointer-Estévez cone fundamentals (normalised to D65).
+    kXyzScaling,  ///< plain XYZ scaling (for comparison only).
+    kCat02,       ///< CIECAM02's CAT02 (CIE 159:2004), with full adaptation.
+    kCat16,       ///< CAM16's CAT16 (Li et al. 2017), with full adaptation.
 };
+/// The method named "bradford", "von_kries", "xyz_scaling", "cat02" or "cat16"; nothing otherwise.
+std::optional<AdaptationMethod> ParseAdaptationMethod(std::string_view name);
 
 /// The 3x3 matrix that maps XYZ seen under white `src` to corresponding XYZ under white `dst`.
 Mat3d ChromaticAdaptationMatrix(const Chromaticity& src, const Chromaticity& dst,

@@ -4,21 +4,29 @@
 #include <cmath>
 
 #include "core/atomic_add.h"
+#include "core/check.h"
 #include "imaging/image_io.h"
 
 namespace nave::render {
 namespace {
 
-/// The white the image is balanced for: none keeps XYZ -> sRGB as is (equal-energy light looks slightly
-/// pink, as in pbrt-v4 without white balance); otherwise the named illuminant's chromaticity is mapped to
-/// the sRGB white (Bradford adaptation).
-Mat3d OutputMatrix(const std::string& white_balance) {
+/// The white the image is balanced for: none keeps XYZ -> sRGB as is (equal-energy light looks
+/// slightly pink, as in pbrt-v4 without white balance); otherwise the named illuminant's
+/// chromaticity, or the scene's own light, is mapped to the sRGB white by the output's adaptation
+/// transform.
+Mat3d OutputMatrix(const OutputConfig& output) {
     const RgbColorSpace& srgb = RgbColorSpace::Srgb();
+    const std::string& white_balance = output.white_balance;
     if (white_balance == "none") return srgb.xyz_to_rgb();
+    if (white_balance == "scene") {
+        NAVE_CHECK(output.scene_white.has_value())
+            << "white_balance = scene without the scene's white";
+        return WhiteBalancedXyzToRgb(srgb, *output.scene_white, output.adaptation);
+    }
     double cct = white_balance == "D65" ? 6504.0 : white_balance == "D50" ? 5003.0
                                                                           : std::stod(white_balance);
     Chromaticity white = XYZToChromaticity(SpectrumToXYZ(Spectrum::CieIlluminantD(std::clamp(cct, 4000.0, 25000.0))));
-    return WhiteBalancedXyzToRgb(srgb, white);
+    return WhiteBalancedXyzToRgb(srgb, white, output.adaptation);
 }
 
 }  // namespace
@@ -57,7 +65,7 @@ Vec3d Film::SumXYZ(uint32_t pixel) const {
 }
 
 std::vector<float> Film::LinearRgb() const {
-    Mat3d m = OutputMatrix(output_.white_balance);
+    Mat3d m = OutputMatrix(output_);
     std::vector<float> rgb(pixel_count() * 3);
     for (size_t p = 0; p < pixel_count(); ++p) {
         Vec3d c = m * PixelXYZ(uint32_t(p));

@@ -293,6 +293,14 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
     // lost.
     const bool last = r.depth >= uint32_t(scene_.settings.max_depth);
     if (last && mat.thin_glass() == nullptr) return false;
+    if (visible_points_ != nullptr && mat.dispersive() && !r.lambda.SecondaryTerminated() &&
+        r.beta.MaxValue() == r.beta.MinValue()) {
+        // Photon mode: the path is about to keep one wavelength. Nothing it did so far depended on
+        // its own (the throughput is the same at all four), so it may take its iteration's shared
+        // wavelengths instead, which some photons carry too (sppm.h).
+        r.lambda = IterationWavelengths(uint64_t(scene_.settings.seed), iteration_,
+                                        VisiblePoints::PixelChannel(r.pixel));
+    }
     Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;

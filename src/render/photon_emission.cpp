@@ -8,6 +8,7 @@
 
 #include "core/sampling.h"
 #include "render/materials/frame.h"
+#include "render/sppm.h"
 #include "render/stream_scheduler.h"
 #include "render/transport_common.h"
 
@@ -249,8 +250,14 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
             r.pixel = uint32_t(i);
             r.t_max = kInfinity;
             VertexRng rng(RayKey(scene_.settings.seed, r, iteration, kStreamEmit));
-            // Each photon its own wavelengths (sppm.h).
-            const SampledWavelengths lambda = SampledWavelengths::SampleVisible(rng.Uniform(7));
+            // Each photon its own wavelengths, but one in kSharedWavelengthEvery the iteration's
+            // (sppm.h).
+            const int channel =
+                VisiblePoints::PhotonChannel(i, uint64_t(scene_.settings.photons_per_iteration));
+            const SampledWavelengths lambda =
+                channel != VisiblePoints::kOwnWavelengths
+                    ? IterationWavelengths(uint64_t(scene_.settings.seed), iteration, channel)
+                    : SampledWavelengths::SampleVisible(rng.Uniform(7));
             r.lambda = lambda;
             float u = rng.Uniform(0);
             size_t k =
@@ -354,6 +361,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
             }
             r.beta /= p_choice;
             if (r.beta.IsZero()) continue;
+
             // Queued at the first brick along it; a photon that misses the model carries nothing.
             ++out.counts.rays;
             const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);

@@ -20,29 +20,34 @@ float SurfaceMaterial::AlbedoForAov() const {
     return 1;
 }
 
-Spectrum GroundRadiance(const Spectrum& albedo, const PreethamSky& sky, float sky_scale,
-                        const Spectrum& sun_radiance, double sun_solid_angle, const Vec3f& to_sun) {
-    // Horizontal irradiance of the sky: ∫ L cos θ dω = ∫∫ L(μ, φ) μ dμ dφ over μ in (0, 1].
-    constexpr int kMu = 64, kPhi = 128;
-    std::vector<double> sky_e(Spectrum::kNumSamples, 0.0);
-    const double cell = (1.0 / kMu) * (2 * std::numbers::pi / kPhi);
-    for (int i = 0; i < kMu; ++i) {
-        const double mu = (i + 0.5) / kMu, r = std::sqrt(1 - mu * mu);
-        for (int j = 0; j < kPhi; ++j) {
-            const double phi = (j + 0.5) * 2 * std::numbers::pi / kPhi;
-            const Spectrum l = sky.RadianceSpectrum(
-                Vec3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(mu)));
-            for (int k = 0; k < Spectrum::kNumSamples; ++k)
-                sky_e[size_t(k)] += double(l.sample(k)) * mu * cell;
+Spectrum HorizontalIrradiance(const RenderScene& scene) {
+    std::vector<double> e(Spectrum::kNumSamples, 0.0);
+    if (scene.preetham) {
+        // ∫ L cos θ dω = ∫∫ L(μ, φ) μ dμ dφ over μ in (0, 1].
+        constexpr int kMu = 64, kPhi = 128;
+        const double cell = (1.0 / kMu) * (2 * std::numbers::pi / kPhi) * scene.sky_scale;
+        for (int i = 0; i < kMu; ++i) {
+            const double mu = (i + 0.5) / kMu, r = std::sqrt(1 - mu * mu);
+            for (int j = 0; j < kPhi; ++j) {
+                const double phi = (j + 0.5) * 2 * std::numbers::pi / kPhi;
+                const Spectrum l = scene.preetham->RadianceSpectrum(
+                    Vec3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(mu)));
+                for (int k = 0; k < Spectrum::kNumSamples; ++k)
+                    e[size_t(k)] += double(l.sample(k)) * mu * cell;
+            }
         }
+    } else if (scene.sky) {
+        for (int k = 0; k < Spectrum::kNumSamples; ++k)
+            e[size_t(k)] = std::numbers::pi * scene.sky_radiance.sample(k);
     }
-    const double sun_e = sun_solid_angle * std::max(0.0, double(to_sun.z));
-    // Lambertian: L = ρ E / π.
-    return Spectrum::FromFunction([&](double lambda) {
-        const int k = int(lambda - kLambdaMinNm);
-        const double e = sky_e[size_t(k)] * sky_scale + sun_e * sun_radiance.sample(k);
-        return albedo.sample(k) * e / std::numbers::pi;
-    });
+    if (scene.sun >= 0) {
+        const Light& sun = scene.lights[size_t(scene.sun)];
+        const double sun_e = sun.SunSolidAngle() * std::max(0.0, double(sun.to_light.z));
+        for (int k = 0; k < Spectrum::kNumSamples; ++k)
+            e[size_t(k)] += sun_e * sun.spectrum.sample(k);
+    }
+    return Spectrum::FromFunction(
+        [&](double lambda) { return e[size_t(int(lambda - kLambdaMinNm))]; });
 }
 
 namespace {
@@ -249,11 +254,19 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         scene.preetham = std::make_shared<PreethamSky>(sun.to_light, float(turbidity));
         scene.sky_scale = config.sky.scale;
         if (config.sky.ground_albedo) {
-            // The parser checked the albedo is within [0, 1].
-            const Spectrum albedo = ToSpectrum(*config.sky.ground_albedo);
-            scene.ground_radiance = GroundRadiance(albedo, *scene.preetham, scene.sky_scale,
-                                                   sun.spectrum, sun.SunSolidAngle(), sun.to_light);
+            // Lambertian: L = ρ E / π (the parser checked ρ is within [0, 1]).
+            scene.ground_radiance = ToSpectrum(*config.sky.ground_albedo) *
+                                    HorizontalIrradiance(scene) * float(1 / std::numbers::pi);
         }
+    }
+    if (scene.output.white_balance == "scene") {
+        const Vec3d white = SpectrumToXYZ(HorizontalIrradiance(scene));
+        if (!(white.y > 0)) {
+            return InvalidArgumentError(
+                "{}: [output] white_balance = \"scene\" needs a sun above the horizon or a sky",
+                file);
+        }
+        scene.output.scene_white = XYZToChromaticity(white);
     }
     return scene;
 }

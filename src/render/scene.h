@@ -73,6 +73,12 @@ struct SurfaceMaterial {
     const ThinGlassMaterial* thin_glass() const {
         return black ? nullptr : std::get_if<ThinGlassMaterial>(&material);
     }
+    /// Whether this is solid glass whose index varies with wavelength (a path through it keeps only
+    /// its hero wavelength).
+    bool dispersive() const {
+        const DielectricMaterial* d = black ? nullptr : std::get_if<DielectricMaterial>(&material);
+        return d != nullptr && d->IsDispersive();
+    }
     /// Diffuse albedo at 550 nm for the albedo AOV (1 for specular materials, 0 for black).
     float AlbedoForAov() const;
 };
@@ -111,7 +117,7 @@ struct RenderScene {
     std::shared_ptr<const PreethamSky> preetham;  ///< physical sky (physics: render/sun/sky.h), or null
     float sky_scale = 1;
     /// With a physical sky and [sky] ground_albedo: the radiance of the ground below the horizon
-    /// (GroundRadiance); otherwise zero there.
+    /// (albedo / π times HorizontalIrradiance); otherwise zero there.
     Spectrum ground_radiance;
     /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths: below the
     /// horizon of a physical sky, the ground's.
@@ -157,12 +163,11 @@ struct SunState {
 };
 StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file);
 
-/// The radiance of a Lambertian ground of `albedo` under `sky` (times `sky_scale`) and a sun of
-/// disc radiance `sun_radiance` and solid angle `sun_solid_angle` in direction `to_sun`: albedo/π
-/// times the horizontal irradiance of the sun (L Ω cos z) and of the sky (∫ L cos θ dω over the
-/// upper hemisphere, a 64 x 128 midpoint quadrature in cos θ and φ). An infinite, unshadowed plane:
-/// the model's own shadow on the ground is not seen.
-Spectrum GroundRadiance(const Spectrum& albedo, const PreethamSky& sky, float sky_scale,
-                        const Spectrum& sun_radiance, double sun_solid_angle, const Vec3f& to_sun);
+/// The spectral irradiance (W m⁻² nm⁻¹) of `scene`'s sun and sky above the horizon on an unshadowed
+/// horizontal surface facing up: the sun's L Ω cos z and the sky's ∫ L cos θ dω over the upper
+/// hemisphere (π L for a uniform sky; a 64 x 128 midpoint quadrature in cos θ and φ for a physical
+/// one). The light a white card on open ground reflects: the ground's under [sky] ground_albedo,
+/// and the white of output.white_balance = "scene".
+Spectrum HorizontalIrradiance(const RenderScene& scene);
 
 }  // namespace nave::render

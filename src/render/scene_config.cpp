@@ -524,10 +524,23 @@ Status ParseOutput(TableReader& r, OutputConfig* o) {
         const std::string& w = o->white_balance;
         bool kelvin = w.size() > 1 && w.back() == 'K' &&
                       std::all_of(w.begin(), w.end() - 1, [](char c) { return c >= '0' && c <= '9'; });
-        if (w != "none" && w != "D65" && w != "D50" && !kelvin) {
-            return r.RangeError("white_balance", *n,
-                                fmt::format("'{}' (expected none, D65, D50 or a temperature like \"5000K\")", w));
+        if (w != "none" && w != "D65" && w != "D50" && w != "scene" && !kelvin) {
+            return r.RangeError(
+                "white_balance", *n,
+                fmt::format("'{}' (expected none, D65, D50, scene or a temperature like \"5000K\")",
+                            w));
         }
+    }
+    if (const toml::node* n = r.Has("adaptation") ? r.Take("adaptation") : nullptr) {
+        if (!n->is_string()) return r.TypeError("adaptation", *n, "a string");
+        std::optional<AdaptationMethod> m = ParseAdaptationMethod(*n->value<std::string>());
+        if (!m) {
+            return r.RangeError(
+                "adaptation", *n,
+                fmt::format("'{}' (expected bradford, von_kries, xyz_scaling, cat02 or cat16)",
+                            *n->value<std::string>()));
+        }
+        o->adaptation = *m;
     }
     NAVE_RETURN_IF_ERROR(r.Float("exposure_ev", &o->exposure_ev, -30, 30));
     if (const toml::node* n = r.Take("aovs")) {

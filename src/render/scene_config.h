@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/color.h"
 #include "core/status.h"
 #include "core/vecmath.h"
 
@@ -143,7 +144,14 @@ struct RenderSettings {
 };
 
 struct OutputConfig {
-    std::string white_balance = "none";  ///< "none" (E), "D65", "D50" or a colour temperature "5000K"
+    /// "none" (E), "D65", "D50", a colour temperature "5000K", or "scene": the light of the scene's
+    /// sun and sky on a horizontal white surface (scene_white).
+    std::string white_balance = "none";
+    /// The chromatic adaptation transform of the white balance.
+    AdaptationMethod adaptation = AdaptationMethod::kBradford;
+    /// With white_balance "scene": the chromaticity of the scene's light (BuildRenderScene fills it
+    /// in RenderScene::output).
+    std::optional<Chromaticity> scene_white;
     float exposure_ev = 0.f;              ///< PNG only; EXR stays linear
     bool aov_albedo = false, aov_normal = false, aov_depth = false;
 };

@@ -9,6 +9,7 @@
 #include "core/color.h"
 #include "render/rng.h"
 #include "render/scene.h"
+#include "render/transport_common.h"
 
 namespace nave::render {
 
@@ -45,7 +46,22 @@ VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float ini
     }
 }
 
-void VisiblePoints::BeginIteration() {
+SampledWavelengths IterationWavelengths(uint64_t seed, uint32_t iteration, int channel) {
+    const VertexRng rng(RngKey{seed, uint32_t(channel), 0, 0, iteration, kStreamWavelengths});
+    return SampledWavelengths::SampleVisible(rng.Uniform(0));
+}
+
+void VisiblePoints::BeginIteration(uint64_t seed, uint32_t iteration, uint64_t photons) {
+    const uint64_t n_shared = PhotonChannel(0, photons) != kOwnWavelengths
+                                  ? (photons + kSharedWavelengthEvery - 1) / kSharedWavelengthEvery
+                                  : 0;
+    for (uint32_t c = 0; c < kWavelengthChannels; ++c) {
+        shared_lambda_[c] = IterationWavelengths(seed, iteration, int(c));
+        // Shared photons k, 2k, 3k... go to channels 0, 1, 2... in turn.
+        const uint64_t n_c = n_shared / kWavelengthChannels + (c < n_shared % kWavelengthChannels);
+        shared_weight_[c] = n_c > 0 ? float(double(photons) / double(n_c)) : 0.f;
+    }
+    own_weight_ = float(double(photons) / double(photons - n_shared));
     for (Point& p : points_) p.valid = false;
     for (BrickGrid& g : grids_) g.cells.clear();
 }
@@ -66,7 +82,10 @@ void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const V
     bool flat = true;
     for (int i = 1; i < kNumWavelengths; ++i) flat = flat && beta[i] == beta[0];
     if (lambda.SecondaryTerminated()) {
-        vp.throughput = Throughput::kHeroOnly;
+        const bool shared =
+            lambda.lambda_nm(0) == shared_lambda_[size_t(PixelChannel(pixel))].lambda_nm(0);
+        vp.throughput = shared ? Throughput::kHeroShared : Throughput::kHeroOnly;
+        vp.beta_nm.fill(beta[0]);
     } else if (flat) {
         vp.throughput = Throughput::kFlat;
         vp.beta_nm.fill(beta[0]);
@@ -139,7 +158,8 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
 }
 
 float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
-                             const SampledSpectrum& beta, const SampledWavelengths& lambda) {
+                             const SampledSpectrum& beta, const SampledWavelengths& lambda,
+                             int channel) {
     const BrickGrid& g = grids_[brick];
     auto it = g.cells.find(CellKey(p, g.cell));
     if (it == g.cells.end()) return 0;
@@ -150,11 +170,30 @@ float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, co
         Vec3f d = vp.p - p;
         if (Dot(d, d) > radius_ * radius_) continue;
         if (vp.throughput == Throughput::kHeroOnly) continue;
+        if ((vp.throughput == Throughput::kHeroShared) != (channel != kOwnWavelengths)) continue;
+        if (channel != kOwnWavelengths && PixelChannel(i) != channel) continue;
         if (std::abs(Dot(ng, vp.ns)) < kSameSurfaceCos) continue;
-        SampledWavelengths l = lambda;
-        SampledSpectrum f = vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint).Eval(vp.wo, wi, l);
-        if (f.IsZero()) continue;
-        const Vec3d xyz = SampledToXYZ(vp.ThroughputAt(l) * f * beta, l);
+        Vec3d xyz;
+        if (vp.throughput == Throughput::kHeroShared) {
+            // The camera path's one wavelength is the shared hero, which this photon carries at its
+            // index 0 (terminated or not).
+            SampledWavelengths l = shared_lambda_[size_t(channel)];
+            l.TerminateSecondary();
+            SampledSpectrum f =
+                vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint)
+                    .Eval(vp.wo, wi, l);
+            SampledSpectrum c;
+            c[0] = vp.beta_nm[0] * f[0] * beta[0] * shared_weight_[size_t(channel)];
+            if (c.IsZero()) continue;
+            xyz = SampledToXYZ(c, l);
+        } else {
+            SampledWavelengths l = lambda;
+            SampledSpectrum f =
+                vp.material->MakeBsdf(vp.ns, &l, vp.has_uv ? &vp.uv : nullptr, vp.footprint)
+                    .Eval(vp.wo, wi, l);
+            if (f.IsZero()) continue;
+            xyz = SampledToXYZ(vp.ThroughputAt(l) * f * beta * own_weight_, l);
+        }
         for (int c = 0; c < 3; ++c) AtomicAdd(px.phi[c], float(xyz[c]));
         added += float(xyz.y);
         deposits_.fetch_add(1, std::memory_order_relaxed);

@@ -21,8 +21,18 @@
 // wavelengths is exact when it does not depend on the wavelength (every point the camera sees
 // directly, the usual case: throughput 1); a point seen through coloured glass or a coloured mirror
 // has it interpolated linearly between the camera path's four wavelengths, an approximation of a
-// smooth spectrum; a point seen through dispersive glass (the camera path kept only its hero
-// wavelength) receives no photons, only its next-event estimated light.
+// smooth spectrum. A point seen through dispersive glass keeps only one wavelength, the camera
+// path's hero, which almost no photon carries: so every iteration has kWavelengthChannels sets of
+// wavelengths of its own (IterationWavelengths), a camera path meeting dispersive glass with a
+// throughput still the same at every wavelength takes its pixel's channel's (nothing it did so far
+// depended on its own, so the swap keeps it unbiased), and one photon in kSharedWavelengthEvery
+// carries one channel's too. Those photons light only the points of their channel, at its hero
+// wavelength, the others only the other points, each set weighted by the share of the photons it
+// is. (pbrt-v4's SPPM, whose photons all share one set of wavelengths per iteration, lights such
+// points with all; sharing them all would bring back the colour blotches, and one set per iteration
+// would tint every point seen through the glass alike.) A point seen
+// through coloured glass and then dispersive glass (its throughput no longer flat when it met the
+// dispersion) still receives no photons, only its next-event estimated light.
 
 //
 // Visible points are kept per brick: a point is registered in every brick whose cell its gather
@@ -57,8 +67,18 @@ class VisiblePoints {
         return pixel_count * (sizeof(Point) + sizeof(PixelState) + 2 * 8 * sizeof(uint32_t) + 32);
     }
 
-    /// Starts an iteration: forgets the previous visible points.
-    void BeginIteration();
+    /// Starts iteration `iteration` of `photons` photons (its shared wavelengths are
+    /// IterationWavelengths(seed, iteration, channel)): forgets the previous visible points.
+    void BeginIteration(uint64_t seed, uint32_t iteration, uint64_t photons);
+    /// The shared-wavelength channel of photon `index` of an iteration of `photons` (one photon in
+    /// kSharedWavelengthEvery, with at least two per channel), or kOwnWavelengths.
+    static int PhotonChannel(uint64_t index, uint64_t photons) {
+        if (photons < 2 * kSharedWavelengthEvery * kWavelengthChannels) return kOwnWavelengths;
+        if (index % kSharedWavelengthEvery != 0) return kOwnWavelengths;
+        return int(index / kSharedWavelengthEvery % kWavelengthChannels);
+    }
+    /// The shared-wavelength channel of the camera path of `pixel`.
+    static int PixelChannel(uint32_t pixel) { return int(pixel % kWavelengthChannels); }
     /// Records pixel's visible point, with its texture coordinates `uv` (null when the mesh has
     /// none) and the camera path's throughput `beta` at its wavelengths `lambda`. Thread-safe for
     /// distinct pixels (one camera path per pixel).
@@ -73,8 +93,10 @@ class VisiblePoints {
     /// the XYZ of beta * f * (camera throughput) to every visible point of that brick within the
     /// radius whose surface faces the same way (|ng . ns| >= kSameSurfaceCos); returns the
     /// luminance it added. Thread-safe.
+    /// `channel`: PhotonChannel of the photon; one on shared wavelengths lights only the points
+    /// seen through dispersive glass of its channel.
     float Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
-                  const SampledSpectrum& beta, const SampledWavelengths& lambda);
+                  const SampledSpectrum& beta, const SampledWavelengths& lambda, int channel);
     /// A photon counts at a visible point only if their surfaces are within ~70 degrees of each
     /// other: the density estimate divides by the area of a flat disc, so photons on a wall must
     /// not add to the floor in the corner below it (Jensen 2001, "Realistic image synthesis using
@@ -96,12 +118,20 @@ class VisiblePoints {
     float radius() const { return radius_; }
     uint64_t deposits() const { return deposits_.load(std::memory_order_relaxed); }
 
+    /// One photon in this many carries shared wavelengths, of one of kWavelengthChannels sets per
+    /// iteration.
+    static constexpr uint32_t kSharedWavelengthEvery = 8;
+    static constexpr uint32_t kWavelengthChannels = 16;
+    static constexpr int kOwnWavelengths = -1;
+
   private:
     /// How a visible point's camera throughput is known at a photon's wavelengths.
     enum class Throughput : uint8_t {
         kFlat,          // the same at every wavelength: beta_nm[0]
         kInterpolated,  // linear between (lambda_nm[i], beta_nm[i]), sorted by wavelength
-        kHeroOnly,      // the camera path kept one wavelength (dispersion): no photon matches it
+        kHeroShared,    // the camera path kept the iteration's shared hero wavelength (dispersion):
+                        // beta_nm[0] there, lit by the photons on the shared wavelengths
+        kHeroOnly,      // the camera path kept a hero wavelength of its own: no photon matches it
     };
     struct Point {
         Vec3f p, ns, wo;
@@ -127,6 +157,11 @@ class VisiblePoints {
     uint64_t CellKey(const Vec3f& p, float cell) const;
 
     std::vector<Point> points_;
+    std::array<SampledWavelengths, kWavelengthChannels> shared_lambda_;  // the iteration's
+    // How many photons each photon on a channel's shared wavelengths, and each other one, stands
+    // for.
+    std::array<float, kWavelengthChannels> shared_weight_{};
+    float own_weight_ = 1;
     std::unique_ptr<PixelState[]> pixels_;
     size_t pixel_count_;
     float radius_;
@@ -138,5 +173,10 @@ class VisiblePoints {
 
 /// Bricks whose cells overlap `box` (kd-tree descent).
 void BricksOverlapping(const store::BrickTree& tree, const Bounds3f& box, std::vector<uint32_t>* out);
+
+/// The wavelengths of shared-wavelength channel `channel` of an iteration of photon mode (sppm.h):
+/// the same for all its camera paths and photons that take them, a sample of the visible
+/// distribution drawn from (seed, iteration, channel).
+SampledWavelengths IterationWavelengths(uint64_t seed, uint32_t iteration, int channel);
 
 }  // namespace nave::render

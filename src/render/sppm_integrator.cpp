@@ -43,7 +43,7 @@ Status SppmIntegrator::Run(RenderStats* stats) {
     for (int it = 0; it < iterations; ++it) {
         iteration_ = uint32_t(it);
         camera_paths.set_iteration(iteration_);
-        visible_->BeginIteration();
+        visible_->BeginIteration(uint64_t(scene_.settings.seed), iteration_, photons);
         // Visible points must all be in place before photons arrive: waves overlap within each pass
         // only. So the queues hold camera paths and their shadow rays, then photons, never both,
         // and each pass is drained by its own processor.
@@ -126,7 +126,9 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     if ((r.depth > 0 || (r.flags & kFromAreaLight) ||
          ((r.flags & kFromSky) && sky_direct_photons_)) &&
         (flags & kBxdfDiffuse)) {
-        const float added = visible_->Deposit(b, h.p, h.ng, wo, r.beta, r.lambda);
+        const float added = visible_->Deposit(
+            b, h.p, h.ng, wo, r.beta, r.lambda,
+            VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)));
         // One writer per photon: a photon is traced by one thread at a time.
         if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
     }

@@ -47,6 +47,7 @@ enum RngStream : uint32_t {
     kStreamPhoton = 1,
     kStreamCamera = 2,
     kStreamEmit = 3,
+    kStreamWavelengths = 4,  // photon mode: the iteration's shared wavelengths
 };
 
 /// The key of ray r's random numbers in `stream`: its path (or photon), its vertex and the SPPM

@@ -132,15 +132,30 @@ TEST(ColorTest, BradfordD65ToD50) {
                                    {-0.0092345, 0.0150436, 0.7521316}};
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) EXPECT_NEAR(m(i, j), expected[i][j], 2e-3) << i << "," << j;
-    // The source white maps exactly onto the destination white, for every method.
-    for (AdaptationMethod method : {AdaptationMethod::kBradford, AdaptationMethod::kVonKries,
-                                    AdaptationMethod::kXyzScaling}) {
-        Mat3d a = ChromaticAdaptationMatrix({0.4476, 0.4074}, {0.3127, 0.3290}, method);
-        Vec3d w = a * ChromaticityToXYZ({0.4476, 0.4074});
-        Vec3d d = ChromaticityToXYZ({0.3127, 0.3290});
-        EXPECT_NEAR(w.x, d.x, 1e-12);
-        EXPECT_NEAR(w.z, d.z, 1e-12);
+}
+
+// CAT02 (CIE 159:2004) and CAT16 (Li et al. 2017) are normalised to equal-energy white (each row of
+// their matrices sums to 1, as published): adapting from E to E is the identity, and between two
+// whites they differ from Bradford by a few thousandths on a saturated colour, never by more than
+// the methods' own spread (a typo in a coefficient moves them far more). The names parse.
+TEST(ColorTest, Cat02AndCat16) {
+    for (AdaptationMethod method : {AdaptationMethod::kCat02, AdaptationMethod::kCat16}) {
+        Mat3d same = ChromaticAdaptationMatrix({1.0 / 3, 1.0 / 3}, {1.0 / 3, 1.0 / 3}, method);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) EXPECT_NEAR(same(i, j), i == j ? 1.0 : 0.0, 1e-9);
+        // Illuminant A to D65, a saturated red: within 0.02 in xy of Bradford.
+        const Vec3d red = ChromaticityToXYZ({0.55, 0.32});
+        const Chromaticity a = XYZToChromaticity(
+            ChromaticAdaptationMatrix({0.4476, 0.4074}, {0.3127, 0.3290}, method) * red);
+        const Chromaticity b =
+            XYZToChromaticity(ChromaticAdaptationMatrix({0.4476, 0.4074}, {0.3127, 0.3290}) * red);
+        EXPECT_NEAR(a.x, b.x, 0.02);
+        EXPECT_NEAR(a.y, b.y, 0.02);
+        EXPECT_GT(std::abs(a.x - b.x) + std::abs(a.y - b.y), 1e-4) << "a different transform";
     }
+    EXPECT_EQ(ParseAdaptationMethod("cat16"), AdaptationMethod::kCat16);
+    EXPECT_EQ(ParseAdaptationMethod("von_kries"), AdaptationMethod::kVonKries);
+    EXPECT_FALSE(ParseAdaptationMethod("CAT16").has_value());
 }
 
 // White balance: a perfect white under illuminant A comes out neutral after balancing to A.

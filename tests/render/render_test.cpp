@@ -222,6 +222,111 @@ spp = 64
     EXPECT_EQ(MeanY(*black->film), 0.0);
 }
 
+// White balance to the scene's own light: a white floor under the sun and sky of a place and time
+// reflects their horizontal irradiance, so with white_balance = "scene" it comes out neutral, with
+// any adaptation transform, at noon as in the evening. Neutral within 1.5 % (the render's noise).
+TEST_F(RenderTest, WhiteBalanceToTheScenesLightMakesAWhiteFloorNeutral) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
+    for (const char* time : {"12:00", "19:40"}) {
+        for (const char* adaptation : {"bradford", "cat16"}) {
+            for (const char* balance : {"scene", "D65"}) {
+                const std::string config = fmt::format(R"(
+[camera]
+position = [0, 0, 5]
+look_at = [0.01, 0, 0]
+fov_deg = 20
+resolution = [8, 8]
+[sun]
+datetime = "2025-06-21T{}:00+02:00"
+latitude_deg = 49.14
+longitude_deg = 2.38
+[sky]
+type = "preetham"
+[materials.plane]
+reflectance = 0.8
+[output]
+white_balance = "{}"
+adaptation = "{}"
+[render]
+spp = 64
+)",
+                                                       time, balance, adaptation);
+                auto t = Render(m, {"plane"}, config, 1);
+                ASSERT_TRUE(t);
+                const std::vector<float> rgb = t->film->LinearRgb();
+                double sum[3] = {0, 0, 0};
+                for (size_t p = 0; p < rgb.size(); ++p) sum[p % 3] += rgb[p];
+                const double r = sum[0] / sum[1], b = sum[2] / sum[1];
+                if (std::string(balance) == "scene") {
+                    EXPECT_NEAR(r, 1.0, 0.015) << time << " " << adaptation;
+                    EXPECT_NEAR(b, 1.0, 0.015) << time << " " << adaptation;
+                } else {
+                    // Balanced for D65 the floor is 6-7 % magenta (R/G and B/G 1.065-1.071
+                    // measured): the sun and sky of the model are not D65, so the neutral result
+                    // above is the scene balance's doing.
+                    EXPECT_GT(std::max(std::abs(r - 1), std::abs(b - 1)), 0.03)
+                        << time << " " << adaptation;
+                }
+            }
+        }
+    }
+}
+
+// The ground's light enters a closed room through a low window in a wall (the sun, high in the
+// west, does not shine through it): path tracing (sky sampled through the window) and photon
+// mapping (sky photons through the window, the sky's direct light from them) agree on the room's
+// light (4 s).
+TEST_F(RenderTest, GroundLightThroughAWallWindowAgreesInBothModes) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 4, 0);         // floor
+    AppendQuad(&m, {0, 0, 3}, {2, 0, 0}, {0, 2, 0}, 4, 1);         // roof
+    AppendQuad(&m, {-2, 0, 1.5f}, {0, 2, 0}, {0, 0, 1.5f}, 4, 1);  // walls
+    AppendQuad(&m, {0, 2, 1.5f}, {2, 0, 0}, {0, 0, 1.5f}, 4, 1);
+    AppendQuad(&m, {0, -2, 1.5f}, {2, 0, 0}, {0, 0, 1.5f}, 4, 1);
+    AppendQuad(&m, {2, 0, 0.25f}, {0, 2, 0}, {0, 0, 0.25f}, 2, 1);  // east wall around the window
+    AppendQuad(&m, {2, 0, 2.25f}, {0, 2, 0}, {0, 0, 0.75f}, 2, 1);
+    AppendQuad(&m, {2, -1.25f, 1}, {0, 0.75f, 0}, {0, 0, 0.5f}, 2, 1);
+    AppendQuad(&m, {2, 1.25f, 1}, {0, 0.75f, 0}, {0, 0, 0.5f}, 2, 1);
+    AppendQuad(&m, {2, 0, 1}, {0, 0.5f, 0}, {0, 0, 0.5f}, 2, 2);  // the window
+    const std::string config = R"(
+[camera]
+position = [-1.5, 0, 1.5]
+look_at = [0.8, 0, 0.6]
+fov_deg = 60
+resolution = [16, 12]
+[sun]
+direction = [-0.3, 0.2, 1]
+[sky]
+type = "preetham"
+ground_albedo = 0.5
+[materials.floor]
+reflectance = 0.6
+[materials.wall]
+reflectance = 0.6
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+portal = true
+[render]
+max_depth = 6
+sky_sampling = "portals"
+photon_target = "portals"
+sky_direct = "photons"
+)";
+    auto path = Render(m, {"floor", "wall", "window"}, config + "mode = \"path\"\nspp = 1024\n", 1);
+    auto photon = Render(m, {"floor", "wall", "window"},
+                         config +
+                             "mode = \"photon\"\niterations = 32\nphotons_per_iteration = "
+                             "200000\ninitial_radius_m = 0.1\n",
+                         1);
+    ASSERT_TRUE(path && photon);
+    // Measured: photon mode 2.7 % under path tracing, 1.6 % under with a black ground (its gather
+    // radius in the room's corners), while the ground brings 94 % of the light: a ground missed or
+    // counted twice by either mode is far outside 5 %.
+    EXPECT_NEAR(MeanY(*photon->film) / MeanY(*path->film), 1.0, 0.05);
+}
+
 TEST(SceneConfigGround, GroundAlbedoIsCheckedAndOnlyForThePhysicalSky) {
     constexpr const char* kCamera =
         "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 1, 5]\n[sun]\ndirection = [0, 0.5, 1]\n";

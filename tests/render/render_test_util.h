@@ -51,7 +51,8 @@ inline std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh, const st
     EXPECT_TRUE(scene.ok()) << scene.status().ToString();
     if (!scene.ok()) return nullptr;
     t->scene = std::move(*scene);
-    t->film = std::make_unique<Film>(t->config.camera.width, t->config.camera.height, t->config.output);
+    t->film =
+        std::make_unique<Film>(t->config.camera.width, t->config.camera.height, t->scene.output);
     Status s = RenderStreams(t->scene, t->film.get(), &t->stats);
     if (render_status != nullptr) {
         *render_status = s;
