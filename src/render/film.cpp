@@ -31,6 +31,53 @@ Mat3d OutputMatrix(const OutputConfig& output) {
 
 }  // namespace
 
+std::vector<uint8_t> DisplayImage(const std::vector<float>& rgb, const OutputConfig& output) {
+    const size_t pixels = rgb.size() / 3;
+    double log_sum = 0;
+    size_t count = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+        double y = 0.2126 * rgb[3 * p] + 0.7152 * rgb[3 * p + 1] + 0.0722 * rgb[3 * p + 2];
+        if (y > 0 && std::isfinite(y)) {
+            log_sum += std::log(1e-6 + y);
+            ++count;
+        }
+    }
+    const double key = count ? std::exp(log_sum / double(count)) : 1.0;
+    double ev = output.exposure_ev;
+    if (output.exposure == OutputConfig::Exposure::kAuto) {
+        // The log-average luminance to middle grey 0.18 (Reinhard et al. 2002, "Photographic tone
+        // reproduction", eq. 1-2).
+        ev += std::log2(0.18 / key);
+    } else {
+        // Luminance in cd/m²: Km = 683.002 lm/W times ∫ȳ L, and the film's Y is ∫ȳ L / ∫ȳ.
+        const double to_cd = 683.002 * CieYIntegral();
+        // A reflected-light meter's EV100 = log2(L S / K), S = 100, K = 12.5 (ISO 2720:1974),
+        // unless given; the sensor saturates at L_max = 78 / (q S) 2^EV100 with q = 0.65
+        // (saturation-based speed, ISO 12232:2006; Lagarde & de Rousiers 2014, "Moving Frostbite to
+        // PBR", eq. 12).
+        const double ev100 = output.ev100 ? *output.ev100 : std::log2(key * to_cd * 100 / 12.5);
+        const double l_max = 78.0 / (0.65 * 100) * std::exp2(ev100);
+        ev += std::log2(to_cd / l_max);
+    }
+    std::vector<uint8_t> png(pixels * 3);
+    for (size_t p = 0; p < pixels; ++p) {
+        Vec3d c = ApplyExposure(Vec3d(rgb[3 * p], rgb[3 * p + 1], rgb[3 * p + 2]), ev);
+        if (output.tone == OutputConfig::Tone::kHuePreserving) {
+            // Compress the largest channel (Reinhard et al. 2002 eq. 4 with a white of 4) and scale
+            // the pixel with it: the channels keep their ratios, so a saturated glass colour keeps
+            // its hue and saturation where clipping each channel would turn it toward yellow or
+            // white.
+            for (int i = 0; i < 3; ++i) c[i] = std::max(0.0, c[i]);
+            const double m = std::max({c.x, c.y, c.z});
+            constexpr double kWhite = 4;
+            if (m > 0) c = c * ((1 + m / (kWhite * kWhite)) / (1 + m));
+        }
+        std::array<uint8_t, 3> v = LinearSrgbTo8Bit(c);
+        for (int i = 0; i < 3; ++i) png[3 * p + i] = v[i];
+    }
+    return png;
+}
+
 Film::Film(int width, int height, const OutputConfig& output)
     : width_(width), height_(height), output_(output) {
     xyz_.reset(new std::atomic<double>[pixel_count() * 3]);
@@ -106,25 +153,7 @@ Status Film::Write(const std::filesystem::path& exr_path,
     }
     NAVE_RETURN_IF_ERROR(imaging::WriteExr(exr_path, image, metadata));
 
-    // PNG: exposure set so the log-average luminance maps to middle grey 0.18 (Reinhard et al. 2002,
-    // "Photographic tone reproduction", eq. 1-2), shifted by exposure_ev, then clamped and sRGB-encoded.
-    double log_sum = 0;
-    size_t count = 0;
-    for (size_t p = 0; p < pixel_count(); ++p) {
-        double y = 0.2126 * rgb[3 * p] + 0.7152 * rgb[3 * p + 1] + 0.0722 * rgb[3 * p + 2];
-        if (y > 0 && std::isfinite(y)) {
-            log_sum += std::log(1e-6 + y);
-            ++count;
-        }
-    }
-    double key = count ? std::exp(log_sum / double(count)) : 1.0;
-    double ev = std::log2(0.18 / key) + output_.exposure_ev;
-    std::vector<uint8_t> png(pixel_count() * 3);
-    for (size_t p = 0; p < pixel_count(); ++p) {
-        std::array<uint8_t, 3> v = LinearSrgbTo8Bit(
-            ApplyExposure(Vec3d(rgb[3 * p], rgb[3 * p + 1], rgb[3 * p + 2]), ev));
-        for (int i = 0; i < 3; ++i) png[3 * p + i] = v[i];
-    }
+    const std::vector<uint8_t> png = DisplayImage(rgb, output_);
     std::filesystem::path png_path = exr_path;
     png_path.replace_extension(".png");
     return imaging::WriteRgb8(png_path, width_, height_, png, metadata);

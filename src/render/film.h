@@ -21,6 +21,11 @@
 
 namespace nave::render {
 
+/// The 8-bit sRGB display image of linear sRGB pixels `rgb` (3 per pixel, in the film's units: a
+/// constant radiance of 1 W m⁻² sr⁻¹ nm⁻¹ has luminance 1) under `output`'s exposure and tone
+/// curve.
+std::vector<uint8_t> DisplayImage(const std::vector<float>& rgb, const OutputConfig& output);
+
 class Film {
   public:
     Film(int width, int height, const OutputConfig& output);

@@ -543,6 +543,19 @@ Status ParseOutput(TableReader& r, OutputConfig* o) {
         o->adaptation = *m;
     }
     NAVE_RETURN_IF_ERROR(r.Float("exposure_ev", &o->exposure_ev, -30, 30));
+    NAVE_RETURN_IF_ERROR(r.Choice(
+        "exposure",
+        {{"auto", OutputConfig::Exposure::kAuto}, {"physical", OutputConfig::Exposure::kPhysical}},
+        &o->exposure));
+    if (r.Has("ev100")) {
+        double ev = 0;
+        NAVE_RETURN_IF_ERROR(r.Double("ev100", &ev, -10, 30));
+        o->ev100 = ev;
+    }
+    NAVE_RETURN_IF_ERROR(r.Choice("tone",
+                                  {{"clip", OutputConfig::Tone::kClip},
+                                   {"hue_preserving", OutputConfig::Tone::kHuePreserving}},
+                                  &o->tone));
     if (const toml::node* n = r.Take("aovs")) {
         const toml::array* a = n->as_array();
         if (a == nullptr) return r.TypeError("aovs", *n, "an array of strings");

@@ -153,6 +153,15 @@ struct OutputConfig {
     /// in RenderScene::output).
     std::optional<Chromaticity> scene_white;
     float exposure_ev = 0.f;              ///< PNG only; EXR stays linear
+    /// PNG exposure: kAuto maps the log-average luminance to middle grey; kPhysical exposes like a
+    /// camera at `ev100` (metered from the log-average luminance in cd/m² when not given).
+    enum class Exposure { kAuto, kPhysical };
+    Exposure exposure = Exposure::kAuto;
+    std::optional<double> ev100;
+    /// PNG tone curve: kClip clips each channel at 1; kHuePreserving compresses the largest channel
+    /// and scales the others with it, so saturated colours keep their hue and saturation.
+    enum class Tone { kClip, kHuePreserving };
+    Tone tone = Tone::kClip;
     bool aov_albedo = false, aov_normal = false, aov_depth = false;
 };
 
