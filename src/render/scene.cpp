@@ -52,6 +52,19 @@ Spectrum HorizontalIrradiance(const RenderScene& scene) {
 
 namespace {
 
+/// The extinction coefficient k of a glass config: `k` as given, or `kappa` times n (ñ = n(1 +
+/// iκ)).
+Spectrum GlassK(const MaterialConfig& mc) {
+    const Spectrum k = ToSpectrum(*mc.glass_k);
+    return mc.glass_k_is_kappa ? k * ToSpectrum(mc.eta) : k;
+}
+
+/// The Beer-Lambert absorption coefficient (m⁻¹) of extinction coefficient `k`: 4πk/λ.
+Spectrum AbsorptionPerMetre(const Spectrum& k) {
+    return Spectrum::FromFunction(
+        [&](double l) { return 4 * std::numbers::pi * double(k.Evaluate(float(l))) / (l * 1e-9); });
+}
+
 /// The physics material a config table describes.
 StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name) {
     if (!mc.builtin.empty()) {
@@ -69,9 +82,20 @@ StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name)
             DielectricMaterial d;
             d.eta = ToSpectrum(mc.eta);
             d.alpha = RoughnessToAlpha(mc.roughness);
+            // Beer-Lambert absorption of a medium of extinction coefficient k: α = 4πk/λ.
+            if (mc.glass_k) d.absorption_per_m = AbsorptionPerMetre(GlassK(mc));
             return Material(d);
         }
         case MaterialConfig::Kind::kThinDielectric:
+            if (mc.glass_k) {
+                // Internal transmittance of one pass at normal incidence: exp(-α d), α = 4πk/λ.
+                const Spectrum alpha = AbsorptionPerMetre(GlassK(mc));
+                const double d = double(mc.thickness_mm) * 1e-3;
+                return Material(
+                    ThinGlassMaterial{ToSpectrum(mc.eta), Spectrum::FromFunction([&](double l) {
+                                          return std::exp(-double(alpha.Evaluate(float(l))) * d);
+                                      })});
+            }
             if (mc.total_transmittance) {
                 return Material(ThinGlassMaterial::FromTotalTransmittance(ToSpectrum(mc.eta),
                                                                           ToSpectrum(*mc.total_transmittance)));

@@ -448,6 +448,28 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
         m->kind = type == "dielectric" ? MaterialConfig::Kind::kDielectric : MaterialConfig::Kind::kThinDielectric;
         NAVE_RETURN_IF_ERROR(r.Spectrum("eta", &m->eta));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
+        // The absorbing part of the index: k, or the paper's κ (ñ = n(1 + iκ)), not both.
+        if (r.Has("k") && r.Has("kappa")) {
+            return InvalidArgumentError(
+                "{}: {}: give either k (ñ = n + ik) or kappa (ñ = n(1 + iκ)), not both", m->where,
+                r.Name(""));
+        }
+        m->glass_k_is_kappa = r.Has("kappa");
+        NAVE_ASSIGN_OR_RETURN(m->glass_k, r.OptionalSpectrum(m->glass_k_is_kappa ? "kappa" : "k"));
+        if (m->kind == MaterialConfig::Kind::kThinDielectric && m->glass_k) {
+            if (!r.Has("thickness_mm")) {
+                return InvalidArgumentError("{}: {}: k or kappa needs the pane's thickness_mm",
+                                            m->where, r.Name(""));
+            }
+            if (r.Has("transmittance") || r.Has("total_transmittance")) {
+                return InvalidArgumentError(
+                    "{}: {}: give the pane's absorption once: k or kappa with thickness_mm, "
+                    "transmittance "
+                    "(internal) or total_transmittance",
+                    m->where, r.Name(""));
+            }
+            NAVE_RETURN_IF_ERROR(r.Float("thickness_mm", &m->thickness_mm, 1e-3f, 1e3f));
+        }
         if (m->kind == MaterialConfig::Kind::kThinDielectric) {
             if (r.Has("transmittance") && r.Has("total_transmittance")) {
                 return InvalidArgumentError("{}: {}: give either transmittance (internal) or total_transmittance",

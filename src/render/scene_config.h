@@ -91,6 +91,13 @@ struct MaterialConfig {
     SpectrumSpec k = SpectrumSpec::Constant(0.f);              ///< conductor absorption
     SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< internal transmittance of thin glass per pass
     std::optional<SpectrumSpec> total_transmittance;           ///< measured total transmittance of a pane
+    /// Glass (dielectric, thin_dielectric): the extinction coefficient k of the complex index
+    /// n + ik, given as `k` or as the ellipsometric κ of ñ = n(1 + iκ) (`kappa`, k = nκ); with a
+    /// pane's `thickness_mm` it sets the internal transmittance exp(-4π k d / λ) per pass, in solid
+    /// glass the absorption coefficient 4π k / λ.
+    std::optional<SpectrumSpec> glass_k;
+    bool glass_k_is_kappa = false;
+    float thickness_mm = 0.f;
     std::string builtin;             ///< a named material of the physics library (BuiltinMaterial)
     float roughness = 0.f;
     std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface

@@ -327,6 +327,44 @@ sky_direct = "photons"
     EXPECT_NEAR(MeanY(*photon->film) / MeanY(*path->film), 1.0, 0.05);
 }
 
+// Glass as the paper measures it, ñ = n(1 + iκ) by ellipsometry, or as tables give it, ñ = n + ik:
+// a pane's internal transmittance per pass is exp(-4π k d / λ), solid glass absorbs α = 4π k / λ
+// (Born & Wolf §14.1; Beer-Lambert). k = 2e-6 over 4 mm at 550 nm: exp(-0.18277) = 0.83296; κ =
+// 1e-6 with n = 1.5 in solid glass: α = 4π 1.5e-6 / 550 nm = 34.272 m⁻¹.
+TEST(SceneConfigGlass, ExtinctionCoefficientSetsTheGlassAbsorption) {
+    store::BrickMesh m;
+    AppendQuad(&m, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1, 0);
+    AppendQuad(&m, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 1, 1);
+    const std::string camera =
+        "[camera]\nposition = [0, 0, 5]\nlook_at = [0.01, 0, 0]\nresolution = [2, 2]\n[sky]\n"
+        "radiance = 1\n[render]\nspp = 1\n";
+    auto t = Render(
+        m, {"pane", "solid"},
+        camera +
+            "[materials.pane]\ntype = \"thin_dielectric\"\neta = 1.5\nk = 2e-6\nthickness_mm = 4\n"
+            "[materials.solid]\ntype = \"dielectric\"\neta = 1.5\nkappa = 1e-6\n",
+        1);
+    ASSERT_TRUE(t);
+    const ThinGlassMaterial* pane = t->scene.materials[0].thin_glass();
+    ASSERT_NE(pane, nullptr);
+    EXPECT_NEAR(pane->internal_transmittance(550.f), 0.83296, 1e-4);
+    const DielectricMaterial* solid =
+        std::get_if<DielectricMaterial>(&t->scene.materials[1].material);
+    ASSERT_NE(solid, nullptr);
+    EXPECT_NEAR(solid->absorption_per_m(550.f), 34.272, 0.01);
+    const char* bad[] = {
+        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\nkappa = 1e-6\nthickness_mm = 4\n",
+        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\n",
+        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\nthickness_mm = 4\ntransmittance = "
+        "0.9\n"};
+    for (const char* b : bad) {
+        auto config = ParseSceneConfig(camera + b, "glass.toml");
+        ASSERT_FALSE(config.ok()) << b;
+        EXPECT_NE(config.status().message().find("materials.pane"), std::string::npos)
+            << config.status().ToString();
+    }
+}
+
 TEST(SceneConfigGround, GroundAlbedoIsCheckedAndOnlyForThePhysicalSky) {
     constexpr const char* kCamera =
         "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 1, 5]\n[sun]\ndirection = [0, 0.5, 1]\n";
