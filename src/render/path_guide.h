@@ -25,7 +25,8 @@
 namespace nave::render {
 
 /// Path mode's guide: coarse cells of about a twelfth of the model's longest axis (8 m in the
-/// abbey), halved twice (2 m), at most 8192 of them with histograms (25 MB).
+/// abbey), halved twice (2 m), at most 8192 of them with histograms (31 MB with the grids, in the
+/// memory reserve).
 inline constexpr int kGuideCoarseCellsLongAxis = 12;
 inline constexpr uint32_t kGuideMaxCells = 8192;
 
