@@ -60,6 +60,9 @@ int main(int argc, char** argv) {
     app.add_flag("-q,--quiet", quiet,
                  "Print only errors (no progress bars, no summaries on stderr)");
     app.add_flag("-v,--verbose", verbose, "Print debugging details");
+    // Global flags also after the subcommand, as users type them (nave render ... -q): options a
+    // subcommand does not know fall through to here. Subcommands inherit this.
+    app.fallthrough();
 
     nave::cli::CommandRun run;
     nave::cli::RegisterVersionCommand(app, run);

@@ -37,5 +37,24 @@ TEST(CliRenderOptionsTest, MalformedResolutionIsAUsageErrorNamingIt) {
     EXPECT_FALSE(std::filesystem::exists("/tmp/never_written.exr"));
 }
 
+// Global flags work after the subcommand too, as users type them; unknown ones are still refused.
+TEST(CliRenderOptionsTest, GlobalFlagsAfterTheSubcommand) {
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_quiet_" + std::to_string(getpid()) + ".exr");
+    const std::string render = "render --procedural furnace --config " + kFurnaceConfig +
+                               " --resolution 8x6 --spp 1 --threads 1 -o " + out.string();
+    const CommandResult loud = RunNave(render);
+    ASSERT_EQ(loud.exit_code, 0) << loud.output;
+    EXPECT_FALSE(loud.output.empty());
+    const CommandResult quiet = RunNave(render + " -q");
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+    EXPECT_TRUE(quiet.output.empty()) << quiet.output;
+    const CommandResult bogus = RunNave(render + " --bogus");
+    EXPECT_NE(bogus.exit_code, 0);
+    EXPECT_NE(bogus.output.find("--bogus"), std::string::npos) << bogus.output;
+    std::filesystem::remove(out);
+    std::filesystem::remove(std::filesystem::path(out).replace_extension(".png"));
+}
+
 }  // namespace
 }  // namespace nave::render
