@@ -1,6 +1,7 @@
 #include "store/face_shading.h"
 
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 #include "core/key_table.h"
@@ -159,7 +160,7 @@ FaceShading ChooseFaceShading(const BrickMesh& mesh, const std::vector<uint32_t>
     }
 
     // 5. Derived normals per (site, group), then the check of every candidate.
-    const double min_cosine = std::cos(max_error_deg * (3.14159265358979323846 / 180));
+    const double min_cosine = std::cos(max_error_deg * (std::numbers::pi / 180));
     std::vector<Vec3d> sum(sites.size() * kSmoothingGroups, Vec3d(0, 0, 0));
     auto slot = [&](size_t k, int j) {
         return corner_site[3 * k + j] * kSmoothingGroups + out.group[k];

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "preprocess/abbey/materials.h"
 #include "preprocess/abbey/pier.h"
@@ -14,7 +15,7 @@
 namespace nave::preprocess::abbey {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // Plan and elevation, in metres (docs/abbey.md). x east, y north, z up; the west facade's inner
 // face is at x = 0, the church's axis is y = 0.

@@ -1,6 +1,7 @@
 #include "preprocess/abbey/pier.h"
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "preprocess/abbey/materials.h"
@@ -9,7 +10,7 @@
 namespace nave::preprocess::abbey {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // Appends an arc of the circle (cx, cz, r) from angle a0 to a1 (radians) to a profile.
 void Arc(std::vector<Vec2>& p, double cx, double cz, double r, double a0, double a1, int n) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "preprocess/abbey/materials.h"
@@ -11,7 +12,7 @@ namespace nave::preprocess::abbey {
 namespace {
 
 constexpr double kRho = 2.0;  // equilateral pointed profile
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 Vec3d Plan(const VaultBay& b, double u, double v) {
     double s = (u + 1) * 0.5, t = (v + 1) * 0.5;

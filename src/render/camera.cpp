@@ -8,7 +8,7 @@ Camera::Camera(const CameraConfig& c)
     : position_(c.position),
       width_(c.width),
       height_(c.height),
-      tan_half_fov_(std::tan(c.fov_deg * 0.5f * 3.14159265358979f / 180.f)),
+      tan_half_fov_(std::tan(c.fov_deg * 0.5f * kPi / 180.f)),
       aspect_(float(c.width) / float(c.height)),
       lens_radius_(c.lens_radius_m) {
     forward_ = Normalize(c.look_at - c.position);

@@ -51,8 +51,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
     const Bounds3f& bounds = scene_.source->bounds();
     scene_center_ = bounds.Center();
     scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
-    const float disk_area = 3.14159265358979f * scene_radius_ * scene_radius_;
-    const float kPiF = 3.14159265358979f;
+    const float disk_area = kPi * scene_radius_ * scene_radius_;
 
     // One pass over the bricks that hold emissive or portal materials. A triangle stored in several
     // bricks (it crosses cells) is kept only in the brick whose cell holds its centroid.
@@ -101,7 +100,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
                 }
                 triangles.push_back(e);
                 // Two-sided Lambertian emitter: power = L pi A per side.
-                triangle_weights.push_back(power[m.material_ids[t]] * 2 * kPiF * e.area);
+                triangle_weights.push_back(power[m.material_ids[t]] * 2 * kPi * e.area);
             }));
     }
     for (const Light& l : scene_.lights) {
@@ -126,7 +125,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
                 break;
             case Light::Kind::kPoint:
             case Light::Kind::kSpot:
-                w *= 4 * kPiF;
+                w *= 4 * kPi;
                 break;
         }
         if (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional) {
@@ -166,7 +165,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
         // Through portals: lines cross them with measure 2 pi A_portals (both sides), through the
         // bounds 4 pi A_disc.
         weights.push_back(mean *
-                          (sky_portals_ ? 2 * kPiF * sky_portals_->area() : 4 * kPiF * disk_area));
+                          (sky_portals_ ? 2 * kPi * sky_portals_->area() : 4 * kPi * disk_area));
     }
     emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
     weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
@@ -240,8 +239,7 @@ void PhotonEmitters::Learn(std::span<const float> deposited) {
 
 void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
                                  StreamScheduler& scheduler) {
-    const float kPiF = 3.14159265358979f;
-    const float disk_area = kPiF * scene_radius_ * scene_radius_;
+    const float disk_area = kPi * scene_radius_ * scene_radius_;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
         RayOutbox out;
         for (uint64_t i = range.begin(); i != range.end(); ++i) {
@@ -306,7 +304,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                                 0.f, 1.f);
                             falloff = x * x * (3 - 2 * x);
                         }
-                        r.beta = l.spectrum.Sample(lambda) * (falloff * 4 * kPiF);
+                        r.beta = l.spectrum.Sample(lambda) * (falloff * 4 * kPi);
                         break;
                     }
                 }
@@ -333,12 +331,12 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 // bounds; through the portals count / (2 pi A_portals), count = portals the line
                 // crosses (Veach's balance heuristic over the portals); aimed at windows, the
                 // mixture of the two.
-                float density = 1 / (4 * kPiF * disk_area);
+                float density = 1 / (4 * kPi * disk_area);
                 if (sky_portals_) {
                     const int count = sky_portals_->ForEachCrossing(r.origin, d, 4 * scene_radius_,
                                                                     [](const BrickHit&) {});
                     density = kSkyPortalPhotonShare * float(count) /
-                                  float(2 * kPiF * sky_portals_->area()) +
+                                  float(2 * kPi * sky_portals_->area()) +
                               (1 - kSkyPortalPhotonShare) * density;
                 }
                 r.beta = scene_.SkyRadiance(-d, lambda) / density;
@@ -355,8 +353,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 std::array<float, 2> uv;
                 for (int k = 0; k < 2; ++k)
                     uv[k] = e.uv[0][k] * w[0] + e.uv[1][k] * w[1] + e.uv[2][k] * w[2];
-                r.beta =
-                    e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPiF * e.area);
+                r.beta = e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPi * e.area);
                 r.flags = kFromAreaLight;
             }
             r.beta /= p_choice;

@@ -2,11 +2,12 @@
 
 #include <cmath>
 
+#include "core/sampling.h"
+
 namespace nave::render {
 
-void AppendSphere(store::BrickMesh* mesh, Vec3f center, float radius, int rings, int segments, uint32_t material,
-                  bool inward) {
-    const float kPi = 3.14159265358979f;
+void AppendSphere(store::BrickMesh* mesh, Vec3f center, float radius, int rings, int segments,
+                  uint32_t material, bool inward) {
     const uint32_t base = uint32_t(mesh->positions.size());
     const bool with_normals = mesh->positions.empty() || mesh->HasNormals();
     for (int i = 0; i <= rings; ++i) {

@@ -113,8 +113,9 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
     if (sun.direction) {
         s.to_sun = *sun.direction;
         s.angular_radius_rad = double(sun.angular_radius_deg) * std::numbers::pi / 180;
-        s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / 3.14159265358979;
-        s.azimuth_deg = std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / 3.14159265358979 + 360.0, 360.0);
+        s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / std::numbers::pi;
+        s.azimuth_deg =
+            std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / std::numbers::pi + 360.0, 360.0);
         if (sun.radiance) {
             s.radiance = ToSpectrum(*sun.radiance);
         } else {
@@ -262,8 +263,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
                 l.kind = Light::Kind::kSpot;
                 l.position = lc.position;
                 l.spot_axis = lc.direction;
-                l.cos_cone = std::cos(lc.cone_deg * 3.14159265358979f / 180.f);
-                l.cos_falloff = std::cos(lc.falloff_start_deg * 3.14159265358979f / 180.f);
+                l.cos_cone = std::cos(lc.cone_deg * kPi / 180.f);
+                l.cos_falloff = std::cos(lc.falloff_start_deg * kPi / 180.f);
                 break;
         }
         scene.lights.push_back(std::move(l));
