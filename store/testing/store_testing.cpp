@@ -1,6 +1,7 @@
 #include "store/testing/store_testing.h"
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 namespace nave::store::testing {
@@ -41,7 +42,7 @@ uint32_t BuildCellTree(const Bounds3f& bounds, Vec3i n, Vec3i lo, Vec3i hi,
 BrickMesh MakeSurface(const SurfaceOptions& o) {
     BrickMesh mesh;
     const uint32_t vx = o.quads_x + 1, vy = o.quads_y + 1;
-    const float k = 2.f * 3.14159265f / o.size_m;  // one period across the surface
+    const float k = 2.f * std::numbers::pi_v<float> / o.size_m;  // one period across the surface
     std::mt19937 rng(o.seed);
     std::uniform_real_distribution<float> unit(0.f, 1.f);
     for (uint32_t j = 0; j < vy; ++j) {
