@@ -16,6 +16,12 @@ namespace {
 // seen light from (the BSDF's share samples every direction too).
 constexpr double kUniformShare = 0.1;
 
+/// The solid-angle pdf of bin `bin` of a cell's CDF: its probability over its solid angle,
+/// 4π / kBins.
+float BinPdf(const float* cdf, int bin) {
+    return (cdf[bin] - (bin > 0 ? cdf[bin - 1] : 0.f)) * float(PathGuide::kBins) / (4 * kPi);
+}
+
 }  // namespace
 
 struct PathGuide::Cell {
@@ -199,16 +205,13 @@ std::optional<GuideSample> PathGuide::Sample(const Vec3f& p, int side, float u_b
     const Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
     // The pdf of the bin the direction falls in as Pdf sees it (rounding at a bin's edge can move
     // it to the neighbour): the sample's pdf and Pdf must agree for MIS.
-    const int seen = BinOf(wi);
-    return GuideSample{wi,
-                       (cdf[seen] - (seen > 0 ? cdf[seen - 1] : 0.f)) * float(kBins) / (4 * kPi)};
+    return GuideSample{wi, BinPdf(cdf, BinOf(wi))};
 }
 
 float PathGuide::Pdf(const Vec3f& p, int side, const Vec3f& w) const {
     const float* cdf = Distribution(p, side);
     if (cdf == nullptr) return 0;
-    const int bin = BinOf(w);
-    return (cdf[bin] - (bin > 0 ? cdf[bin - 1] : 0.f)) * float(kBins) / (4 * kPi);
+    return BinPdf(cdf, BinOf(w));
 }
 
 float GuidedBsdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda) const {

@@ -5,6 +5,7 @@
 
 #include "core/log.h"
 #include "core/rgb_to_spectrum.h"
+#include "render/materials/ior.h"
 #include "render/sun/sun.h"
 
 namespace nave::render {
@@ -59,12 +60,6 @@ Spectrum GlassK(const MaterialConfig& mc) {
     return mc.glass_k_is_kappa ? k * ToSpectrum(mc.eta) : k;
 }
 
-/// The Beer-Lambert absorption coefficient (m⁻¹) of extinction coefficient `k`: 4πk/λ.
-Spectrum AbsorptionPerMetre(const Spectrum& k) {
-    return Spectrum::FromFunction(
-        [&](double l) { return 4 * std::numbers::pi * double(k.Evaluate(float(l))) / (l * 1e-9); });
-}
-
 /// The physics material a config table describes.
 StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name) {
     if (!mc.builtin.empty()) {
@@ -82,7 +77,6 @@ StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name)
             DielectricMaterial d;
             d.eta = ToSpectrum(mc.eta);
             d.alpha = RoughnessToAlpha(mc.roughness);
-            // Beer-Lambert absorption of a medium of extinction coefficient k: α = 4πk/λ.
             if (mc.glass_k) d.absorption_per_m = AbsorptionPerMetre(GlassK(mc));
             return Material(d);
         }

@@ -37,13 +37,14 @@ const Spectrum& SodaLimeIndex() {
     return s;
 }
 
+Spectrum AbsorptionPerMetre(const Spectrum& k) {
+    return Spectrum::FromFunction(
+        [&](double l_nm) { return 4.0 * M_PI * k.Evaluate(float(l_nm)) / (l_nm * 1e-9); });
+}
+
 const Spectrum& SodaLimeAbsorptionPerMetre() {
-    static const Spectrum s = [] {
-        Spectrum k = EmbeddedSpectraTable("glass_soda_lime_rubin1985.csv").ToSpectrum(0);
-        // Beer-Lambert absorption coefficient of a medium of extinction coefficient κ: α = 4πκ/λ.
-        return Spectrum::FromFunction(
-            [&](double l_nm) { return 4.0 * M_PI * k.Evaluate(float(l_nm)) / (l_nm * 1e-9); });
-    }();
+    static const Spectrum s =
+        AbsorptionPerMetre(EmbeddedSpectraTable("glass_soda_lime_rubin1985.csv").ToSpectrum(0));
     return s;
 }
 

@@ -20,6 +20,9 @@ const Spectrum& Bk7Index();
 /// Clear soda-lime-silica window glass, Rubin (1985) fit n = 1.5130 - 0.003169 λ² + 0.003962 / λ²
 /// (µm).
 const Spectrum& SodaLimeIndex();
+/// The Beer-Lambert absorption coefficient α = 4πk/λ (per metre) of a medium of extinction
+/// coefficient `k` (the imaginary part of its index n + ik; Born & Wolf §14.1).
+Spectrum AbsorptionPerMetre(const Spectrum& k);
 /// Absorption coefficient α = 4πκ/λ (per metre) of clear soda-lime glass from Rubin's κ (1985).
 const Spectrum& SodaLimeAbsorptionPerMetre();
 
