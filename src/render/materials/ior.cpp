@@ -48,6 +48,12 @@ const Spectrum& SodaLimeAbsorptionPerMetre() {
     return s;
 }
 
+const Spectrum& GreenSodaLimeAbsorptionPerMetre() {
+    static const Spectrum s = AbsorptionPerMetre(
+        EmbeddedSpectraTable("glass_soda_lime_green_rubin1985.csv").ToSpectrum(0));
+    return s;
+}
+
 StatusOr<ComplexIndex> NamedMetal(std::string_view name) {
     std::string n;
     for (char c : name) n += char(std::tolower(static_cast<unsigned char>(c)));

@@ -25,6 +25,10 @@ const Spectrum& SodaLimeIndex();
 Spectrum AbsorptionPerMetre(const Spectrum& k);
 /// Absorption coefficient α = 4πκ/λ (per metre) of clear soda-lime glass from Rubin's κ (1985).
 const Spectrum& SodaLimeAbsorptionPerMetre();
+/// Absorption coefficient of green (iron-tinted) soda-lime window glass from Rubin's measured k
+/// (1985, the same paper's green glass): the nearest published measurement nave has of the
+/// greenish, iron-coloured glass of medieval grisaille windows.
+const Spectrum& GreenSodaLimeAbsorptionPerMetre();
 
 /// Complex index n + iκ of a metal.
 struct ComplexIndex {
