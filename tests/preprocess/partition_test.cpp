@@ -153,10 +153,11 @@ QTri Canonical(QTri q) {
 class PartitionedSphere : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
-        dir_ = testing::MakeTempDir("sphere");
+        scratch_ = std::make_unique<test::ScratchDir>(testing::MakeTempDir("sphere"));
+        dir_ = scratch_->path();
         WriteIcosphere(dir_ / "sphere.obj", 5, 2.0);  // 20480 triangles
     }
-    static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+    static void TearDownTestSuite() { scratch_.reset(); }
 
     static PreprocessStats Run(const std::filesystem::path& out, uint64_t memory, int threads) {
         PreprocessOptions o;
@@ -169,6 +170,7 @@ class PartitionedSphere : public ::testing::Test {
         EXPECT_TRUE(stats.ok()) << stats.status().ToString();
         return stats.ok() ? *stats : PreprocessStats{};
     }
+    static inline std::unique_ptr<test::ScratchDir> scratch_;
     static inline std::filesystem::path dir_;
 };
 
@@ -381,7 +383,8 @@ struct LeafDigest {
 };
 
 std::vector<LeafDigest> PartitionAbbey(int threads, int max_fanout) {
-    auto temp = TempDir::Create(testing::MakeTempDir("split-threads"));
+    const auto parent = testing::MakeTempDir("split-threads");
+    auto temp = TempDir::Create(parent);
     EXPECT_TRUE(temp.ok()) << temp.status().ToString();
     if (!temp.ok()) return {};
     PartitionConfig config;

@@ -28,14 +28,8 @@ std::string ReadError(const std::filesystem::path& path) {
     return all.ok() ? std::string() : all.status().ToString();
 }
 
-std::filesystem::path MakeTempDir(const std::string& tag) {
-    static int counter = 0;
-    auto dir =
-        std::filesystem::temp_directory_path() /
-        ("nave_test_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
+::nave::test::ScratchDir MakeTempDir(const std::string& tag) {
+    return ::nave::test::ScratchDir("test_" + tag);
 }
 
 AbbeyDigest DigestOf(TriangleSource& source) {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "common/scratch_dir.h"
 #include "core/vecmath.h"
 #include "preprocess/triangle_source.h"
 
@@ -34,7 +35,7 @@ struct AbbeyDigest {
 /// Reads `source` to the end; fails the test on a read error.
 AbbeyDigest DigestOf(TriangleSource& source);
 
-/// A fresh empty directory under the system temp dir, removed by the caller.
-std::filesystem::path MakeTempDir(const std::string& tag);
+/// A fresh empty directory under the system temp dir, removed when the returned object goes.
+::nave::test::ScratchDir MakeTempDir(const std::string& tag);
 
 }  // namespace nave::preprocess::testing

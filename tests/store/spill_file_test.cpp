@@ -8,15 +8,15 @@
 #include <vector>
 
 #include "common/file_size_limit.h"
+#include "common/scratch_dir.h"
 
 namespace nave::store {
 namespace {
 
-std::filesystem::path TestDir() {
-    std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / ("nave_spill_test_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir;
+// One directory for the whole binary, removed at exit.
+const std::filesystem::path& TestDir() {
+    static const test::ScratchDir dir("spill_test");
+    return dir.path();
 }
 
 std::vector<char> Noise(size_t n, uint32_t seed) {

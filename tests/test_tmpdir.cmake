@@ -1,0 +1,16 @@
+# The test run's TMPDIR: emptied before the first test (MODE=setup), checked empty after the last
+# (MODE=check), so that a test which leaves files behind is named.
+get_filename_component(DIR "${DIR}" ABSOLUTE)
+if(MODE STREQUAL "setup")
+  file(REMOVE_RECURSE "${DIR}")
+  file(MAKE_DIRECTORY "${DIR}")
+elseif(MODE STREQUAL "check")
+  file(GLOB left RELATIVE "${DIR}" "${DIR}/*" "${DIR}/.*")
+  list(FILTER left EXCLUDE REGEX "^\\.\\.?$")
+  if(left)
+    list(JOIN left ", " names)
+    message(FATAL_ERROR "the tests left these behind in ${DIR}: ${names}")
+  endif()
+else()
+  message(FATAL_ERROR "MODE must be setup or check")
+endif()
