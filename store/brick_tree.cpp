@@ -59,6 +59,25 @@ Status BrickTree::Validate(uint32_t brick_count) const {
     return Status::Ok();
 }
 
+void BrickTree::BricksOverlapping(const Bounds3f& box, std::vector<uint32_t>* out) const {
+    out->clear();
+    if (nodes_.empty() || !bounds_.Overlaps(box)) return;
+    uint32_t stack[kMaxDepth + 1];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BrickTreeNode& n = nodes_[stack[--top]];
+        if (n.IsLeaf()) {
+            if (n.brick != kNoBrick) out->push_back(n.brick);
+            continue;
+        }
+        // Below the plane: [.., split); above: [split, ..]. Closed tests: a box touching the plane
+        // is on both sides.
+        if (box.min[n.axis] <= n.split && top <= kMaxDepth) stack[top++] = n.child[0];
+        if (box.max[n.axis] >= n.split && top <= kMaxDepth) stack[top++] = n.child[1];
+    }
+}
+
 uint32_t BrickTree::Locate(const Vec3f& p) const {
     if (nodes_.empty() || !bounds_.Contains(p)) return kNoBrick;
     uint32_t n = 0;

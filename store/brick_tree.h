@@ -46,6 +46,9 @@ class BrickTree {
     uint32_t Locate(const Vec3f& p) const;
     /// The cell (box) of every leaf, indexed by brick id (size brick_count; empty leaves are not listed).
     std::vector<Bounds3f> BrickCells(uint32_t brick_count) const;
+    /// The non-empty bricks whose cells overlap `box` (closed: a box touching a split plane is on
+    /// both sides), into `out` (cleared first).
+    void BricksOverlapping(const Bounds3f& box, std::vector<uint32_t>* out) const;
 
     /// Calls `visit(brick, t_enter, t_exit)` for every non-empty cell the ray o + t d crosses within
     /// [t_min, t_max], front to back; stops early when `visit` returns false.

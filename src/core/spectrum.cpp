@@ -185,12 +185,16 @@ double PlanckRadiance(double lambda_nm, double t_kelvin) {
     return le * 1e-9;  // per metre of wavelength -> per nanometre
 }
 
+double PlanckRelativeToPeak(double lambda_nm, double t_kelvin) {
+    if (t_kelvin <= 0) return 0;
+    // Wien's displacement law gives the peak: λmax = b / T, b = 2.897771955e-3 m K (CODATA 2018).
+    const double peak_nm = 2.897771955e6 / t_kelvin;
+    return PlanckRadiance(lambda_nm, t_kelvin) / PlanckRadiance(peak_nm, t_kelvin);
+}
+
 Spectrum Spectrum::Blackbody(double t_kelvin) {
     NAVE_CHECK_GT(t_kelvin, 0.0);
-    // Wien's displacement law gives the peak: λmax = b / T, b = 2.897771955e-3 m K (CODATA 2018).
-    double peak_nm = 2.897771955e6 / t_kelvin;
-    double norm = 1.0 / PlanckRadiance(peak_nm, t_kelvin);
-    return FromFunction([&](double l) { return PlanckRadiance(l, t_kelvin) * norm; });
+    return FromFunction([&](double l) { return PlanckRelativeToPeak(l, t_kelvin); });
 }
 
 Spectrum Spectrum::CieIlluminantD(double cct_kelvin) {

@@ -234,6 +234,8 @@ class Spectrum {
 
 /// Planck's law: spectral radiance of a black body in W·sr⁻¹·m⁻²·nm⁻¹ (CODATA 2018 constants).
 double PlanckRadiance(double lambda_nm, double t_kelvin);
+/// Planck's law relative to its peak over all wavelengths (Wien's λmax = b / T): 1 at the peak.
+double PlanckRelativeToPeak(double lambda_nm, double t_kelvin);
 
 /// A table of spectra read from CSV text: one wavelength column (nm) then one or more value
 /// columns.

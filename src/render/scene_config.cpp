@@ -25,17 +25,8 @@ float SpectrumSpec::Evaluate(float lambda_nm) const {
             float f = (lambda_nm - wavelengths_nm[i]) / (wavelengths_nm[i + 1] - wavelengths_nm[i]);
             return ((1 - f) * values[i] + f * values[i + 1]) * scale;
         }
-        case Kind::kBlackbody: {
-            // Planck's law B(lambda, T) = 2hc^2 / lambda^5 / (exp(hc / (lambda k T)) - 1), normalised by its
-            // value at Wien's peak lambda_max = b / T, b = 2.897771955e-3 m K (CODATA 2018).
-            auto planck = [](double l_m, double t) {
-                const double c = 299792458.0, h = 6.62607015e-34, kb = 1.380649e-23;
-                return 2 * h * c * c / std::pow(l_m, 5) / (std::exp(h * c / (l_m * kb * t)) - 1);
-            };
-            double t = temperature_k;
-            double peak = planck(2.897771955e-3 / t, t);
-            return float(planck(lambda_nm * 1e-9, t) / peak) * scale;
-        }
+        case Kind::kBlackbody:
+            return float(PlanckRelativeToPeak(lambda_nm, temperature_k)) * scale;
     }
     return 0.f;
 }

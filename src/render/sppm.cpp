@@ -13,26 +13,6 @@
 
 namespace nave::render {
 
-void BricksOverlapping(const store::BrickTree& tree, const Bounds3f& box, std::vector<uint32_t>* out) {
-    out->clear();
-    const auto& nodes = tree.nodes();
-    if (nodes.empty() || !tree.bounds().Overlaps(box)) return;
-    uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const store::BrickTreeNode& n = nodes[stack[--top]];
-        if (n.IsLeaf()) {
-            if (n.brick != store::kNoBrick) out->push_back(n.brick);
-            continue;
-        }
-        // Below the plane: [.., split); above: [split, ..]. Closed tests: a sphere touching the plane is
-        // registered on both sides.
-        if (box.min[n.axis] <= n.split && top < 128) stack[top++] = n.child[0];
-        if (box.max[n.axis] >= n.split && top < 128) stack[top++] = n.child[1];
-    }
-}
-
 VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius,
                              float alpha)
     : points_(pixel_count),
@@ -139,7 +119,7 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
         if (!vp.valid) continue;
         const float r = radius_;
         Bounds3f box(vp.p - Vec3f(r, r, r), vp.p + Vec3f(r, r, r));
-        BricksOverlapping(tree, box, &bricks);
+        tree.BricksOverlapping(box, &bricks);
         for (uint32_t b : bricks) {
             BrickGrid& g = grids_[b];
             int lo[3], hi[3];

@@ -171,9 +171,6 @@ class VisiblePoints {
     std::atomic<uint64_t> deposits_{0};
 };
 
-/// Bricks whose cells overlap `box` (kd-tree descent).
-void BricksOverlapping(const store::BrickTree& tree, const Bounds3f& box, std::vector<uint32_t>* out);
-
 /// The wavelengths of shared-wavelength channel `channel` of an iteration of photon mode (sppm.h):
 /// the same for all its camera paths and photons that take them, a sample of the visible
 /// distribution drawn from (seed, iteration, channel).

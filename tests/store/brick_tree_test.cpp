@@ -98,6 +98,33 @@ TEST(BrickTree, LocateMatchesBruteForce) {
     }
 }
 
+// BricksOverlapping lists exactly the bricks whose closed cells overlap the closed box, whatever
+// its size: points, boxes within a cell, boxes across many and boxes partly outside the tree.
+TEST(BrickTree, BricksOverlappingMatchesBruteForce) {
+    std::mt19937 rng(11);
+    const Bounds3f bounds({-3, -2, -1}, {5, 4, 2});
+    for (int trial = 0; trial < 20; ++trial) {
+        uint32_t bricks = 0;
+        const BrickTree tree = RandomTree(rng, bounds, 7, &bricks);
+        ASSERT_TRUE(tree.Validate(bricks).ok());
+        const std::vector<Bounds3f> cells = tree.BrickCells(bricks);
+        std::uniform_real_distribution<float> x(-4, 6), y(-3, 5), z(-2, 3), size(0, 3);
+        std::vector<uint32_t> found;
+        for (int i = 0; i < 300; ++i) {
+            const Vec3f lo{x(rng), y(rng), z(rng)};
+            const float s = i % 3 == 0 ? 0.f : size(rng);
+            const Bounds3f box(lo, lo + Vec3f(s, s * 0.5f, s * 0.25f));
+            std::vector<uint32_t> expected;
+            for (uint32_t b = 0; b < bricks; ++b) {
+                if (cells[b].Overlaps(box)) expected.push_back(b);
+            }
+            tree.BricksOverlapping(box, &found);
+            std::sort(found.begin(), found.end());
+            EXPECT_EQ(found, expected) << "box " << box.min << " - " << box.max;
+        }
+    }
+}
+
 TEST(BrickTree, TraverseVisitsEveryCrossedCellOnceFrontToBack) {
     std::mt19937 rng(11);
     const Bounds3f bounds({0, 0, 0}, {10, 6, 4});
