@@ -15,18 +15,6 @@ namespace {
 constexpr uint32_t kMaxStringBytes = 1u << 24;
 constexpr uint32_t kMaxHeaderBytes = 1u << 16;
 
-void PutTableRef(ByteWriter& w, const TableRef& t) {
-    w.Put(t.offset);
-    w.Put(t.length);
-    w.Put(t.checksum);
-}
-
-Status GetTableRef(ByteReader& r, TableRef* t) {
-    NAVE_RETURN_IF_ERROR(r.Get(&t->offset));
-    NAVE_RETURN_IF_ERROR(r.Get(&t->length));
-    return r.Get(&t->checksum);
-}
-
 void PutSection(ByteWriter& w, const SectionInfo& s) {
     w.Put(s.offset);
     w.Put(s.length);
@@ -109,10 +97,10 @@ std::string EncodeHeader(const RawHeader& h) {
     w.Put(h.directory_entry_bytes);
     w.Put(h.tree_node_bytes);
     w.Put(uint32_t(0));  // reserved flags
-    PutTableRef(w, h.provenance);
-    PutTableRef(w, h.directory);
-    PutTableRef(w, h.tree);
-    PutTableRef(w, h.materials);
+    PutSection(w, h.provenance);
+    PutSection(w, h.directory);
+    PutSection(w, h.tree);
+    PutSection(w, h.materials);
     NAVE_CHECK_LE(w.size(), size_t(kHeaderBytes - 8));
     w.PutZeros(kHeaderBytes - 8 - w.size());
     w.Put(Checksum64(w.bytes().data(), w.size()));
@@ -196,10 +184,10 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     NAVE_RETURN_IF_ERROR(r.Get(&h.tree_node_bytes));
     uint32_t reserved = 0;
     NAVE_RETURN_IF_ERROR(r.Get(&reserved));
-    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.provenance));
-    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.directory));
-    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.tree));
-    NAVE_RETURN_IF_ERROR(GetTableRef(r, &h.materials));
+    NAVE_RETURN_IF_ERROR(GetSection(r, &h.provenance));
+    NAVE_RETURN_IF_ERROR(GetSection(r, &h.directory));
+    NAVE_RETURN_IF_ERROR(GetSection(r, &h.tree));
+    NAVE_RETURN_IF_ERROR(GetSection(r, &h.materials));
 
     // The checksum matched, so what follows catches writer bugs and files cut or extended after
     // writing.
@@ -224,7 +212,7 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     }
     struct Named {
         const char* what;
-        const TableRef* ref;
+        const SectionInfo* ref;
     };
     for (const Named& t : {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
                            Named{"tree", &h.tree}, Named{"materials", &h.materials}}) {

@@ -40,13 +40,6 @@ inline constexpr uint32_t kTreeNodeBytes = 20;
 inline constexpr uint32_t kBrickHasNormals = 1u << 0;
 inline constexpr uint32_t kBrickHasUvs = 1u << 1;
 
-/// Where a table is in the file.
-struct TableRef {
-    uint64_t offset = 0;
-    uint64_t length = 0;
-    uint64_t checksum = 0;
-};
-
 /// The header as stored, beyond what StoreHeader exposes.
 struct RawHeader {
     uint16_t major = kFormatMajor;
@@ -62,10 +55,10 @@ struct RawHeader {
     uint32_t tree_node_count = 0;
     uint32_t directory_entry_bytes = kDirectoryEntryBytes;
     uint32_t tree_node_bytes = kTreeNodeBytes;
-    TableRef provenance;
-    TableRef directory;
-    TableRef tree;
-    TableRef materials;
+    SectionInfo provenance;
+    SectionInfo directory;
+    SectionInfo tree;
+    SectionInfo materials;
 };
 
 /// A directory entry as stored: BrickInfo plus flags.

@@ -26,7 +26,8 @@ struct StoreProvenance {
     std::string options;                    ///< the creation options, as text ("brick-triangles=1000000 ...")
 };
 
-/// One section of a brick (the Draco mesh, a side section): where it is in the file and its checksum.
+/// One section of the file, where it is and its checksum: a table the header points to (provenance,
+/// directory, tree, materials) or a section of a brick (the Draco mesh, a side section).
 struct SectionInfo {
     uint64_t offset = 0;     ///< byte offset from the start of the file
     uint64_t length = 0;     ///< bytes on disk

@@ -24,7 +24,7 @@ struct Store::Impl {
     mutable std::atomic<uint64_t> bytes_read{0};
 
     // Reads a table and checks its checksum.
-    StatusOr<std::string> ReadTable(const char* what, const format::TableRef& ref) const {
+    StatusOr<std::string> ReadTable(const char* what, const SectionInfo& ref) const {
         std::string bytes(ref.length, '\0');
         NAVE_RETURN_IF_ERROR(file.ReadAt(ref.offset, bytes.data(), bytes.size()));
         const uint64_t checksum = Checksum64(bytes.data(), bytes.size());

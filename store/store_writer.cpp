@@ -105,7 +105,7 @@ Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
                             const StoreProvenance& provenance,
                             const std::vector<format::RawBrickEntry>& entries,
                             const BrickTree& tree, const std::vector<MaterialRecord>& materials) {
-    auto write_table = [&](const std::string& bytes, format::TableRef* ref) -> Status {
+    auto write_table = [&](const std::string& bytes, SectionInfo* ref) -> Status {
         *ref = {file.size(), bytes.size(), Checksum64(bytes.data(), bytes.size())};
         return file.Write(bytes);
     };

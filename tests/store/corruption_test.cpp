@@ -108,7 +108,7 @@ TEST_F(StoreCorruption, FlippedHeaderByteIsDataLoss) {
 TEST_F(StoreCorruption, FlippedTableByteNamesTheTableAndItsOffset) {
     struct Case {
         const char* table;
-        format::TableRef ref;
+        SectionInfo ref;
     };
     for (const Case& c :
          {Case{"provenance", header_.provenance}, Case{"directory", header_.directory},
@@ -176,7 +176,7 @@ TEST_F(StoreCorruption, DamagedPayloadBehindValidChecksumsNeverCrashes) {
 TEST_F(StoreCorruption, InconsistentTablesBehindValidChecksumsAreRefused) {
     auto rechecksum = [&](std::string bytes) {
         format::RawHeader h = header_;
-        for (format::TableRef* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
+        for (SectionInfo* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
             t->checksum = Checksum64(bytes.data() + t->offset, t->length);
         }
         const std::string header = format::EncodeHeader(h);
@@ -236,7 +236,7 @@ TEST_F(StoreCorruption, RandomTableDamageBehindValidChecksumsNeverCrashes) {
         std::string bytes = bytes_;
         for (int k = 0; k < 1 + trial % 4; ++k) bytes[pos(rng)] ^= char(1 + rng() % 255);
         format::RawHeader h = header_;
-        for (format::TableRef* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
+        for (SectionInfo* t : {&h.provenance, &h.directory, &h.tree, &h.materials}) {
             t->checksum = Checksum64(bytes.data() + t->offset, t->length);
         }
         const std::string header = format::EncodeHeader(h);
