@@ -142,13 +142,6 @@ void DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
 
 }  // namespace
 
-uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                      bool has_uvs) {
-    return vertex_count * (sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) +
-                           (has_uvs ? sizeof(std::array<float, 2>) : 0)) +
-           triangle_count * (3 * sizeof(uint32_t) + sizeof(uint32_t));
-}
-
 StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
                                         const EncodeOptions& options,
                                         const Bounds3f& complete_within) {
@@ -415,7 +408,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     out.triangle_count = kept.size();
     out.vertex_count = encoded_points;
     out.decoded_bytes =
-        DecodedBytes(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
+        BrickMesh::BytesFor(out.vertex_count, out.triangle_count, out.has_normals, out.has_uvs);
     // Dequantizing is monotonic per axis: the box of the decoded positions is that of the extremes.
     if (point_count > 0) out.geometry_bounds = Bounds3f(grid.Dequantize(lo), grid.Dequantize(hi));
     if (!options.verify) return out;
@@ -507,7 +500,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
 
     const uint32_t point_count = dm->num_points();
     const uint32_t face_count = dm->num_faces();
-    // Exact sizes, so that MemoryBytes() equals DecodedBytes() and the directory's decoded_bytes.
+    // Exact sizes, so that MemoryBytes() equals BytesFor() and the directory's decoded_bytes.
     out.positions.resize(point_count);
     if (normal != nullptr || shading_marked) out.normals.resize(point_count);
     if (uv != nullptr) out.uvs.resize(point_count);

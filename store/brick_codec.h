@@ -63,10 +63,6 @@ StatusOr<EncodedMesh> EncodeMeshSection(
 StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& grid,
                                       uint64_t material_count, const std::string& what);
 
-/// BrickMesh::MemoryBytes() of a decoded mesh with these counts (decoding allocates exactly this).
-uint64_t DecodedBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                      bool has_uvs);
-
 /// LZ4-compresses a side section: uint64 raw size, then one LZ4 block.
 std::string CompressSideSection(std::string_view raw);
 /// Inverse of CompressSideSection; errors (DataLoss) are prefixed by `what`.

@@ -29,7 +29,15 @@ struct BrickMesh {
     std::array<Vec3f, 3> TrianglePositions(size_t t) const {
         return {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
     }
-    /// Bytes held by the vectors (for memory budgets).
+    /// The bytes a mesh of these counts holds with its vectors at their exact sizes (as decoding
+    /// allocates them; a store directory's decoded_bytes).
+    static uint64_t BytesFor(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
+                             bool has_uvs) {
+        return vertex_count * (sizeof(Vec3f) + (has_normals ? sizeof(Vec3f) : 0) +
+                               (has_uvs ? sizeof(std::array<float, 2>) : 0)) +
+               triangle_count * (3 * sizeof(uint32_t) + sizeof(uint32_t));
+    }
+    /// Bytes held by the vectors (for memory budgets): BytesFor(counts) when sized exactly.
     size_t MemoryBytes() const {
         return positions.capacity() * sizeof(Vec3f) + normals.capacity() * sizeof(Vec3f) +
                uvs.capacity() * sizeof(uvs[0]) + indices.capacity() * 4 + material_ids.capacity() * 4;

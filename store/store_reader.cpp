@@ -102,7 +102,7 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
         const BrickInfo& b = e.info;
         const uint64_t entry_offset = h.directory.offset + uint64_t(b.id) * h.directory_entry_bytes;
         const uint64_t expected =
-            codec::DecodedBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
+            BrickMesh::BytesFor(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs);
         if (b.decoded_bytes != expected) {
             return DataLossError(
                 "{} brick {} @0x{:x}: decoded size {} != {} implied by its {} vertices and {} "

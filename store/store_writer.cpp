@@ -164,7 +164,7 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
             "{}: brick {} has a mesh section of {} bytes; use EncodeBrick to make one", name, id,
             brick.mesh_bytes.size());
     }
-    if (brick.decoded_bytes != codec::DecodedBytes(brick.vertex_count, brick.triangle_count,
+    if (brick.decoded_bytes != BrickMesh::BytesFor(brick.vertex_count, brick.triangle_count,
                                                    brick.has_normals, brick.has_uvs)) {
         return InvalidArgumentError(
             "{}: brick {}: decoded_bytes {} does not match its counts; use EncodeBrick", name, id,
