@@ -2,9 +2,10 @@
 // decodes it and compares it with the directory. Succeeds (exit 0) only if every brick is intact;
 // otherwise lists each damaged brick with its error and fails (exit 1).
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -33,24 +34,19 @@ Status Verify(const std::string& file, bool json, int threads) {
 
     // Bricks are independent and reads are positional: verify on several threads.
     ProgressBar progress("verify", s->header().triangle_count, "triangles");
-    std::atomic<uint32_t> next{0};
     std::mutex bad_mutex;
     std::vector<BadBrick> bad;
-    auto worker = [&] {
-        for (uint32_t id = next.fetch_add(1); id < brick_count; id = next.fetch_add(1)) {
+    tbb::task_arena arena(std::max(1, threads));
+    arena.execute([&] {
+        tbb::parallel_for(uint32_t(0), brick_count, [&](uint32_t id) {
             Status st = s->VerifyBrick(id);
             if (!st.ok()) {
                 std::lock_guard<std::mutex> lock(bad_mutex);
                 bad.push_back({id, st});
             }
             progress.Add(bricks[id].triangle_count);
-        }
-    };
-    const int n = std::max(1, std::min<int>(threads, int(std::max<uint32_t>(brick_count, 1))));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < n; ++i) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
+        });
+    });
     progress.Finish();
     std::sort(bad.begin(), bad.end(),
               [](const BadBrick& a, const BadBrick& b) { return a.id < b.id; });

@@ -1,10 +1,11 @@
 #include "core/rgb_to_spectrum.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <map>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "core/check.h"
 #include "core/illuminant.h"
@@ -195,9 +196,8 @@ RgbToSpectrumTable::RgbToSpectrumTable(const RgbColorSpace& space)
             }
         }
     };
-    std::vector<std::thread> threads;
-    for (int l = 0; l < 3; ++l) threads.emplace_back(solve_component, l);
-    for (std::thread& t : threads) t.join();
+    // The three components are independent.
+    tbb::parallel_for(0, 3, solve_component);
     max_node_delta_e_ = std::max({max_de[0], max_de[1], max_de[2]});
 }
 
