@@ -279,6 +279,7 @@ bool PathIntegrator::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& br
     SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
+    AbsorbInsideGlass(mat, h, &r);
     if (r.depth == 0) film_->AddAov(r.pixel, Vec3f(1, 1, 1) * mat.AlbedoForAov(), h.ns, hit.t);
     if (mat.emissive) {
         // Emission found by the path itself (two-sided; emissive surfaces are not light-sampled, so

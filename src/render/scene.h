@@ -69,6 +69,11 @@ struct SurfaceMaterial {
         }
         return emission.Sample(lambda);
     }
+    /// Solid glass that absorbs (a dielectric with an absorption coefficient), else null.
+    const DielectricMaterial* absorbing_dielectric() const {
+        const DielectricMaterial* d = black ? nullptr : std::get_if<DielectricMaterial>(&material);
+        return d != nullptr && d->absorption_per_m.MaxValue() > 0 ? d : nullptr;
+    }
     /// The window pane, if this is thin glass (rays cross it without bending).
     const ThinGlassMaterial* thin_glass() const {
         return black ? nullptr : std::get_if<ThinGlassMaterial>(&material);

@@ -117,6 +117,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
+    AbsorbInsideGlass(mat, h, &r);
     Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
@@ -147,6 +148,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
         // is still direct sunlight, which next-event estimation through glass already counts.
         r.beta = beta;
         if (r.beta.IsZero()) return false;
+        r.since_vertex += Length(h.p - r.origin);
         r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
         r.t_max = kInfinity;
         return true;
@@ -158,6 +160,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     r.beta = beta / (1 - q);
     if (r.beta.IsZero()) return false;
     r.origin = OffsetOrigin(h.p, h.ng, bs->wi);
+    r.since_vertex = 0;
     r.dir = bs->wi;
     r.t_max = kInfinity;
     r.depth += 1;

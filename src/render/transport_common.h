@@ -15,6 +15,7 @@
 #include "render/rng.h"
 #include "render/scene.h"
 #include "render/stream_scheduler.h"
+#include "render/surface_hit.h"
 
 namespace nave::render {
 
@@ -62,6 +63,16 @@ inline float PowerHeuristic(float a, float b) {
     if (std::isinf(a)) return 1;
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0 ? a2 / (a2 + b2) : 0;
+}
+
+/// A path or photon leaving solid absorbing glass through the hit `h` (its ray runs along the
+/// surface's outward, winding-given normal) crossed the glass from its last vertex: Beer-Lambert,
+/// exp(-α d) over that length d (Beer 1852), for closed, outward-wound objects not nested in
+/// another.
+inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, RayRecord* r) {
+    const DielectricMaterial* glass = m.absorbing_dielectric();
+    if (glass == nullptr || Dot(r->dir, h.ng) <= 0) return;
+    r->beta *= glass->Transmittance(r->since_vertex + Length(h.p - r->origin), r->lambda);
 }
 
 /// One pass over the bricks (pinned through `scheduler`, so through the pager when paging) calling
