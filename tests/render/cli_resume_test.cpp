@@ -1,5 +1,6 @@
 // End-to-end: `nave render --checkpoint / --resume / --stop-after / --checkpoint-every` as users
-// type them, on small built-in scenes: the resumed image is the uninterrupted one, and every
+// type them, on small built-in scenes: the resumed image is the uninterrupted one (bit for bit on
+// one thread with the fullest brick always first: prefer_resident above 1), and every
 // checkpoint that does not belong to the render, or is damaged, is refused with a message saying
 // why.
 
@@ -37,7 +38,8 @@ class CliResumeTest : public ::testing::Test {
                           const std::string& resolution = "32x24", int spp = 6) const {
         return RunNave("render --procedural clutter:bricks=2 --config " + kConfigs +
                        "test_clutter.toml --resolution " + resolution + " --spp " +
-                       std::to_string(spp) + " --threads 1 -o " + Path(out) + " " + extra);
+                       std::to_string(spp) + " --threads 1 --pager prefer_resident=2 -o " +
+                       Path(out) + " " + extra);
     }
     /// Expects `r` to have failed with exit code `code`, saying each of `says`.
     static void ExpectRefused(const CommandResult& r, int code,
@@ -59,7 +61,8 @@ TEST_F(CliResumeTest, StoppedAndResumedEqualsOneRunInBothModes) {
                 : "--procedural caustic --config " + kConfigs +
                       "test_caustic.toml --iterations 5 --photons 20000";
         const std::string render =
-            "render " + scene + " --resolution 32x24 --threads 1 --checkpoint-every 0 ";
+            "render " + scene +
+            " --resolution 32x24 --threads 1 --pager prefer_resident=2 --checkpoint-every 0 ";
         const CommandResult whole =
             RunNave(render + "--checkpoint " + Path("whole.ckpt") + " -o " + Path("whole.exr"));
         ASSERT_EQ(whole.exit_code, 0) << whole.output;
