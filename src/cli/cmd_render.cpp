@@ -423,22 +423,28 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                     "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
                     "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
+    cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
+                    "Write the render's state to FILE between passes (photon mode: iterations), at "
+                    "most every "
+                    "--checkpoint-every and after the last, so that --resume FILE continues it "
+                    "after a crash "
+                    "or "
+                    "an interruption (SIGINT/SIGTERM: finish the pass, write FILE, exit). Every "
+                    "pass then ends "
+                    "with all its rays traced (docs/render.md, \"Checkpoints\")")
+        ->type_name("FILE");
     cmd->add_option(
-        "--checkpoint", opts->checkpoint.checkpoint,
-        "Write the render's state to FILE between passes (photon mode: iterations), at most every "
-        "--checkpoint-every and after the last, so that --resume FILE continues it after a crash "
-        "or "
-        "an interruption (SIGINT/SIGTERM: finish the pass, write FILE, exit). Every pass then ends "
-        "with all its rays traced (docs/render.md, \"Checkpoints\")");
+           "--checkpoint-every", opts->checkpoint.checkpoint_every,
+           "Least time between two checkpoints, as 90s, 10m, 1.5h or 2d (0: after every pass or "
+           "iteration). Default 10m")
+        ->type_name("DURATION");
     cmd->add_option(
-        "--checkpoint-every", opts->checkpoint.checkpoint_every,
-        "Least time between two checkpoints, as 90s, 10m, 1.5h or 2d (0: after every pass or "
-        "iteration). Default 10m");
-    cmd->add_option(
-        "--resume", opts->checkpoint.resume,
-        "Continue the render whose checkpoint is FILE: same model, config, --resolution, --seed, "
-        "--photons, --mode and nave version, else refused; --spp / --iterations may be raised. "
-        "Checkpoints go on to FILE unless --checkpoint names another");
+           "--resume", opts->checkpoint.resume,
+           "Continue the render whose checkpoint is FILE: same model, config, --resolution, "
+           "--seed, "
+           "--photons, --mode and nave version, else refused; --spp / --iterations may be raised. "
+           "Checkpoints go on to FILE unless --checkpoint names another")
+        ->type_name("FILE");
     cmd->add_option("--stop-after", opts->checkpoint.stop_after,
                     "End this run after N passes (photon mode: iterations) of its own, writing the "
                     "image so far "

@@ -154,6 +154,36 @@ TEST_F(CliResumeTest, CheckpointEveryParsingErrors) {
     EXPECT_EQ(c->done, 6u);
 }
 
+TEST_F(CliResumeTest, SigintFinishesThePassWritesTheCheckpointAndNoImage) {
+    // Signalled once its first checkpoint exists (so its handlers are in place), a render of far
+    // more passes than it will get through stops at the end of its pass.
+    const std::string ckpt = Path("sig.ckpt");
+    const std::string script =
+        std::string(NAVE_BINARY) + " render --procedural clutter:bricks=2 --config " + kConfigs +
+        "test_clutter.toml --resolution 32x24 --spp 100000 --threads 1 --checkpoint-every 0 "
+        "--checkpoint " +
+        ckpt + " -o " + Path("sig.exr") + " > " + Path("sig.log") +
+        " 2>&1 & pid=$!; while [ ! -e " + ckpt +
+        " ]; do sleep 0.05; done; kill -INT $pid; "
+        "wait $pid; echo $?";
+    FILE* pipe = ::popen(("sh -c '" + script + "'").c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    char buffer[64] = {};
+    const size_t n = std::fread(buffer, 1, sizeof(buffer) - 1, pipe);
+    ::pclose(pipe);
+    const std::string exit_code(buffer, n);
+    auto log = ReadFileToString(Path("sig.log"));
+    ASSERT_TRUE(log.ok());
+    EXPECT_EQ(exit_code, "130\n") << *log;
+    EXPECT_NE(log->find("interrupted after"), std::string::npos) << *log;
+    EXPECT_NE(log->find("--resume " + ckpt), std::string::npos) << *log;
+    EXPECT_FALSE(std::filesystem::exists(Path("sig.exr")));
+    auto c = ReadCheckpoint(ckpt);
+    ASSERT_TRUE(c.ok()) << c.status().ToString();
+    EXPECT_GE(c->done, 1u);
+    EXPECT_LT(c->done, 100000u);
+}
+
 TEST_F(CliResumeTest, StaleTemporariesOfKilledRendersAreRemovedAndSaid) {
     // A pid that is surely gone: a child that has exited and been reaped.
     const pid_t child = ::fork();
