@@ -206,11 +206,18 @@ Status RunRender(const RenderOptions& o) {
             options.queue_memory_bytes = render::QueueMemoryBytes(memory);
         }
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        // Writing a checkpoint holds the film's and the guide's state beside them.
+        const uint64_t checkpoint_bytes =
+            session->checkpoints() ? render::CheckpointMemoryBytes(
+                                         config.render, config.camera.width, config.camera.height,
+                                         config.output.aov_albedo || config.output.aov_normal ||
+                                             config.output.aov_depth)
+                                   : 0;
         auto reserve_for = [&](const render::RenderSettings& settings) {
             return render::RenderReserveBytes(settings, config.camera.width, config.camera.height,
-                                              source->brick_count(), options.wave_overlap, CurrentRssBytes(),
-                                              options.queue_memory_bytes) +
-                   texture_bytes + MaxLoadScratchBytes(*source);
+                                              source->brick_count(), options.wave_overlap,
+                                              CurrentRssBytes(), options.queue_memory_bytes) +
+                   texture_bytes + MaxLoadScratchBytes(*source) + checkpoint_bytes;
         };
         uint64_t reserve = reserve_for(scene.settings);
         // When the bricks will not all fit, one wave for the whole image unless the user chose

@@ -33,6 +33,8 @@ class ByteWriter {
         bytes_.append(reinterpret_cast<const char*>(values), size_t(count) * sizeof(T));
     }
     void PutString(std::string_view text) { PutArray(text.data(), text.size()); }
+    /// Makes room for `bytes` more bytes at once (large states put value by value).
+    void Reserve(size_t bytes) { bytes_.reserve(bytes_.size() + bytes); }
 
     const std::string& bytes() const { return bytes_; }
     std::string Take() { return std::move(bytes_); }
@@ -55,18 +57,22 @@ class ByteReader {
         offset_ += sizeof(T);
         return Status::Ok();
     }
+    /// The count PutArray wrote before its values, which must be `expected`; the values can then
+    /// be read one by one with Get.
+    Status GetCount(uint64_t expected, std::string_view field) {
+        uint64_t count = 0;
+        NAVE_RETURN_IF_ERROR(Get(&count, field));
+        if (count == expected) return Status::Ok();
+        return DataLossError("{} @{}: {} holds {} values, expected {}", what_, offset_ - 8, field,
+                             count, expected);
+    }
     /// An array written by PutArray, which must hold exactly `expected` values.
     template <typename T>
     Status GetArray(T* values, uint64_t expected, std::string_view field) {
-        uint64_t count = 0;
-        NAVE_RETURN_IF_ERROR(Get(&count, field));
-        if (count != expected) {
-            return DataLossError("{} @{}: {} holds {} values, expected {}", what_, offset_ - 8,
-                                 field, count, expected);
-        }
-        NAVE_RETURN_IF_ERROR(Need(count * sizeof(T), field));
-        std::memcpy(values, bytes_.data() + offset_, size_t(count) * sizeof(T));
-        offset_ += size_t(count) * sizeof(T);
+        NAVE_RETURN_IF_ERROR(GetCount(expected, field));
+        NAVE_RETURN_IF_ERROR(Need(expected * sizeof(T), field));
+        std::memcpy(values, bytes_.data() + offset_, size_t(expected) * sizeof(T));
+        offset_ += size_t(expected) * sizeof(T);
         return Status::Ok();
     }
     /// A string written by PutString, of at most `max_bytes`.

@@ -50,31 +50,42 @@ StatusOr<std::string_view> Checkpoint::Section(const std::string& name,
 }
 
 Status WriteCheckpoint(const std::filesystem::path& path, const Checkpoint& checkpoint) {
-    ByteWriter body;
-    auto section = [&](const std::string& name, std::string_view bytes) {
-        body.PutString(name);
-        body.PutString(bytes);
+    NAVE_ASSIGN_OR_RETURN(AtomicFile out, AtomicFile::Create(path));
+    // The body goes to the file section by section, its checksum computed on the way and the
+    // header written last: the film and the guide are never copied into one buffer (under
+    // --memory they can be a good part of the reserve).
+    const std::string blank(kCheckpointHeaderBytes, '\0');
+    NAVE_RETURN_IF_ERROR(out.Write(blank));
+    StreamingChecksum64 body_sum;
+    auto piece = [&](std::string_view bytes) {
+        body_sum.Update(bytes.data(), bytes.size());
+        return out.Write(bytes);
     };
-    section("identity", EncodeIdentity(checkpoint.identity));
+    auto section = [&](const std::string& name, std::string_view bytes) -> Status {
+        ByteWriter frame;
+        frame.PutString(name);
+        frame.Put(uint64_t(bytes.size()));
+        NAVE_RETURN_IF_ERROR(piece(frame.bytes()));
+        return piece(bytes);
+    };
+    NAVE_RETURN_IF_ERROR(section("identity", EncodeIdentity(checkpoint.identity)));
     ByteWriter progress;
     progress.Put(checkpoint.done);
     progress.Put(checkpoint.elapsed_seconds);
-    section("progress", progress.bytes());
-    for (const auto& [name, bytes] : checkpoint.sections) section(name, bytes);
+    NAVE_RETURN_IF_ERROR(section("progress", progress.bytes()));
+    for (const auto& [name, bytes] : checkpoint.sections)
+        NAVE_RETURN_IF_ERROR(section(name, bytes));
 
     ByteWriter header;
     header.Put(kCheckpointMagic);
     header.Put(kCheckpointMajor);
     header.Put(kCheckpointMinor);
     header.Put(uint32_t(2 + checkpoint.sections.size()));
-    header.Put(uint64_t(body.bytes().size()));
-    header.Put(Checksum64(body.bytes().data(), body.bytes().size()));
+    header.Put(uint64_t(out.size() - kCheckpointHeaderBytes));
+    header.Put(body_sum.Digest());
     header.Put(Checksum64(header.bytes().data(), header.bytes().size()));
     NAVE_CHECK_EQ(header.bytes().size(), size_t(kCheckpointHeaderBytes));
-
-    NAVE_ASSIGN_OR_RETURN(AtomicFile out, AtomicFile::Create(path));
-    NAVE_RETURN_IF_ERROR(out.Write(header.bytes()));
-    NAVE_RETURN_IF_ERROR(out.Write(body.bytes()));
+    NAVE_RETURN_IF_ERROR(out.WriteAt(0, header.bytes().data(), header.bytes().size()));
     return out.Commit();
 }
 

@@ -114,25 +114,29 @@ Vec3d Film::SumXYZ(uint32_t pixel) const {
 
 namespace {
 
-// Atomics hold plain values: copied through a vector, so that the bytes are the values'.
+// Value by value, in PutArray's layout: a copy of a large film in between would add its size to
+// the memory a checkpoint takes.
 template <typename T>
 void PutAtomics(ByteWriter* out, const std::atomic<T>* values, size_t count) {
-    std::vector<T> plain(count);
-    for (size_t i = 0; i < count; ++i) plain[i] = values[i].load(std::memory_order_relaxed);
-    out->PutArray(plain.data(), plain.size());
+    out->Put(uint64_t(count));
+    for (size_t i = 0; i < count; ++i) out->Put(values[i].load(std::memory_order_relaxed));
 }
 
 template <typename T>
 Status GetAtomics(ByteReader* in, std::atomic<T>* values, size_t count, std::string_view field) {
-    std::vector<T> plain(count);
-    NAVE_RETURN_IF_ERROR(in->GetArray(plain.data(), count, field));
-    for (size_t i = 0; i < count; ++i) values[i].store(plain[i], std::memory_order_relaxed);
+    NAVE_RETURN_IF_ERROR(in->GetCount(count, field));
+    for (size_t i = 0; i < count; ++i) {
+        T value;
+        NAVE_RETURN_IF_ERROR(in->Get(&value, field));
+        values[i].store(value, std::memory_order_relaxed);
+    }
     return Status::Ok();
 }
 
 }  // namespace
 
 void Film::SaveState(ByteWriter* out) const {
+    out->Reserve(StateBytes(width_, height_, aov_ != nullptr));
     out->Put(int32_t(width_));
     out->Put(int32_t(height_));
     out->Put(uint8_t(aov_ != nullptr));

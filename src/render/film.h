@@ -82,6 +82,10 @@ class Film {
     /// beside it (same name, .png). Both through temp name + rename.
     Status Write(const std::filesystem::path& exr_path,
                  const std::vector<std::pair<std::string, std::string>>& metadata) const;
+    /// The bytes SaveState appends for a film of width x height (`aov`: with AOV buffers).
+    static uint64_t StateBytes(int width, int height, bool aov) {
+        return 64 + uint64_t(width) * uint64_t(height) * (5 * 8 + (aov ? 7 * 4 + 4 : 0));
+    }
     /// Appends the sums (not the output settings) to `out`, for a checkpoint. Not concurrent with
     /// adds.
     void SaveState(ByteWriter* out) const;

@@ -73,6 +73,7 @@ Status PathIntegrator::Run(RenderStats* stats, RenderSession* session) {
         NAVE_RETURN_IF_ERROR(guide_->LoadState(&in));
         NAVE_RETURN_IF_ERROR(in.ExpectEnd());
     }
+    session->ReleaseResumed();
     // Advanced by every path as it ends, on the workers: a wave can be the whole image.
     ProgressBar progress("render", pixels * uint64_t(std::max(spp, start)), "paths");
     progress.Add(pixels * uint64_t(start));

@@ -2,11 +2,34 @@
 
 #include "core/byte_stream.h"
 #include "core/log.h"
+#include "render/path_guide.h"
 
 namespace nave::render {
 
+uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int height, bool aov) {
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    uint64_t state = 0;
+    if (settings.mode == RenderSettings::Mode::kPath) {
+        if (settings.path_guiding)
+            state = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
+    } else {
+        // Four doubles per pixel, and a few photon guides of 128 x 128 doubles.
+        state = pixels * 4 * sizeof(double) + (uint64_t(1) << 20);
+    }
+    return Film::StateBytes(width, height, aov) + state;
+}
+
 RenderSession::RenderSession(const SessionOptions* options, Film* film)
-    : options_(options), film_(film), last_write_(std::chrono::steady_clock::now()) {}
+    : options_(options), film_(film), last_write_(std::chrono::steady_clock::now()) {
+    if (resume() != nullptr) {
+        start_ = int(resume()->done);
+        elapsed_before_s_ = resume()->elapsed_seconds;
+    }
+}
+
+void RenderSession::ReleaseResumed() {
+    if (resume() != nullptr) options_->resume->sections.clear();
+}
 
 StatusOr<std::string_view> RenderSession::Section(const std::string& name) const {
     NAVE_CHECK(resume() != nullptr) << "section " << name << " without a checkpoint";

@@ -18,8 +18,9 @@ namespace nave::render {
 
 /// What the command asks of the run.
 struct SessionOptions {
-    /// Continue from this state (already checked against `identity`); null: from the start.
-    const Checkpoint* resume = nullptr;
+    /// Continue from this state (already checked against `identity`); null: from the start. The
+    /// run drops its sections once restored (they can be as large as the film and the guide).
+    Checkpoint* resume = nullptr;
     /// The file `resume` was read from, for messages.
     std::string resume_name;
     /// Write checkpoints here; empty: none.
@@ -39,6 +40,12 @@ struct SessionOptions {
     bool active() const { return resume != nullptr || !checkpoint_path.empty() || stop_after > 0; }
 };
 
+/// The most memory writing a checkpoint takes beside the render (its sections, built one after
+/// the other and held until written): the film's state and the path guide's (path mode with
+/// render.path_guiding) or photon mode's per-pixel sums and photon guides. `aov`: the film has
+/// AOV buffers.
+uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int height, bool aov);
+
 /// One run's checkpointing, used by the integrators from the render's thread.
 class RenderSession {
   public:
@@ -49,8 +56,8 @@ class RenderSession {
     /// The checkpoint this run continues from, or null.
     const Checkpoint* resume() const { return options_ != nullptr ? options_->resume : nullptr; }
     /// Passes or iterations done before this run, and the seconds they took.
-    int start() const { return resume() != nullptr ? int(resume()->done) : 0; }
-    double elapsed_before_s() const { return resume() != nullptr ? resume()->elapsed_seconds : 0; }
+    int start() const { return start_; }
+    double elapsed_before_s() const { return elapsed_before_s_; }
     /// Restores the film from the checkpoint (nothing without one). Errors: a film section of
     /// another size or truncated.
     Status RestoreFilm();
@@ -58,6 +65,8 @@ class RenderSession {
     const std::string& resume_name() const { return options_->resume_name; }
     /// The bytes of section `name` of the checkpoint resumed from (there must be one).
     StatusOr<std::string_view> Section(const std::string& name) const;
+    /// Frees the checkpoint's sections once everything is restored from them.
+    void ReleaseResumed();
 
     /// Called after `done` passes or iterations in all, `elapsed_s` seconds of rendering in all;
     /// `last`: the render ends here anyway. Writes a checkpoint when one is due (or this run ends
@@ -68,6 +77,8 @@ class RenderSession {
   private:
     const SessionOptions* options_;
     Film* film_;
+    int start_ = 0;
+    double elapsed_before_s_ = 0;
     std::chrono::steady_clock::time_point last_write_;
 };
 

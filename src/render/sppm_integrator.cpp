@@ -50,6 +50,7 @@ Status SppmIntegrator::Run(RenderStats* stats, RenderSession* session) {
         ByteReader learned_in(learned, session->resume_name() + " section photon_emitters");
         NAVE_RETURN_IF_ERROR(emitters->LoadState(&learned_in));
     }
+    session->ReleaseResumed();
     ProgressBar progress("photon mapping", uint64_t(std::max(iterations, start)), "iterations");
     progress.Add(uint64_t(start));
     StoppingRule stop(scene_.settings, &progress, session->elapsed_before_s());
