@@ -104,9 +104,9 @@ echo "preprocess: ${pre_summary%, }; temporaries left by the kills: $pre_left, a
 out=$work/render/out.exr
 ckpt=$work/render/out.ckpt
 render_path=("$nave" render "$store" --config configs/abbey.toml --resolution 96x64 --threads 1
-             --pager prefer_resident=2 --checkpoint-every 0 --mode path --spp 16)
+             --pager prefer_resident=2 --checkpoint-every 0 --mode path --spp 40)
 render_photon=("$nave" render "$store" --config configs/abbey.toml --resolution 96x64 --threads 1
-               --pager prefer_resident=2 --checkpoint-every 0 --mode photon --iterations 8 --photons 40000)
+               --pager prefer_resident=2 --checkpoint-every 0 --mode photon --iterations 20 --photons 40000)
 declare -A render_s=()
 for mode in path photon; do
     declare -n cmd=render_$mode
@@ -119,8 +119,8 @@ for mode in path photon; do
     render_s[$mode]=$(seconds_since "$t0")
     unset -n cmd
 done
-echo "render: uninterrupted runs ${render_s[path]} s (path, 16 passes), ${render_s[photon]} s (photon, 8 iterations);" \
-    "$trials kills at random moments in [0, 1.2 x that)"
+echo "render: uninterrupted runs ${render_s[path]} s (path, 40 passes), ${render_s[photon]} s (photon, 20 iterations);" \
+    "$trials kills at random moments in [0, that)"
 declare -A render_outcomes=()
 resumed_same=0
 render_left=0
@@ -131,7 +131,7 @@ for ((i = 1; i <= trials; i++)); do
     old=$work/old_$mode.exr
     rm -f "$ckpt" "$work/render/out.png"
     if ((i % 2 == 1)); then cp "$old" "$out"; else rm -f "$out"; fi
-    delay=$(random_delay "$(awk -v t="${render_s[$mode]}" 'BEGIN { print 1.2 * t }')")
+    delay=$(random_delay "${render_s[$mode]}")
     "${cmd[@]}" -q --checkpoint "$ckpt" -o "$out" >"$work/render/run.log" 2>&1 &
     pid=$!
     sleep "$delay"
