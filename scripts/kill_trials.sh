@@ -36,10 +36,11 @@ seconds_since() {
     awk -v t0="$1" -v t1="$(date +%s.%N)" 'BEGIN { printf "%.2f", t1 - t0 }'
 }
 
-# Temporaries of nave runs in directory $1 (names carry the pid: "*.tmp-<pid>-<n>*",
-# ".nave-tmp-<pid>-<n>").
+# Temporaries of nave runs in directory $1 and its texture folder, relative to $1 (names carry the
+# pid: "*.tmp-<pid>-<n>*", ".tmp-<pid>-<n>.exr", ".nave-tmp-<pid>-<n>").
 temporaries() {
-    find "$1" -maxdepth 1 \( -name '*.tmp-*' -o -name '.nave-tmp-*' \) -printf '%f\n' | sort
+    find "$1" -mindepth 1 -maxdepth 2 \( -name '*.tmp-*' -o -name '.tmp-*' -o -name '.nave-tmp-*' \) -prune \
+        -printf '%P\n' | sort
 }
 
 # ---------------------------------------------------------------------------------------------
