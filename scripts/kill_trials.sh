@@ -53,13 +53,30 @@ pre_s=$(seconds_since "$t0")
 echo "preprocess: uninterrupted run $pre_s s; $trials kills at random moments in [0, 1.2 x that)"
 declare -A pre_outcomes=()
 pre_left=0
+pre_named=0
+pending=()  # temporaries left by kills and not yet removed
+# Each leftover in `pending` must, after the run whose log is $1, either be gone and named in that log,
+# or still be there (that run was killed before it looked).
+check_pending() {
+    local still=()
+    for name in "${pending[@]}"; do
+        if [[ -e $work/pre/$name ]]; then
+            still+=("$name")
+        elif grep -q "removed $work/pre/$name, left by an earlier nave run that was killed" "$1"; then
+            pre_named=$((pre_named + 1))
+        else
+            fail "$name was removed without the run saying so"
+        fi
+    done
+    pending=("${still[@]}")
+}
 for ((i = 1; i <= trials; i++)); do
     # Odd trials start with a complete store in place (it must survive or be replaced whole),
     # even ones with none.
     if ((i % 2 == 1)); then cp "$work/ref.nave" "$store"; else rm -f "$store"; fi
     before=$(sha256sum "$store" 2>/dev/null | cut -c1-64)
     delay=$(random_delay "$(awk -v t="$pre_s" 'BEGIN { print 1.2 * t }')")
-    "${preprocess[@]}" -q -o "$store" >"$work/pre/run.log" 2>&1 &
+    "${preprocess[@]}" -o "$store" >"$work/pre/run.log" 2>&1 &
     pid=$!
     sleep "$delay"
     kill -9 "$pid" 2>/dev/null && killed=yes || killed=no
@@ -76,26 +93,37 @@ for ((i = 1; i <= trials; i++)); do
         outcome=INVALID
         fail "trial $i: $store is neither the old store nor a valid one"
     fi
-    left=$(temporaries "$work/pre" | wc -l)
+    check_pending "$work/pre/run.log"
+    mine=$(temporaries "$work/pre" | grep -e "-$pid-" || true)
+    left=$(echo "$mine" | grep -c .)
     pre_left=$((pre_left + left))
+    for name in $mine; do pending+=("$name"); done
     pre_outcomes[$outcome]=$((${pre_outcomes[$outcome]:-0} + 1))
     printf '  trial %2d: kill -9 at %6.3f s (%s): store %s, %d temporaries left%s\n' "$i" "$delay" \
         "$([[ $killed == yes ]] && echo "while running" || echo "after it finished")" "$outcome" "$left" \
-        "$( ((left > 0)) && echo ": $(temporaries "$work/pre" | tr '\n' ' ')")"
+        "$( ((left > 0)) && echo ": $(echo $mine)")"
 done
-# The next run into the same place removes them all, saying so.
-leftovers=$(temporaries "$work/pre")
+# One more run killed half way, so that the last run below surely has leftovers to remove.
+"${preprocess[@]}" -o "$store" >"$work/pre/run.log" 2>&1 &
+pid=$!
+sleep "$(awk -v t="$pre_s" 'BEGIN { print 0.5 * t }')"
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+check_pending "$work/pre/run.log"
+half_left=0
+for name in $(temporaries "$work/pre" | grep -e "-$pid-"); do
+    pending+=("$name")
+    half_left=$((half_left + 1))
+done
 "${preprocess[@]}" -o "$store" >"$work/pre/clean.log" 2>&1 || fail "the run after the trials failed"
-for name in $leftovers; do
-    grep -q "removed $work/pre/$name, left by an earlier nave run that was killed" "$work/pre/clean.log" ||
-        fail "the next run did not say it removed $name"
-done
-[[ -z $(temporaries "$work/pre") ]] || fail "temporaries remain after the next run: $(temporaries "$work/pre")"
-"$nave" -q verify "$store" >/dev/null 2>&1 || fail "the store of the run after the trials does not verify"
+check_pending "$work/pre/clean.log"
+((${#pending[@]} == 0)) || fail "temporaries remain after the last run: ${pending[*]}"
+[[ -z $(temporaries "$work/pre") ]] || fail "temporaries remain after the last run: $(temporaries "$work/pre")"
+"$nave" -q verify "$store" >/dev/null 2>&1 || fail "the store of the last run does not verify"
 pre_summary=""
 for k in "${!pre_outcomes[@]}"; do pre_summary+="$k ${pre_outcomes[$k]}, "; done
-echo "preprocess: ${pre_summary%, }; temporaries left by the kills: $pre_left, all removed by the next run" \
-    "($(echo "$leftovers" | grep -c . ) present before it)"
+echo "preprocess: ${pre_summary%, }; temporaries left by the kills: $pre_left, plus $half_left by a run" \
+    "killed half way; $pre_named removed by a later run that named each in its log, none left"
 
 # ---------------------------------------------------------------------------------------------
 # Render with checkpoints after every pass, on one thread and the fullest brick always first
