@@ -269,14 +269,17 @@ Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(
         render::RenderStreams(scene, &film, &stats, {}, &options, &session->options));
     const bool photon = config.render.mode == render::RenderSettings::Mode::kPhoton;
-    if (session->options.stop_requested != nullptr && session->options.stop_requested->load()) {
-        // No image: the output must be either absent, the previous one, or a complete render.
+    const int done = photon ? stats.iterations : stats.samples_per_pixel;
+    const int asked = photon ? config.render.iterations : config.render.spp;
+    if (session->options.stop_requested != nullptr && session->options.stop_requested->load() &&
+        done < asked) {
+        // Stopped early, no image: the output is either absent, the previous one, or a complete
+        // render (a signal during the last pass does not cost the image).
         return Status(
             StatusCode::kCancelled,
             fmt::format("interrupted after {} {}: {} not written; the checkpoint {} continues it "
                         "(--resume {})",
-                        photon ? stats.iterations : stats.samples_per_pixel,
-                        photon ? "iterations" : "passes", out.string(),
+                        done, photon ? "iterations" : "passes", out.string(),
                         session->options.checkpoint_path.string(),
                         session->options.checkpoint_path.string()));
     }
