@@ -122,6 +122,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     stats.units = source->units();
 
     RemoveStaleOutputTemporaries(options.output);
+    RemoveStaleTextureTemporaries(options.output);
     std::filesystem::path temp_parent = !options.temp_dir.empty() ? options.temp_dir
                                         : options.output.has_parent_path()
                                             ? options.output.parent_path()

@@ -10,7 +10,9 @@
 
 #include "core/file.h"
 #include "core/hash.h"
+#include "core/log.h"
 #include "core/progress.h"
+#include "core/stale_temporaries.h"
 #include "imaging/make_texture.h"
 
 namespace nave::preprocess {
@@ -37,6 +39,16 @@ struct Converted {
 
 std::filesystem::path TextureFolderFor(const std::filesystem::path& store_path) {
     return store_path.parent_path() / (store_path.filename().string() + ".textures");
+}
+
+void RemoveStaleTextureTemporaries(const std::filesystem::path& store_path) {
+    const std::filesystem::path folder = TextureFolderFor(store_path);
+    if (!std::filesystem::is_directory(folder)) return;
+    // The extensions ConvertTextures writes.
+    for (const char* extension : {".exr", ".tx"}) {
+        for (const std::filesystem::path& p : RemoveStaleTemporaries(folder, ".tmp-", extension))
+            log::Info("removed {}, left by an earlier nave run that was killed", p.string());
+    }
 }
 
 bool IsColourTextureSlot(const std::string& slot) {

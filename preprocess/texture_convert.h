@@ -36,6 +36,10 @@ struct TextureConvertStats {
 /// The folder of converted textures for `store_path`: "<store file name>.textures" beside it.
 std::filesystem::path TextureFolderFor(const std::filesystem::path& store_path);
 
+/// Removes, and logs, the temporaries ".tmp-<pid>-<n>.exr" / ".tx" that conversions of killed runs
+/// left in TextureFolderFor(store_path) (those of processes still running stay).
+void RemoveStaleTextureTemporaries(const std::filesystem::path& store_path);
+
 /// True for slots whose texels are sRGB-encoded colours (map_Kd, map_Ka, map_Ks, map_Ke,
 /// baseColorTexture, emissiveTexture); false for data (alpha, normals, bump, roughness...).
 bool IsColourTextureSlot(const std::string& slot);

@@ -57,6 +57,9 @@ struct StoreHeader {
     uint64_t triangle_count = 0;  ///< sum over bricks (triangles crossing cells counted once per brick)
     uint64_t source_triangle_count = 0;  ///< triangles in the input before duplication across bricks
     StoreProvenance provenance;
+    /// XXH64 of the header's bytes as stored (which hold the checksums of every table): the
+    /// store's identity, for render checkpoints.
+    uint64_t header_checksum = 0;
 };
 
 }  // namespace nave::store

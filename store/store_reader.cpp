@@ -93,6 +93,8 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
     impl->header.bounds = h.bounds;
     impl->header.triangle_count = h.triangle_count;
     impl->header.source_triangle_count = h.source_triangle_count;
+    impl->header.header_checksum =
+        Checksum64(head.data(), std::min<size_t>(head.size(), h.header_bytes));
 
     // Cross-checks between tables: each passed its checksum, so a failure here is a writer bug or a
     // deliberate edit, and still must not reach the renderer.

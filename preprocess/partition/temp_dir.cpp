@@ -7,6 +7,10 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <vector>
+
+#include "core/log.h"
+#include "core/stale_temporaries.h"
 
 namespace nave::preprocess {
 namespace {
@@ -20,17 +24,11 @@ void OnSignal(int sig) {
     }
 }
 
-bool ProcessAlive(long pid) {
-    if (pid <= 0) return false;
-    return ::kill(pid_t(pid), 0) == 0 || errno == EPERM;
-}
-
-// The pid in "<prefix><pid>-<n>", or -1.
-long PidAfter(const std::string& name, const std::string& prefix) {
-    if (name.rfind(prefix, 0) != 0) return -1;
-    char* end = nullptr;
-    long pid = std::strtol(name.c_str() + prefix.size(), &end, 10);
-    return (end != nullptr && *end == '-') ? pid : -1;
+/// Says which leftovers of killed runs were removed: a user who finds space freed, or a file gone,
+/// learns why.
+void LogRemoved(const std::vector<std::filesystem::path>& removed) {
+    for (const std::filesystem::path& p : removed)
+        log::Info("removed {}, left by an earlier nave run that was killed", p.string());
 }
 
 }  // namespace
@@ -42,12 +40,7 @@ StatusOr<TempDir> TempDir::Create(const std::filesystem::path& parent) {
         return NotFoundError("{}: temporary directory parent does not exist", dir.string());
     }
     const std::string prefix = ".nave-tmp-";
-    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-        std::string name = entry.path().filename().string();
-        long pid = PidAfter(name, prefix);
-        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid))
-            std::filesystem::remove_all(entry.path(), ec);
-    }
+    LogRemoved(RemoveStaleTemporaries(dir, prefix));
     static std::atomic<int> counter{0};
     for (int attempt = 0; attempt < 100; ++attempt) {
         auto path = dir / (prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
@@ -72,15 +65,9 @@ TempDir::~TempDir() {
 }
 
 void RemoveStaleOutputTemporaries(const std::filesystem::path& output) {
-    std::error_code ec;
-    std::filesystem::path dir =
+    const std::filesystem::path dir =
         output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
-    const std::string prefix = output.filename().string() + ".tmp-";
-    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-        long pid = PidAfter(entry.path().filename().string(), prefix);
-        if (pid > 0 && pid != long(::getpid()) && !ProcessAlive(pid))
-            std::filesystem::remove(entry.path(), ec);
-    }
+    LogRemoved(RemoveStaleTemporaries(dir, output.filename().string() + ".tmp-"));
 }
 
 void InstallInterruptHandlers() {

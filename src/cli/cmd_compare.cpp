@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,7 +23,40 @@ struct CompareOptions {
     bool reference = false;
     int blur_radius = 0;
     bool json = false;
+    bool identical = false;
 };
+
+/// --identical: whether every channel of every pixel of the two images has the same bits (a
+/// resumed render against an uninterrupted one, say). Half-float EXR channels widen to float
+/// exactly, so equal floats are equal stored values.
+Status CompareIdentical(const CompareOptions& o) {
+    NAVE_ASSIGN_OR_RETURN(imaging::FloatImage a, imaging::ReadImage(o.a));
+    NAVE_ASSIGN_OR_RETURN(imaging::FloatImage b, imaging::ReadImage(o.b));
+    if (a.width != b.width || a.height != b.height || a.channels != b.channels) {
+        return DataLossError(
+            "{} ({}x{}, {} channels) and {} ({}x{}, {} channels) differ in size or "
+            "channels",
+            o.a, a.width, a.height, a.channels.size(), o.b, b.width, b.height, b.channels.size());
+    }
+    const size_t nc = a.channels.size();
+    uint64_t differing = 0;
+    size_t first = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(float)) == 0) continue;
+        if (differing++ == 0) first = i;
+    }
+    if (differing == 0) {
+        std::printf("%s and %s are identical (%dx%d, %zu channels)\n", o.a.c_str(), o.b.c_str(),
+                    a.width, a.height, nc);
+        return Status::Ok();
+    }
+    const size_t pixel = first / nc;
+    return DataLossError(
+        "{} and {} differ in {} of {} values; the first at pixel ({}, {}) channel "
+        "{}: {} vs {}",
+        o.a, o.b, differing, a.pixels.size(), pixel % size_t(a.width), pixel / size_t(a.width),
+        a.channels[first % nc], a.pixels[first], b.pixels[first]);
+}
 
 /// The luminance of an image's R, G, B channels, per pixel.
 StatusOr<std::vector<float>> ReadLuminance(const std::string& path, int* width, int* height) {
@@ -47,6 +81,7 @@ StatusOr<std::vector<float>> ReadLuminance(const std::string& path, int* width, 
 }
 
 Status RunCompare(const CompareOptions& o) {
+    if (o.identical) return CompareIdentical(o);
     int wa = 0, ha = 0, wb = 0, hb = 0;
     NAVE_ASSIGN_OR_RETURN(std::vector<float> a, ReadLuminance(o.a, &wa, &ha));
     NAVE_ASSIGN_OR_RETURN(std::vector<float> b, ReadLuminance(o.b, &wb, &hb));
@@ -99,6 +134,10 @@ void RegisterCompareCommand(CLI::App& app, CommandRun& run) {
            "Box-blur both images over this many pixels around each pixel first (default 0)")
         ->check(CLI::Range(0, 1000));
     cmd->add_flag("--json", o->json, "Print JSON");
+    cmd->add_flag(
+        "--identical", o->identical,
+        "Only check that A and B hold the same value in every channel of every pixel, bit for "
+        "bit (exit code 1 and the first difference if not)");
     cmd->callback([&run, o] { run = [o] { return RunCompare(*o); }; });
 }
 

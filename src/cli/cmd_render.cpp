@@ -6,6 +6,10 @@
 #include <optional>
 
 #include "cli/commands.h"
+#include "cli/interrupt.h"
+#include "cli/render_checkpoint.h"
+#include "core/file.h"
+#include "core/hash.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "core/progress.h"
@@ -17,6 +21,7 @@
 #include "render/procedural_scenes.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
+#include "store/store_reader.h"
 
 namespace nave::cli {
 namespace {
@@ -36,6 +41,7 @@ struct RenderOptions {
     std::string trace;       // --trace FILE.json
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     bool no_textures = false;
+    CheckpointFlags checkpoint;  // --checkpoint, --checkpoint-every, --resume, --stop-after
 };
 
 /// Parses "960x640" into width and height.
@@ -95,6 +101,7 @@ Status RunRender(const RenderOptions& o) {
     if (out.extension() != ".exr") {
         return InvalidArgumentError("-o {}: the output must end in .exr (the PNG is written beside it)", o.output);
     }
+    NAVE_RETURN_IF_ERROR(CheckCheckpointFlags(o.checkpoint));
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, render::LoadSceneConfig(o.config));
     if (!o.resolution.empty()) {
         NAVE_RETURN_IF_ERROR(ParseResolution(o.resolution, &config.camera.width, &config.camera.height));
@@ -123,11 +130,35 @@ Status RunRender(const RenderOptions& o) {
     // took as long as the BVH builds themselves (in-core abbey: 42 s -> 35 s with huge pages).
     NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create("hugepages=1"));
     std::unique_ptr<render::BrickSource> source;
+    uint64_t model_id = 0;  // what a checkpoint of this render must have been written for
     if (!o.model.empty()) {
-        NAVE_ASSIGN_OR_RETURN(source, render::StoreBrickSource::Open(o.model, device));
+        NAVE_ASSIGN_OR_RETURN(auto store, render::StoreBrickSource::Open(o.model, device));
+        model_id = store->store().header().header_checksum;
+        source = std::move(store);
     } else {
         NAVE_ASSIGN_OR_RETURN(source, render::OpenProceduralSource(o.procedural, device));
+        const std::string name = "procedural " + o.procedural;
+        model_id = Checksum64(name.data(), name.size());
     }
+    // Checked before the long work of building the scene: a checkpoint of another render is refused
+    // at once.
+    NAVE_ASSIGN_OR_RETURN(std::string config_text, ReadFileToString(o.config));
+    NAVE_ASSIGN_OR_RETURN(
+        std::unique_ptr<PreparedSession> session,
+        PrepareSession(
+            o.checkpoint,
+            RenderIdentity(model_id, o.model.empty() ? "procedural " + o.procedural : o.model,
+                           o.config, config_text, config)));
+    RemoveStaleRenderTemporaries(out, session->options.checkpoint_path);
+    if (session->options.resume != nullptr) {
+        log::Info(
+            "render: resuming from {} after {} {}", o.checkpoint.resume,
+            session->options.resume->done,
+            config.render.mode == render::RenderSettings::Mode::kPath ? "passes" : "iterations");
+    }
+    // Interrupted, a render that writes checkpoints finishes its pass and leaves one to resume
+    // from.
+    if (session->checkpoints()) session->options.stop_requested = InstallRenderInterruptHandlers();
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, *source));
     // The model's textures, through a capped tile cache (docs/textures.md); only when some material has one,
     // so that untextured models never load OpenImageIO's texture system.
@@ -175,11 +206,18 @@ Status RunRender(const RenderOptions& o) {
             options.queue_memory_bytes = render::QueueMemoryBytes(memory);
         }
         const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        // Writing a checkpoint holds the film's and the guide's state beside them.
+        const uint64_t checkpoint_bytes =
+            session->checkpoints() ? render::CheckpointMemoryBytes(
+                                         config.render, config.camera.width, config.camera.height,
+                                         config.output.aov_albedo || config.output.aov_normal ||
+                                             config.output.aov_depth)
+                                   : 0;
         auto reserve_for = [&](const render::RenderSettings& settings) {
             return render::RenderReserveBytes(settings, config.camera.width, config.camera.height,
-                                              source->brick_count(), options.wave_overlap, CurrentRssBytes(),
-                                              options.queue_memory_bytes) +
-                   texture_bytes + MaxLoadScratchBytes(*source);
+                                              source->brick_count(), options.wave_overlap,
+                                              CurrentRssBytes(), options.queue_memory_bytes) +
+                   texture_bytes + MaxLoadScratchBytes(*source) + checkpoint_bytes;
         };
         uint64_t reserve = reserve_for(scene.settings);
         // When the bricks will not all fit, one wave for the whole image unless the user chose
@@ -228,7 +266,23 @@ Status RunRender(const RenderOptions& o) {
 
     render::Film film(config.camera.width, config.camera.height, scene.output);
     render::RenderStats stats;
-    NAVE_RETURN_IF_ERROR(render::RenderStreams(scene, &film, &stats, {}, &options));
+    NAVE_RETURN_IF_ERROR(
+        render::RenderStreams(scene, &film, &stats, {}, &options, &session->options));
+    const bool photon = config.render.mode == render::RenderSettings::Mode::kPhoton;
+    const int done = photon ? stats.iterations : stats.samples_per_pixel;
+    const int asked = photon ? config.render.iterations : config.render.spp;
+    if (session->options.stop_requested != nullptr && session->options.stop_requested->load() &&
+        done < asked) {
+        // Stopped early, no image: the output is either absent, the previous one, or a complete
+        // render (a signal during the last pass does not cost the image).
+        return Status(
+            StatusCode::kCancelled,
+            fmt::format("interrupted after {} {}: {} not written; the checkpoint {} continues it "
+                        "(--resume {})",
+                        done, photon ? "iterations" : "passes", out.string(),
+                        session->options.checkpoint_path.string(),
+                        session->options.checkpoint_path.string()));
+    }
     // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),
     // so that the two never add up (the allocator keeps freed pages a while otherwise).
     for (uint32_t b = 0; b < source->brick_count(); ++b) source->Evict(b);
@@ -379,6 +433,33 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                     "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
                     "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
+    cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
+                    "Write the render's state to FILE between passes (photon mode: iterations), at "
+                    "most every "
+                    "--checkpoint-every and after the last, so that --resume FILE continues it "
+                    "after a crash "
+                    "or "
+                    "an interruption (SIGINT/SIGTERM: finish the pass, write FILE, exit). Every "
+                    "pass then ends "
+                    "with all its rays traced (docs/render.md, \"Checkpoints\")")
+        ->type_name("FILE");
+    cmd->add_option(
+           "--checkpoint-every", opts->checkpoint.checkpoint_every,
+           "Least time between two checkpoints, as 90s, 10m, 1.5h or 2d (0: after every pass or "
+           "iteration). Default 10m")
+        ->type_name("DURATION");
+    cmd->add_option(
+           "--resume", opts->checkpoint.resume,
+           "Continue the render whose checkpoint is FILE: same model, config, --resolution, "
+           "--seed, "
+           "--photons, --mode and nave version, else refused; --spp / --iterations may be raised. "
+           "Checkpoints go on to FILE unless --checkpoint names another")
+        ->type_name("FILE");
+    cmd->add_option("--stop-after", opts->checkpoint.stop_after,
+                    "End this run after N passes (photon mode: iterations) of its own, writing the "
+                    "image so far "
+                    "and the checkpoint: a long render in several sittings")
+        ->check(CLI::PositiveNumber);
     cmd->callback([&run, opts] { run = [opts] { return RunRender(*opts); }; });
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/atomic_add.h"
+#include "core/byte_stream.h"
 #include "core/check.h"
 #include "imaging/image_io.h"
 
@@ -109,6 +110,62 @@ Vec3d Film::SumXYZ(uint32_t pixel) const {
     return {xyz_[3 * size_t(pixel)].load(std::memory_order_relaxed),
             xyz_[3 * size_t(pixel) + 1].load(std::memory_order_relaxed),
             xyz_[3 * size_t(pixel) + 2].load(std::memory_order_relaxed)};
+}
+
+namespace {
+
+// Value by value, in PutArray's layout: a copy of a large film in between would add its size to
+// the memory a checkpoint takes.
+template <typename T>
+void PutAtomics(ByteWriter* out, const std::atomic<T>* values, size_t count) {
+    out->Put(uint64_t(count));
+    for (size_t i = 0; i < count; ++i) out->Put(values[i].load(std::memory_order_relaxed));
+}
+
+template <typename T>
+Status GetAtomics(ByteReader* in, std::atomic<T>* values, size_t count, std::string_view field) {
+    NAVE_RETURN_IF_ERROR(in->GetCount(count, field));
+    for (size_t i = 0; i < count; ++i) {
+        T value;
+        NAVE_RETURN_IF_ERROR(in->Get(&value, field));
+        values[i].store(value, std::memory_order_relaxed);
+    }
+    return Status::Ok();
+}
+
+}  // namespace
+
+void Film::SaveState(ByteWriter* out) const {
+    out->Reserve(StateBytes(width_, height_, aov_ != nullptr));
+    out->Put(int32_t(width_));
+    out->Put(int32_t(height_));
+    out->Put(uint8_t(aov_ != nullptr));
+    PutAtomics(out, xyz_.get(), pixel_count() * 3);
+    PutAtomics(out, y_half_.get(), pixel_count() * 2);
+    if (aov_) {
+        PutAtomics(out, aov_.get(), pixel_count() * 7);
+        PutAtomics(out, aov_count_.get(), pixel_count());
+    }
+}
+
+Status Film::LoadState(ByteReader* in) {
+    int32_t width = 0, height = 0;
+    uint8_t has_aov = 0;
+    NAVE_RETURN_IF_ERROR(in->Get(&width, "width"));
+    NAVE_RETURN_IF_ERROR(in->Get(&height, "height"));
+    NAVE_RETURN_IF_ERROR(in->Get(&has_aov, "AOV flag"));
+    if (width != width_ || height != height_ || bool(has_aov) != (aov_ != nullptr)) {
+        return DataLossError("{}: a film of {}x{}{}, this render's is {}x{}{}", in->what(), width,
+                             height, has_aov ? " with AOVs" : "", width_, height_,
+                             aov_ ? " with AOVs" : "");
+    }
+    NAVE_RETURN_IF_ERROR(GetAtomics(in, xyz_.get(), pixel_count() * 3, "XYZ sums"));
+    NAVE_RETURN_IF_ERROR(GetAtomics(in, y_half_.get(), pixel_count() * 2, "half sums"));
+    if (aov_) {
+        NAVE_RETURN_IF_ERROR(GetAtomics(in, aov_.get(), pixel_count() * 7, "AOV sums"));
+        NAVE_RETURN_IF_ERROR(GetAtomics(in, aov_count_.get(), pixel_count(), "AOV counts"));
+    }
+    return in->ExpectEnd();
 }
 
 std::vector<float> Film::LinearRgb() const {

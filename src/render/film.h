@@ -19,6 +19,11 @@
 #include "core/vecmath.h"
 #include "render/scene_config.h"
 
+namespace nave {
+class ByteReader;
+class ByteWriter;
+}  // namespace nave
+
 namespace nave::render {
 
 /// The 8-bit sRGB display image of linear sRGB pixels `rgb` (3 per pixel, in the film's units: a
@@ -77,6 +82,16 @@ class Film {
     /// beside it (same name, .png). Both through temp name + rename.
     Status Write(const std::filesystem::path& exr_path,
                  const std::vector<std::pair<std::string, std::string>>& metadata) const;
+    /// The bytes SaveState appends for a film of width x height (`aov`: with AOV buffers).
+    static uint64_t StateBytes(int width, int height, bool aov) {
+        return 64 + uint64_t(width) * uint64_t(height) * (5 * 8 + (aov ? 7 * 4 + 4 : 0));
+    }
+    /// Appends the sums (not the output settings) to `out`, for a checkpoint. Not concurrent with
+    /// adds.
+    void SaveState(ByteWriter* out) const;
+    /// Replaces the sums with those SaveState wrote. Errors: DataLoss for a film of another size
+    /// or other channels, or truncated bytes. Not concurrent with adds.
+    Status LoadState(ByteReader* in);
     /// Linear RGB of the output space (sRGB primaries) after white balance, per pixel.
     std::vector<float> LinearRgb() const;
 

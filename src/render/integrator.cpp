@@ -17,18 +17,19 @@ namespace nave::render {
 namespace {
 
 /// Runs the mode of scene.settings on `scheduler` and fills `stats`.
-Status Render(const RenderScene& scene, Film* film, RenderStats* stats,
-              StreamScheduler& scheduler) {
+Status Render(const RenderScene& scene, Film* film, RenderStats* stats, StreamScheduler& scheduler,
+              const SessionOptions* options) {
+    RenderSession session(options, film);
     const auto start = std::chrono::steady_clock::now();
     const BrickSourceStats before = scene.source->stats();
     if (scene.settings.mode == RenderSettings::Mode::kPath) {
         NAVE_ASSIGN_OR_RETURN(std::unique_ptr<LightSampler> lights,
                               LightSampler::Create(scene, scheduler, nullptr));
         PathIntegrator paths(scene, film, scheduler, *lights);
-        NAVE_RETURN_IF_ERROR(paths.Run(stats));
+        NAVE_RETURN_IF_ERROR(paths.Run(stats, &session));
     } else {
         SppmIntegrator sppm(scene, film, scheduler);
-        NAVE_RETURN_IF_ERROR(sppm.Run(stats));
+        NAVE_RETURN_IF_ERROR(sppm.Run(stats, &session));
     }
     stats->wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -44,7 +45,7 @@ uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource&
 }
 
 Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker,
-                     const PagerOptions* paging) {
+                     const PagerOptions* paging, const SessionOptions* session) {
     NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
     int threads = scene.settings.threads > 0 ? scene.settings.threads
                                              : tbb::this_task_arena::max_concurrency();
@@ -54,7 +55,7 @@ Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, B
         StreamScheduler scheduler(*scene.source, std::move(picker), scene.settings.wave_paths);
         // In-core too, the pager loads bricks in the background while the workers trace.
         status = scheduler.EnablePaging(paging != nullptr ? *paging : PagerOptions());
-        if (status.ok()) status = Render(scene, film, stats, scheduler);
+        if (status.ok()) status = Render(scene, film, stats, scheduler, session);
     });
     return status;
 }

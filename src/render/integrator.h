@@ -20,6 +20,7 @@
 #include "core/status.h"
 #include "render/film.h"
 #include "render/pager.h"
+#include "render/render_session.h"
 #include "render/scene.h"
 
 namespace nave::render {
@@ -80,13 +81,15 @@ using BrickPicker = std::function<uint32_t(const std::vector<size_t>& waiting, c
 /// The default policy: the most rays waiting, lowest id on ties.
 uint32_t PickFullestBrick(const std::vector<size_t>& waiting, const BrickSource& source);
 
-/// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's resolution.
-/// Thread count: scene.settings.threads (0: all cores). `picker` empty: the pager's choice (the fullest
-/// resident brick first). `paging` null: in-core with the default tunables (bricks stay once loaded, and
-/// are loaded in the background while the workers trace); else bricks are paged under
-/// paging->brick_budget_bytes (pager.h; kUnlimitedBrickBudget is in-core), and an impossible budget is
-/// refused before anything is traced.
-Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker = {},
-                     const PagerOptions* paging = nullptr);
+/// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's
+/// resolution. Thread count: scene.settings.threads (0: all cores). `picker` empty: the pager's
+/// choice (the fullest resident brick first). `paging` null: in-core with the default tunables
+/// (bricks stay once loaded, and are loaded in the background while the workers trace); else bricks
+/// are paged under paging->brick_budget_bytes (pager.h; kUnlimitedBrickBudget is in-core), and an
+/// impossible budget is refused before anything is traced. `session` (null: one run from the start)
+/// continues from a checkpoint, writes checkpoints and may end the run early (render_session.h).
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats,
+                     BrickPicker picker = {}, const PagerOptions* paging = nullptr,
+                     const SessionOptions* session = nullptr);
 
 }  // namespace nave::render

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <tuple>
 
+#include "core/byte_stream.h"
 #include "core/check.h"
 #include "core/sampling.h"
 
@@ -180,6 +181,55 @@ void PathGuide::Update(uint32_t min_credits) {
         levels_[c.level].slot[c.index] = uint32_t(cells_.size());
         cells_.push_back(std::make_unique<Cell>());
     }
+}
+
+void PathGuide::SaveState(ByteWriter* out) const {
+    for (const Level& level : levels_) {
+        out->PutArray(level.slot.get(), level.size);
+        out->PutArray(level.count.get(), level.size);
+    }
+    out->Put(uint32_t(cells_.size()));
+    for (const std::unique_ptr<Cell>& cell : cells_) {
+        out->Put(cell->sum);
+        out->Put(cell->cdf);
+        out->Put(cell->credits);
+        out->Put(uint8_t(cell->guiding));
+    }
+    out->Put(cells_guiding_);
+}
+
+Status PathGuide::LoadState(ByteReader* in) {
+    for (Level& level : levels_) {
+        NAVE_RETURN_IF_ERROR(in->GetArray(level.slot.get(), level.size, "guide cell slots"));
+        NAVE_RETURN_IF_ERROR(in->GetArray(level.count.get(), level.size, "guide cell counts"));
+    }
+    uint32_t cells = 0;
+    NAVE_RETURN_IF_ERROR(in->Get(&cells, "guide cell count"));
+    if (cells > max_cells_) {
+        return DataLossError("{}: {} guide cells, at most {} expected", in->what(), cells,
+                             max_cells_);
+    }
+    for (const Level& level : levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) {
+            if (level.slot[i] != kNoCell && level.slot[i] >= cells) {
+                return DataLossError("{}: guide slot {} points at cell {} of {}", in->what(), i,
+                                     level.slot[i], cells);
+            }
+        }
+    }
+    cells_.clear();
+    for (uint32_t c = 0; c < cells; ++c) {
+        auto cell = std::make_unique<Cell>();
+        uint8_t guiding = 0;
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->sum, "guide cell sums"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distribution"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->credits, "guide cell credits"));
+        NAVE_RETURN_IF_ERROR(in->Get(&guiding, "guide cell flag"));
+        cell->guiding = guiding != 0;
+        cells_.push_back(std::move(cell));
+    }
+    NAVE_RETURN_IF_ERROR(in->Get(&cells_guiding_, "guiding cell count"));
+    return Status::Ok();
 }
 
 const float* PathGuide::Distribution(const Vec3f& p, int side) const {

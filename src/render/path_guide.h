@@ -19,8 +19,14 @@
 #include <vector>
 
 #include "core/spectrum.h"
+#include "core/status.h"
 #include "core/vecmath.h"
 #include "render/materials/bxdf.h"
+
+namespace nave {
+class ByteReader;
+class ByteWriter;
+}  // namespace nave
 
 namespace nave::render {
 
@@ -95,6 +101,14 @@ class PathGuide {
                                       float u1) const;
     /// The solid-angle pdf of Sample at `p`, `side` for direction `w` (0 if no cell there guides).
     float Pdf(const Vec3f& p, int side, const Vec3f& w) const;
+
+    /// Appends everything learned (credits, counts, cells and their distributions) to `out`, for
+    /// a checkpoint; LoadState into a guide made with the same arguments restores it exactly (the
+    /// credits are integers). Not concurrent with Credit or Update.
+    void SaveState(ByteWriter* out) const;
+    /// Replaces the guide's state with what SaveState wrote. Errors: DataLoss for another grid,
+    /// more cells than the cap, or truncated bytes. Not concurrent with anything.
+    Status LoadState(ByteReader* in);
 
     /// Cells holding histograms, and those of them guiding since the last Update.
     uint32_t cells_used() const { return uint32_t(cells_.size()); }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/byte_stream.h"
 #include "core/image_error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -57,27 +58,43 @@ double PathIntegrator::GuideRadianceScale() const {
     return scale > 0 ? scale : 1.0;
 }
 
-Status PathIntegrator::Run(RenderStats* stats) {
+Status PathIntegrator::Run(RenderStats* stats, RenderSession* session) {
     const Camera& camera = *scene_.camera;
     const uint64_t pixels = uint64_t(camera.width()) * camera.height();
     const int spp = scene_.settings.spp;
     const uint64_t wave = scene_.settings.wave_paths;
+    RenderSession one_run(nullptr, film_);
+    if (session == nullptr) session = &one_run;
+    const int start = session->start();
+    NAVE_RETURN_IF_ERROR(session->RestoreFilm());
+    if (guide_ && session->resume() != nullptr) {
+        NAVE_ASSIGN_OR_RETURN(std::string_view bytes, session->Section("path_guide"));
+        ByteReader in(bytes, session->resume_name() + " section path_guide");
+        NAVE_RETURN_IF_ERROR(guide_->LoadState(&in));
+        NAVE_RETURN_IF_ERROR(in.ExpectEnd());
+    }
+    session->ReleaseResumed();
     // Advanced by every path as it ends, on the workers: a wave can be the whole image.
-    ProgressBar progress("render", pixels * uint64_t(spp), "paths");
+    ProgressBar progress("render", pixels * uint64_t(std::max(spp, start)), "paths");
+    progress.Add(pixels * uint64_t(start));
     progress_ = &progress;
     struct Unset {
         ProgressBar*& bar;
         ~Unset() { bar = nullptr; }
     } unset{progress_};  // before `progress` goes, whichever way Run returns
-    StoppingRule stop(scene_.settings, &progress);
-    int passes = 0;
+    StoppingRule stop(scene_.settings, &progress, session->elapsed_before_s());
+    int passes = start;
     // Small images put several passes in one wave, so that the streams stay long enough to keep
     // every thread busy; large images split a pass into waves to bound the memory of the queues.
-    const int passes_per_wave = int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
+    // A render that may be checkpointed ends every pass with a complete drain instead: its state
+    // is then the film and the guide alone, and the order in which the film adds up its samples
+    // does not depend on when checkpoints were written.
+    const int passes_per_wave =
+        session->active() ? 1 : int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
     // With a noise target or a time limit, a wave stops for a check at least every quarter of the
     // passes done so far (2, 3, 4, 5, ... 8, 10, 12, 15...): at most ~25 % more passes than needed.
     const bool checks = scene_.settings.noise_target > 0 || scene_.settings.time_limit_s > 0;
-    for (int s = 0; s < spp;) {
+    for (int s = start; s < spp;) {
         const int group =
             checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
         int s_end = std::min(spp, s + group);
@@ -93,8 +110,8 @@ Status PathIntegrator::Run(RenderStats* stats) {
                 NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k), nullptr));
             NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
         }
+        if (update || session->active()) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
         if (update) {
-            NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
             guide_->Update();
             log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
                        guide_->cells_used(), guide_->cells_guiding());
@@ -103,7 +120,18 @@ Status PathIntegrator::Run(RenderStats* stats) {
         s = s_end;
         // The last wave's tail may still be in flight: the estimate misses a little of the last
         // pass, which the final estimate, after the last drain, does not.
-        if (stop.ShouldStop([&] { return NoiseEstimate(passes); })) break;
+        const bool enough = stop.ShouldStop([&] { return NoiseEstimate(passes); });
+        bool end_run = false;
+        NAVE_RETURN_IF_ERROR(session->AtBoundary(
+            passes, stop.Elapsed(), enough || passes >= spp,
+            [&](Checkpoint* checkpoint) {
+                if (!guide_) return;
+                ByteWriter out;
+                guide_->SaveState(&out);
+                checkpoint->sections["path_guide"] = out.Take();
+            },
+            &end_run));
+        if (enough || end_run) break;
     }
     NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));  // the last wave's tail
     progress.Finish();

@@ -16,6 +16,7 @@
 #include "render/light_sampling.h"
 #include "render/path_guide.h"
 #include "render/ray.h"
+#include "render/render_session.h"
 #include "render/scene.h"
 #include "render/stream_scheduler.h"
 
@@ -39,8 +40,10 @@ class PathIntegrator final : public RayProcessor {
 
     /// Path mode: renders scene.settings.spp passes (fewer once time_limit_s runs out or the
     /// noise estimate reaches noise_target) in waves of wave_paths, and fills samples_per_pixel,
-    /// camera_paths and noise_relmse of `stats`.
-    Status Run(RenderStats* stats);
+    /// camera_paths and noise_relmse of `stats`. `session` (may be null: one run from the start)
+    /// resumes from a checkpoint, writes checkpoints and may end the run early. Errors: a
+    /// checkpoint that does not match this scene, a failed checkpoint write.
+    Status Run(RenderStats* stats, RenderSession* session = nullptr);
     /// Queues the camera rays of pixels [first, last) for sample `sample` (wavelengths per path, or
     /// the iteration's when `lambda` is given), spilling queues beyond their cap as it goes.
     /// Errors: a failed spill.

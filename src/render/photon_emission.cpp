@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/byte_stream.h"
 #include "core/sampling.h"
 #include "render/materials/frame.h"
 #include "render/sppm.h"
@@ -235,6 +236,27 @@ void PhotonEmitters::Learn(std::span<const float> deposited) {
     }
     for (PhotonGuide& guide : guides_) guide.Update();
     std::fill(photon_cells_.begin(), photon_cells_.end(), kNoGuideCell);
+}
+
+void PhotonEmitters::SaveState(ByteWriter* out) const {
+    out->Put(uint32_t(guides_.size()));
+    for (const PhotonGuide& guide : guides_)
+        out->PutArray(guide.learned().data(), guide.learned().size());
+}
+
+Status PhotonEmitters::LoadState(ByteReader* in) {
+    uint32_t guides = 0;
+    NAVE_RETURN_IF_ERROR(in->Get(&guides, "photon guide count"));
+    if (guides != guides_.size()) {
+        return DataLossError("{}: {} photon guides, this scene has {}", in->what(), guides,
+                             guides_.size());
+    }
+    for (PhotonGuide& guide : guides_) {
+        std::vector<double> learned(guide.learned().size());
+        NAVE_RETURN_IF_ERROR(in->GetArray(learned.data(), learned.size(), "photon guide cells"));
+        NAVE_CHECK(guide.SetLearned(std::move(learned)));
+    }
+    return in->ExpectEnd();
 }
 
 void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,

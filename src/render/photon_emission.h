@@ -19,6 +19,11 @@
 #include "render/photon_portals.h"
 #include "render/scene.h"
 
+namespace nave {
+class ByteReader;
+class ByteWriter;
+}  // namespace nave
+
 namespace nave::render {
 
 class StreamScheduler;
@@ -40,6 +45,11 @@ class PhotonEmitters {
     /// deposited[k], the luminance photon k brought to the visible points, for the first
     /// learned_photons() photons of the pass.
     void Learn(std::span<const float> deposited);
+    /// Appends what the guides learned to `out`, for a checkpoint.
+    void SaveState(ByteWriter* out) const;
+    /// Restores what SaveState saved, as after the Learn calls that learned it. Errors: DataLoss
+    /// for other guides or truncated bytes.
+    Status LoadState(ByteReader* in);
     /// How many photons of a pass Learn looks at (the first ones): a cap on its memory.
     uint64_t learned_photons() const { return photon_cells_.size(); }
     /// The bytes learning takes with `photons_per_iteration`: per learned photon its start cell

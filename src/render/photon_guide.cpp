@@ -47,6 +47,13 @@ void PhotonGuide::Learn(std::span<const uint16_t> cells, std::span<const float> 
     Update();
 }
 
+bool PhotonGuide::SetLearned(std::vector<double> learned) {
+    if (learned.size() != learned_.size()) return false;
+    learned_ = std::move(learned);
+    Update();
+    return true;
+}
+
 void PhotonGuide::Update() {
     total_ = 0;
     cdf_.assign(1, 0.0);

@@ -45,6 +45,11 @@ class PhotonGuide {
         if (cell != kNoCell && deposited > 0 && deposited < 1e30f) learned_[cell] += deposited;
     }
     void Update();
+    /// What Learn has gathered so far (per cell), for a checkpoint; SetLearned restores it and
+    /// updates the distribution, exactly as after the Learn that gathered it.
+    const std::vector<double>& learned() const { return learned_; }
+    /// False (and nothing changed) if `learned` does not hold one value per cell.
+    bool SetLearned(std::vector<double> learned);
 
   private:
     int cells_;

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/atomic_add.h"
+#include "core/byte_stream.h"
 #include "core/color.h"
 #include "render/rng.h"
 #include "render/scene.h"
@@ -197,6 +198,41 @@ void VisiblePoints::EndIteration(int half) {
     // Knaus & Zwicker 2011 eq. 16: r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1).
     radius_ *= float(std::sqrt((iteration_ + double(alpha_)) / (iteration_ + 1.0)));
     ++iteration_;
+}
+
+void VisiblePoints::SaveState(ByteWriter* out) const {
+    out->Put(radius_);
+    out->Put(int32_t(iteration_));
+    out->Put(deposits_.load(std::memory_order_relaxed));
+    std::vector<double> sums(pixel_count_ * 4);
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        for (int c = 0; c < 3; ++c) sums[4 * i + c] = pixels_[i].density_sum[c];
+        sums[4 * i + 3] = pixels_[i].density_sum_y_half0;
+    }
+    out->PutArray(sums.data(), sums.size());
+}
+
+Status VisiblePoints::LoadState(ByteReader* in) {
+    int32_t iteration = 0;
+    uint64_t deposits = 0;
+    NAVE_RETURN_IF_ERROR(in->Get(&radius_, "radius"));
+    NAVE_RETURN_IF_ERROR(in->Get(&iteration, "iteration"));
+    NAVE_RETURN_IF_ERROR(in->Get(&deposits, "deposits"));
+    std::vector<double> sums(pixel_count_ * 4);
+    NAVE_RETURN_IF_ERROR(in->GetArray(sums.data(), sums.size(), "pixel density sums"));
+    if (!(radius_ > 0) || iteration < 1) {
+        return DataLossError(
+            "{}: radius {} at iteration {}, expected a positive radius from "
+            "iteration 1 on",
+            in->what(), radius_, iteration);
+    }
+    iteration_ = iteration;
+    deposits_.store(deposits, std::memory_order_relaxed);
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        for (int c = 0; c < 3; ++c) pixels_[i].density_sum[c] = sums[4 * i + c];
+        pixels_[i].density_sum_y_half0 = sums[4 * i + 3];
+    }
+    return in->ExpectEnd();
 }
 
 Vec3d VisiblePoints::IndirectXYZ(uint32_t pixel, double photons_emitted) const {

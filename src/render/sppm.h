@@ -39,17 +39,23 @@
 // sphere overlaps, so a photon landing in a brick finds all the points it can reach in that brick's
 // own grid.
 
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
 #include <vector>
 
 #include "core/spectrum.h"
+#include "core/status.h"
 #include "core/vecmath.h"
 #include "imaging/texture_cache.h"
 #include "store/brick_tree.h"
+
+namespace nave {
+class ByteReader;
+class ByteWriter;
+}  // namespace nave
 
 namespace nave::render {
 
@@ -114,6 +120,12 @@ class VisiblePoints {
     /// The luminance of the same estimate from the iterations of half `half` alone,
     /// `photons_emitted` being the photons of those iterations.
     double IndirectHalfY(uint32_t pixel, int half, double photons_emitted) const;
+    /// Between two iterations (after EndIteration): appends the radius, the iteration and every
+    /// pixel's sums to `out`, for a checkpoint. The visible points themselves are remade by each
+    /// iteration and are not saved.
+    void SaveState(ByteWriter* out) const;
+    /// Replaces what SaveState saved. Errors: DataLoss for another pixel count or truncated bytes.
+    Status LoadState(ByteReader* in);
     /// The gather radius of the current iteration (metres).
     float radius() const { return radius_; }
     uint64_t deposits() const { return deposits_.load(std::memory_order_relaxed); }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/byte_stream.h"
 #include "core/image_error.h"
 #include "core/progress.h"
 #include "render/light_sampling.h"
@@ -22,7 +23,7 @@ SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamSched
       scheduler_(scheduler),
       sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
 
-Status SppmIntegrator::Run(RenderStats* stats) {
+Status SppmIntegrator::Run(RenderStats* stats, RenderSession* session) {
     const Camera& camera = *scene_.camera;
     const uint64_t pixels = uint64_t(camera.width()) * camera.height();
     const int iterations = scene_.settings.iterations;
@@ -37,10 +38,24 @@ Status SppmIntegrator::Run(RenderStats* stats) {
     visible_ = std::make_unique<VisiblePoints>(pixels, scene_.source->brick_count(), radius,
                                                scene_.settings.alpha);
     PathIntegrator camera_paths(scene_, film_, scheduler_, *lights, visible_.get());
-    ProgressBar progress("photon mapping", uint64_t(iterations), "iterations");
-    StoppingRule stop(scene_.settings, &progress);
-    int done = 0;
-    for (int it = 0; it < iterations; ++it) {
+    RenderSession one_run(nullptr, film_);
+    if (session == nullptr) session = &one_run;
+    const int start = session->start();
+    NAVE_RETURN_IF_ERROR(session->RestoreFilm());
+    if (session->resume() != nullptr) {
+        NAVE_ASSIGN_OR_RETURN(std::string_view points, session->Section("visible_points"));
+        ByteReader points_in(points, session->resume_name() + " section visible_points");
+        NAVE_RETURN_IF_ERROR(visible_->LoadState(&points_in));
+        NAVE_ASSIGN_OR_RETURN(std::string_view learned, session->Section("photon_emitters"));
+        ByteReader learned_in(learned, session->resume_name() + " section photon_emitters");
+        NAVE_RETURN_IF_ERROR(emitters->LoadState(&learned_in));
+    }
+    session->ReleaseResumed();
+    ProgressBar progress("photon mapping", uint64_t(std::max(iterations, start)), "iterations");
+    progress.Add(uint64_t(start));
+    StoppingRule stop(scene_.settings, &progress, session->elapsed_before_s());
+    int done = start;
+    for (int it = start; it < iterations; ++it) {
         iteration_ = uint32_t(it);
         camera_paths.set_iteration(iteration_);
         visible_->BeginIteration(uint64_t(scene_.settings.seed), iteration_, photons);
@@ -64,7 +79,20 @@ Status SppmIntegrator::Run(RenderStats* stats) {
         visible_->EndIteration(Film::SampleHalf(iteration_));
         done = it + 1;
         progress.Add(1);
-        if (stop.ShouldStop([&] { return NoiseEstimate(done); })) break;
+        // Every iteration ends with its photons drained: a checkpoint needs no extra drain here.
+        const bool enough = stop.ShouldStop([&] { return NoiseEstimate(done); });
+        bool end_run = false;
+        NAVE_RETURN_IF_ERROR(session->AtBoundary(
+            done, stop.Elapsed(), enough || done >= iterations,
+            [&](Checkpoint* checkpoint) {
+                ByteWriter points, learned;
+                visible_->SaveState(&points);
+                emitters->SaveState(&learned);
+                checkpoint->sections["visible_points"] = points.Take();
+                checkpoint->sections["photon_emitters"] = learned.Take();
+            },
+            &end_run));
+        if (enough || end_run) break;
     }
     progress.Finish();
     // Direct light and specular chains were summed by the film over `done` iterations; the photon

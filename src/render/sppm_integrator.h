@@ -15,6 +15,7 @@
 #include "render/integrator.h"
 #include "render/photon_emission.h"
 #include "render/ray.h"
+#include "render/render_session.h"
 #include "render/scene.h"
 #include "render/sppm.h"
 #include "render/stream_scheduler.h"
@@ -33,8 +34,10 @@ class SppmIntegrator final : public RayProcessor {
     /// noise estimate reaches noise_target) and adds
     /// the photon estimate to the film; fills iterations, samples_per_pixel, camera_paths and
     /// photons of `stats`. Errors: no emitter, portal settings without portals, a brick that cannot
-    /// be pinned.
-    Status Run(RenderStats* stats);
+    /// be pinned. `session` (may be null: one run from the start) resumes from a checkpoint, writes
+    /// checkpoints and may end the run early; errors: a checkpoint that does not match this scene,
+    /// a failed checkpoint write.
+    Status Run(RenderStats* stats, RenderSession* session = nullptr);
 
     void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                       std::span<const RayRecord> rays, RayOutbox& out) override;

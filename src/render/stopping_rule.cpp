@@ -8,14 +8,17 @@
 
 namespace nave::render {
 
-StoppingRule::StoppingRule(const RenderSettings& settings, ProgressBar* progress)
+StoppingRule::StoppingRule(const RenderSettings& settings, ProgressBar* progress,
+                           double elapsed_before_s)
     : time_limit_s_(settings.time_limit_s),
       noise_target_(settings.noise_target),
       progress_(progress),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()),
+      elapsed_before_s_(elapsed_before_s) {}
 
 double StoppingRule::Elapsed() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    return elapsed_before_s_ +
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
 bool StoppingRule::ShouldStop(const std::function<double()>& noise) {

@@ -6,6 +6,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -133,6 +134,28 @@ TEST_F(TextureConvertTest, NoTexturesNoFolder) {
     StatusOr<TextureConvertStats> stats = ConvertTextures(&materials, {dir_}, dir_ / "m.nave");
     ASSERT_TRUE(stats.ok());
     EXPECT_FALSE(std::filesystem::exists(TextureFolderFor(dir_ / "m.nave")));
+}
+
+// A conversion killed outright leaves ".tmp-<pid>-<n>.exr" in the folder: the next run removes it
+// when its process is gone, and keeps the converted textures and a running process's temporaries.
+TEST_F(TextureConvertTest, StaleTemporariesOfKilledRunsAreRemoved) {
+    const std::filesystem::path store = dir_ / "m.nave";
+    const std::filesystem::path folder = TextureFolderFor(store);
+    std::filesystem::create_directories(folder);
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
+    for (const std::string& name : {".tmp-" + dead + "-0.exr", ".tmp-" + dead + "-1.tx",
+                                    ".tmp-" + alive + "-0.exr", std::string("wood.0123.exr")})
+        std::ofstream(folder / name) << "x";
+    RemoveStaleTextureTemporaries(store);
+    EXPECT_FALSE(std::filesystem::exists(folder / (".tmp-" + dead + "-0.exr")));
+    EXPECT_FALSE(std::filesystem::exists(folder / (".tmp-" + dead + "-1.tx")));
+    EXPECT_TRUE(std::filesystem::exists(folder / (".tmp-" + alive + "-0.exr")));
+    EXPECT_TRUE(std::filesystem::exists(folder / "wood.0123.exr"));
 }
 
 }  // namespace
