@@ -410,7 +410,9 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--time-limit", opts->time_limit,
                     "Override render.time_limit_s (seconds; 0: none)")
         ->check(CLI::Range(0.0, 1e7));
-    cmd->add_option("--photons", opts->photons, "Override render.photons_per_iteration")->check(CLI::PositiveNumber);
+    cmd->add_option("--photons", opts->photons,
+                    "Override render.photons_per_iteration (at most 4294967295)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
     cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
     cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));

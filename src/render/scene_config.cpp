@@ -508,7 +508,10 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Double("time_limit_s", &s->time_limit_s, 0, 1e7));
     NAVE_RETURN_IF_ERROR(r.Double("noise_target", &s->noise_target, 0, 100));
     NAVE_RETURN_IF_ERROR(r.Int("iterations", &s->iterations, 1, 1 << 20));
-    NAVE_RETURN_IF_ERROR(r.Int("photons_per_iteration", &s->photons_per_iteration, 1, int64_t(1) << 36));
+    // A photon's index within its iteration keys its random numbers in 32 bits (RayRecord::pixel):
+    // beyond that, photons would repeat each other's.
+    NAVE_RETURN_IF_ERROR(
+        r.Int("photons_per_iteration", &s->photons_per_iteration, 1, int64_t(UINT32_MAX)));
     NAVE_RETURN_IF_ERROR(r.Float("initial_radius_m", &s->initial_radius_m, 0, 1e6));
     NAVE_RETURN_IF_ERROR(r.Float("alpha", &s->alpha, 0.01, 1));
     NAVE_RETURN_IF_ERROR(r.Int("max_depth", &s->max_depth, 1, 1000));

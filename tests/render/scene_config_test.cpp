@@ -91,6 +91,19 @@ TEST(SceneConfig, UnknownTopLevelTable) {
     EXPECT_NE(c.status().message().find("'rendr'"), std::string::npos) << c.status().message();
 }
 
+// A photon's number within its iteration keys its random numbers in 32 bits: more photons than that
+// in one iteration would repeat each other's, so the config refuses them.
+TEST(SceneConfig, PhotonsPerIterationFitIn32Bits) {
+    const std::string camera = "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\n";
+    auto most = ParseSceneConfig(camera + "photons_per_iteration = 4294967295\n", "s.toml");
+    ASSERT_TRUE(most.ok()) << most.status().ToString();
+    EXPECT_EQ(most->render.photons_per_iteration, 4294967295);
+    auto over = ParseSceneConfig(camera + "photons_per_iteration = 4294967296\n", "s.toml");
+    ASSERT_FALSE(over.ok());
+    EXPECT_NE(over.status().message().find("render.photons_per_iteration"), std::string::npos)
+        << over.status().message();
+}
+
 TEST(SceneConfig, WrongTypeSaysExpectedAndFound) {
     auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfov_deg = \"wide\"\n", "s.toml");
     ASSERT_FALSE(c.ok());
