@@ -40,7 +40,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=2, help="runs per setting; the fastest is kept")
     ap.add_argument("--budgets", default="0.5,0.25,0.1,0.05", help="fractions of the in-core brick bytes")
     ap.add_argument("--tune-at", type=float, default=0.1, help="budget fraction where tunables are varied")
-    ap.add_argument("--variants", default="prefetch=off;overlap=0;overlap=0.25;nearly_empty=1;nearly_empty=65536;"
+    ap.add_argument("--variants", default="prefetch=off;wave_overlap=0;wave_overlap=0.25;nearly_empty_rays=1;nearly_empty_rays=65536;"
                     "prefer_resident=0.25;evict=traffic", help="';'-separated --pager settings tried at --tune-at")
     args = ap.parse_args()
 

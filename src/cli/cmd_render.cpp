@@ -424,10 +424,9 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--memory", opts->memory,
                     "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
                     "Default: every brick stays resident once loaded");
-    cmd->add_option("--pager", opts->pager,
-                    "Pager tunables, comma separated (docs/pager.md): prefetch=on|off, loaders=N, "
-                    "nearly_empty=RAYS, prefer_resident=FRACTION, evict=lru|traffic, overlap=FRACTION, "
-                    "bvh=low|medium|high, bvh_compact=on|off, cache=on|off, cache_limit=SIZE, queue_memory=SIZE");
+    cmd->add_option(
+        "--pager", opts->pager,
+        "Pager tunables, comma separated (docs/pager.md): " + std::string(render::kPagerTunables));
     cmd->add_option("--temp-dir", opts->temp_dir,
                     "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "
                     "and vanish when nave exits. Default: beside the output");

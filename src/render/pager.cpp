@@ -35,10 +35,7 @@ Status ParseOnOff(std::string_view key, std::string_view value, bool* out) {
 }  // namespace
 
 Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
-    constexpr const char* kKeys =
-        "prefetch=on|off, loaders=N, nearly_empty=RAYS, prefer_resident=FRACTION, "
-        "evict=lru|traffic, overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off, "
-        "cache=on|off, cache_limit=SIZE, queue_memory=SIZE";
+    constexpr std::string_view kKeys = kPagerTunables;
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
@@ -84,19 +81,19 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->bvh.compact));
         } else if (key == "evict") {
             if (value == "lru") {
-                options->evict_least_traffic = false;
+                options->evict = PagerOptions::Evict::kLru;
             } else if (value == "traffic") {
-                options->evict_least_traffic = true;
+                options->evict = PagerOptions::Evict::kTraffic;
             } else {
                 return InvalidArgumentError("pager tunable evict={}: expected lru or traffic",
                                             value);
             }
-        } else if (key == "nearly_empty") {
+        } else if (key == "nearly_empty_rays") {
             uint64_t rays = 0;
             auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), rays);
             if (ec != std::errc() || end != value.data() + value.size()) {
-                return InvalidArgumentError("pager tunable nearly_empty={}: expected a ray count",
-                                            value);
+                return InvalidArgumentError(
+                    "pager tunable nearly_empty_rays={}: expected a ray count", value);
             }
             options->nearly_empty_rays = size_t(rays);
         } else if (key == "loaders") {
@@ -107,13 +104,13 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                     "pager tunable loaders={}: expected a thread count from 1 to 64", value);
             }
             options->loaders = n;
-        } else if (key == "overlap") {
+        } else if (key == "wave_overlap") {
             std::string v(value);
             char* end = nullptr;
             double f = std::strtod(v.c_str(), &end);
             if (v.empty() || end != v.c_str() + v.size() || !(f >= 0 && f <= 1)) {
                 return InvalidArgumentError(
-                    "pager tunable overlap={}: expected a fraction in [0, 1]", value);
+                    "pager tunable wave_overlap={}: expected a fraction in [0, 1]", value);
             }
             options->wave_overlap = f;
         } else if (key == "prefer_resident") {
@@ -378,8 +375,9 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
         if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
         // Nearly empty queues count as empty when traffic decides: their few rays matter less than
         // how busy the brick is.
-        if (options_.evict_least_traffic && w < options_.nearly_empty_rays) w = 0;
-        candidates.push_back({w, options_.evict_least_traffic ? traffic_[b] : 0, last_used_[b], b});
+        const bool by_traffic = options_.evict == PagerOptions::Evict::kTraffic;
+        if (by_traffic && w < options_.nearly_empty_rays) w = 0;
+        candidates.push_back({w, by_traffic ? traffic_[b] : 0, last_used_[b], b});
     }
     // Emptiest queue first: the fewer rays wait for a brick, the fewer need it back soon (the paper
     // unloads a sub-model once almost all its rays are handled); least recently used breaks ties.

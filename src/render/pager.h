@@ -57,9 +57,10 @@ struct PagerOptions {
     /// one has at least this fraction of the fullest brick's rays waiting (0: drain resident bricks
     /// before any load; above 1: always the fullest brick, as in-core).
     double prefer_resident = 0;
-    /// Among bricks evictable alike, evict first the least recently used (false) or the one that
-    /// has taken the fewest rays so far (true: busy bricks, like the floor in view, stay).
-    bool evict_least_traffic = false;
+    /// Among bricks evictable alike, which goes first: the least recently used, or the one that
+    /// has taken the fewest rays so far (busy bricks, like the floor in view, stay).
+    enum class Evict { kLru, kTraffic };
+    Evict evict = Evict::kLru;
     /// The next wave of camera paths (or photons) is generated once no more than this fraction of a
     /// wave's paths are still waiting, so that its rays join the previous wave's tail (0: waves do
     /// not overlap).
@@ -99,8 +100,15 @@ uint32_t WavePathsUnderPaging(const RenderSettings& settings, int width, int hei
 /// enough that the batch and the two rays each of its rays may send on stay within the cap.
 size_t MaxBatchRays(uint64_t queue_memory_bytes);
 
-/// Parses "prefetch=off,nearly_empty=4096,prefer_resident=0.25" (any subset, comma separated) into
-/// `options`. Errors name the key or value and list the accepted keys.
+/// The tunables ParsePagerTunables accepts, for help texts and errors; each key is named after the
+/// PagerOptions field it sets.
+inline constexpr std::string_view kPagerTunables =
+    "prefetch=on|off, loaders=N, nearly_empty_rays=RAYS, prefer_resident=FRACTION, "
+    "evict=lru|traffic, wave_overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off, "
+    "cache=on|off, cache_limit=SIZE, queue_memory=SIZE";
+
+/// Parses "prefetch=off,nearly_empty_rays=4096,prefer_resident=0.25" (any subset, comma separated)
+/// into `options`. Errors name the key or value and list the accepted keys.
 Status ParsePagerTunables(std::string_view text, PagerOptions* options);
 
 /// The smallest brick budget paging can work with: the largest brick plus, with prefetching, room

@@ -345,11 +345,13 @@ TEST_F(PagerTest, PickPrefersAResidentBrickWithEnoughRays) {
 
 TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     PagerOptions o;
-    ASSERT_TRUE(ParsePagerTunables(
-                    "prefetch=off,nearly_empty=100,prefer_resident=0.5,evict=traffic,overlap=0", &o)
-                    .ok());
+    ASSERT_TRUE(
+        ParsePagerTunables(
+            "prefetch=off,nearly_empty_rays=100,prefer_resident=0.5,evict=traffic,wave_overlap=0",
+            &o)
+            .ok());
     EXPECT_FALSE(o.prefetch);
-    EXPECT_TRUE(o.evict_least_traffic);
+    EXPECT_EQ(o.evict, PagerOptions::Evict::kTraffic);
     EXPECT_EQ(o.wave_overlap, 0.0);
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
@@ -358,8 +360,8 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     EXPECT_FALSE(o.brick_cache);
     EXPECT_EQ(o.brick_cache_limit_bytes, uint64_t(3) << 30);
     for (const char* bad :
-         {"prefetch=maybe", "nearly_empty=-3", "prefer_resident=x", "speed=11", "prefetch",
-          "evict=random", "overlap=2", "cache=yes", "cache_limit=lots"}) {
+         {"prefetch=maybe", "nearly_empty_rays=-3", "prefer_resident=x", "speed=11", "prefetch",
+          "evict=random", "wave_overlap=2", "cache=yes", "cache_limit=lots"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));
