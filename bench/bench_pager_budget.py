@@ -133,8 +133,8 @@ def main():
             "peak_rss_bytes": stats["peak_rss"],
             "stall_s": stats["stall"],
             "prefetch_loads": stats["prefetch_loads"],
-            "prefetch_hits": stats["prefetch_hits"],
-            "brick_visits": stats["brick_visits"],
+            "resident_hits": stats["resident_hits"],
+            "batches": stats["batches"],
         })
         return row
 
@@ -174,7 +174,7 @@ def main():
               "time_s", "time_ratio", "runs_s", "cpu_s",
               "loads", "reloads", "evictions", "bytes_read", "peak_brick_bytes", "peak_rss_bytes",
               "process_peak_rss_bytes", "stall_s",
-              "prefetch_loads", "prefetch_hits", "brick_visits", "process_s"]
+              "prefetch_loads", "resident_hits", "batches", "process_s"]
     nave_bench.write_csv(csv_path, fields, rows)
     print(f"wrote {csv_path}", file=sys.stderr)
 

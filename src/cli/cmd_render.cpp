@@ -299,17 +299,20 @@ Status RunRender(const RenderOptions& o) {
         config.render.threads, config.render.noise_target, config.render.time_limit_s);
     std::string statistics = fmt::format(
         "wall={:.3f}s rays={} segments={} shadow_segments={} photons={} brick_moves={} "
-        "brick_visits={} brick_loads={} bytes_read={} peak_rss={} brick_budget={} "
+        "batches={} brick_loads={} bytes_read={} peak_rss={} brick_budget={} "
         "peak_brick_bytes={} brick_evictions={} brick_reloads={} prefetch_loads={} "
-        "prefetch_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
+        "resident_hits={} stall={:.3f}s brick_cache_reads={} brick_cache_disk_bytes={} "
         "spilled_rays={} spill_bytes_written={} memory_returns={} noise_relmse={:.6g}",
         stats.wall_seconds, stats.rays, stats.segments_traced, stats.shadow_segments, stats.photons,
-        stats.brick_moves, stats.batches, stats.brick_loads, stats.bytes_read, stats.peak_rss_bytes,
-        stats.brick_budget_bytes > 0 ? std::to_string(stats.brick_budget_bytes)
-                                     : std::string("in-core"),
-        stats.peak_brick_bytes, stats.brick_evictions, stats.brick_reloads, stats.prefetch_loads,
-        stats.prefetch_hits, stats.stall_seconds, stats.cache_reads, stats.cache_disk_bytes,
-        stats.spilled_rays, stats.spill_bytes_written, stats.memory_returns, stats.noise_relmse);
+        stats.brick_moves, stats.batches, stats.residency.loads, stats.bytes_read,
+        stats.peak_rss_bytes,
+        stats.residency.brick_budget_bytes > 0 ? std::to_string(stats.residency.brick_budget_bytes)
+                                               : std::string("in-core"),
+        stats.residency.peak_resident_bytes, stats.residency.evictions, stats.residency.reloads,
+        stats.residency.prefetch_loads, stats.residency.resident_hits,
+        stats.residency.stall_seconds, stats.cache_reads, stats.cache_disk_bytes,
+        stats.spilled_rays, stats.spill_bytes_written, stats.residency.memory_returns,
+        stats.noise_relmse);
     std::vector<std::pair<std::string, std::string>> metadata = {
         {"Software", std::string("nave ") + NAVE_VERSION},
         {"nave:model", o.model.empty() ? "procedural " + o.procedural : o.model},
@@ -330,44 +333,46 @@ Status RunRender(const RenderOptions& o) {
     const uint64_t process_peak = PeakRssBytes();
     std::filesystem::path png = out;
     png.replace_extension(".png");
-    std::fprintf(stderr,
-                 "nave render: wrote %s and %s\n"
-                 "  time %s, %s rays/s (%s rays: %s segments traced, %s shadow segments), %s photons/s\n"
-                 "  rays moved between bricks %s, brick visits %s, loads %s, read %s, peak memory %s (%llu "
-                 "bytes), peak queues %s\n",
-                 out.string().c_str(), png.string().c_str(), FormatDuration(stats.wall_seconds).c_str(),
-                 FormatCount(double(rays) / secs).c_str(), FormatCount(double(rays)).c_str(),
-                 FormatCount(double(stats.segments_traced)).c_str(),
-                 FormatCount(double(stats.shadow_segments)).c_str(),
-                 FormatCount(double(stats.photons) / secs).c_str(), FormatCount(double(stats.brick_moves)).c_str(),
-                 FormatCount(double(stats.batches)).c_str(), FormatCount(double(stats.brick_loads)).c_str(),
-                 FormatBytes(stats.bytes_read).c_str(), FormatBytes(process_peak).c_str(),
-                 static_cast<unsigned long long>(process_peak),
-                 FormatBytes(stats.peak_queue_bytes).c_str());
-    std::fprintf(stderr, "  %s\n", NoiseLine(config.render, stats).c_str());
     std::fprintf(
         stderr,
-        "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
-        "resident when needed %s of %s, workers stalled on loads %s%s\n",
-        memory_limit
-            ? ("budget " + FormatBytes(stats.brick_budget_bytes) + " (--memory " + o.memory + ")")
-                  .c_str()
-            : "in-core",
-        FormatBytes(stats.peak_brick_bytes).c_str(),
-        memory_limit ? fmt::format(" ({:.0f}% of budget)", 100.0 * double(stats.peak_brick_bytes) /
-                                                               double(stats.brick_budget_bytes))
+        "nave render: wrote %s and %s\n"
+        "  time %s, %s rays/s (%s rays: %s segments traced, %s shadow segments), %s photons/s\n"
+        "  rays moved between bricks %s, brick visits %s, loads %s, read %s, peak memory %s (%llu "
+        "bytes), peak queues %s\n",
+        out.string().c_str(), png.string().c_str(), FormatDuration(stats.wall_seconds).c_str(),
+        FormatCount(double(rays) / secs).c_str(), FormatCount(double(rays)).c_str(),
+        FormatCount(double(stats.segments_traced)).c_str(),
+        FormatCount(double(stats.shadow_segments)).c_str(),
+        FormatCount(double(stats.photons) / secs).c_str(),
+        FormatCount(double(stats.brick_moves)).c_str(), FormatCount(double(stats.batches)).c_str(),
+        FormatCount(double(stats.residency.loads)).c_str(), FormatBytes(stats.bytes_read).c_str(),
+        FormatBytes(process_peak).c_str(), static_cast<unsigned long long>(process_peak),
+        FormatBytes(stats.peak_queue_bytes).c_str());
+    std::fprintf(stderr, "  %s\n", NoiseLine(config.render, stats).c_str());
+    std::fprintf(stderr,
+                 "  bricks: %s, peak resident %s%s, evictions %s, reloads %s, prefetched %s, "
+                 "resident when needed %s of %s, workers stalled on loads %s%s\n",
+                 memory_limit ? ("budget " + FormatBytes(stats.residency.brick_budget_bytes) +
+                                 " (--memory " + o.memory + ")")
+                                    .c_str()
+                              : "in-core",
+                 FormatBytes(stats.residency.peak_resident_bytes).c_str(),
+                 memory_limit ? fmt::format(" ({:.0f}% of budget)",
+                                            100.0 * double(stats.residency.peak_resident_bytes) /
+                                                double(stats.residency.brick_budget_bytes))
+                                    .c_str()
+                              : "",
+                 FormatCount(double(stats.residency.evictions)).c_str(),
+                 FormatCount(double(stats.residency.reloads)).c_str(),
+                 FormatCount(double(stats.residency.prefetch_loads)).c_str(),
+                 FormatCount(double(stats.residency.resident_hits)).c_str(),
+                 FormatCount(double(stats.residency.acquires)).c_str(),
+                 FormatDuration(stats.residency.stall_seconds).c_str(),
+                 stats.residency.memory_returns > 0
+                     ? fmt::format(", free pages given back {} times near --memory",
+                                   stats.residency.memory_returns)
                            .c_str()
-                     : "",
-        FormatCount(double(stats.brick_evictions)).c_str(),
-        FormatCount(double(stats.brick_reloads)).c_str(),
-        FormatCount(double(stats.prefetch_loads)).c_str(),
-        FormatCount(double(stats.prefetch_hits)).c_str(),
-        FormatCount(double(stats.brick_acquires)).c_str(),
-        FormatDuration(stats.stall_seconds).c_str(),
-        stats.memory_returns > 0
-            ? fmt::format(", free pages given back {} times near --memory", stats.memory_returns)
-                  .c_str()
-            : "");
+                     : "");
     if (stats.spilled_rays > 0) {
         std::fprintf(stderr, "  ray queues: %s rays spilled to disk (%s written, at most %s on disk at once)\n",
                      FormatCount(double(stats.spilled_rays)).c_str(), FormatBytes(stats.spill_bytes_written).c_str(),

@@ -35,19 +35,11 @@ struct RenderStats {
     uint64_t shadow_segments = 0;  ///< shadow-ray segments traced inside a brick (occlusion queries)
     uint64_t photons = 0;          ///< photons emitted
     uint64_t brick_moves = 0;      ///< rays queued at another brick (crossed a cell face or spawned there)
-    uint64_t batches = 0;          ///< brick visits by the scheduler
-    uint64_t brick_loads = 0;
+    uint64_t batches = 0;          ///< times the scheduler gave the workers a brick's waiting rays
     uint64_t bytes_read = 0;
-    // Residency (docs/pager.md). In-core: no budget, no evictions; stall = time the scheduler waited for loads.
-    uint64_t brick_budget_bytes = 0;   ///< 0: in-core (no --memory)
-    uint64_t peak_brick_bytes = 0;     ///< peak bytes of resident bricks (pager: plus the load being made)
-    uint64_t brick_evictions = 0;
-    uint64_t brick_reloads = 0;        ///< loads of a brick already loaded before during this render
-    uint64_t prefetch_loads = 0;       ///< loads done by the background loader
-    uint64_t prefetch_hits = 0;        ///< bricks already resident when the scheduler asked for them
-    uint64_t brick_acquires = 0;
-    uint64_t memory_returns = 0;  ///< times the allocator gave its free pages back near --memory
-    double stall_seconds = 0;          ///< time the workers idled while the scheduler waited for a load
+    /// Bricks in memory (docs/pager.md): the pager's counts. In-core: no budget (0), no evictions,
+    /// stall = time the scheduler waited for loads.
+    PagerStats residency;
     uint64_t peak_rss_bytes = 0;
     uint64_t peak_queue_bytes = 0;
     // The brick cache under a budget (BrickMeshCache): meshes written, loads it served, its size

@@ -408,7 +408,7 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     std::unique_lock<std::mutex> lock(mutex_);
     last_used_[id] = ++tick_;
     ++stats_.acquires;
-    if (state_[id] == State::kResident) ++stats_.prefetch_hits;
+    if (state_[id] == State::kResident) ++stats_.resident_hits;
     bool waited = false;
     for (;;) {
         if (state_[id] == State::kResident) {

@@ -147,7 +147,7 @@ inline constexpr uint64_t kImageWriterBytes = uint64_t(128) << 20;
 
 /// What the pager did during one render.
 struct PagerStats {
-    uint64_t brick_budget_bytes = 0;
+    uint64_t brick_budget_bytes = 0;  ///< 0: in-core (no --memory)
     uint64_t peak_resident_bytes =
         0;                        ///< peak of resident bricks' bytes plus the reservation of a load
     uint64_t loads = 0;           ///< bricks loaded (on demand and prefetched)
@@ -155,7 +155,7 @@ struct PagerStats {
     uint64_t reloads = 0;         ///< loads of a brick this render had loaded before
     uint64_t evictions = 0;
     uint64_t acquires = 0;         ///< bricks pinned for a batch (or for the emitters' pass)
-    uint64_t prefetch_hits = 0;    ///< of which were already resident when asked for
+    uint64_t resident_hits = 0;    ///< of which were already resident when asked for
     uint64_t estimate_misses = 0;  ///< loads whose real size exceeded the estimate (should stay 0)
     uint64_t memory_returns = 0;   ///< times the allocator's free pages went back near --memory
     double stall_seconds = 0;      ///< time the scheduler waited for a load while the workers idled

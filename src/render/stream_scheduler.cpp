@@ -214,20 +214,15 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
     stats->batches = batches_.load();
     stats->peak_queue_bytes =
         std::max<uint64_t>(stats->peak_queue_bytes, queues_.PeakMemoryBytes());
-    stats->brick_loads = after.loads - before.loads;
     stats->bytes_read = after.bytes_read - before.bytes_read;
-    stats->brick_acquires = after.acquires - before.acquires;
+    PagerStats& residency = stats->residency;
     if (pager_) {
-        const PagerStats p = pager_->stats();
-        stats->brick_budget_bytes = pager_->options().in_core() ? 0 : p.brick_budget_bytes;
-        stats->peak_brick_bytes = p.peak_resident_bytes;
-        stats->brick_evictions = p.evictions;
-        stats->brick_reloads = p.reloads;
-        stats->prefetch_loads = p.prefetch_loads;
-        stats->prefetch_hits = p.prefetch_hits;
-        stats->brick_acquires = p.acquires;
-        stats->stall_seconds = p.stall_seconds;
-        stats->memory_returns = p.memory_returns;
+        residency = pager_->stats();
+        if (pager_->options().in_core()) residency.brick_budget_bytes = 0;
+    }
+    // The source counts every load, the pager's and any before it.
+    residency.loads = after.loads - before.loads;
+    if (pager_) {
         if (queue_spill_) {
             const store::SpillStats q = queue_spill_->stats();
             stats->spilled_rays = spilled_rays_;
@@ -242,11 +237,12 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, RenderStats* sta
             stats->cache_mesh_bytes = c.mesh_bytes;
         }
     } else {
-        stats->peak_brick_bytes = after.peak_resident_bytes;
-        stats->brick_evictions = after.evictions - before.evictions;
-        stats->stall_seconds = stall_seconds_;
-        stats->prefetch_hits =
-            stats->brick_acquires - std::min(stats->brick_acquires, stats->brick_loads);
+        residency.acquires = after.acquires - before.acquires;
+        residency.peak_resident_bytes = after.peak_resident_bytes;
+        residency.evictions = after.evictions - before.evictions;
+        residency.stall_seconds = stall_seconds_;
+        residency.resident_hits =
+            residency.acquires - std::min(residency.acquires, residency.loads);
     }
 }
 

@@ -137,19 +137,19 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
         EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound)
             << mode << " variant " << variant;
         // The budget holds, by the pager's count and by the source's own.
-        EXPECT_LE(paged.stats.peak_brick_bytes, options.brick_budget_bytes);
+        EXPECT_LE(paged.stats.residency.peak_resident_bytes, options.brick_budget_bytes);
         EXPECT_LE(paged.source->stats().peak_resident_bytes, options.brick_budget_bytes);
-        EXPECT_GT(paged.stats.brick_evictions, 0u);
-        EXPECT_GT(paged.stats.brick_reloads, 0u);
-        EXPECT_GT(paged.stats.brick_loads, in_core.stats.brick_loads);
-        EXPECT_EQ(paged.stats.prefetch_loads > 0, prefetch);
-        EXPECT_EQ(paged.stats.brick_budget_bytes, options.brick_budget_bytes);
+        EXPECT_GT(paged.stats.residency.evictions, 0u);
+        EXPECT_GT(paged.stats.residency.reloads, 0u);
+        EXPECT_GT(paged.stats.residency.loads, in_core.stats.residency.loads);
+        EXPECT_EQ(paged.stats.residency.prefetch_loads > 0, prefetch);
+        EXPECT_EQ(paged.stats.residency.brick_budget_bytes, options.brick_budget_bytes);
         EXPECT_EQ(paged.stats.spilled_rays > 0, variant == 4) << variant;
         // With the cache, every brick is decoded once and every reload read back from it.
         if (options.brick_cache) {
-            EXPECT_EQ(paged.stats.cache_reads, paged.stats.brick_reloads) << variant;
-            EXPECT_EQ(paged.stats.cache_bricks_written + paged.stats.brick_reloads,
-                      paged.stats.brick_loads)
+            EXPECT_EQ(paged.stats.cache_reads, paged.stats.residency.reloads) << variant;
+            EXPECT_EQ(paged.stats.cache_bricks_written + paged.stats.residency.reloads,
+                      paged.stats.residency.loads)
                 << variant;
         } else {
             EXPECT_EQ(paged.stats.cache_reads, 0u);
@@ -187,9 +187,9 @@ TEST_F(PagerTest, InCoreBudgetLoadsEveryBrickOnceAndEvictsNothing) {
     options.brick_budget_bytes = MinimumBrickBudget(*in_core.source, true).total_bytes;
     Rendered paged = RenderBallGrid("path", &options);
     ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
-    EXPECT_EQ(paged.stats.brick_evictions, 0u);
-    EXPECT_EQ(paged.stats.brick_reloads, 0u);
-    EXPECT_EQ(paged.stats.brick_loads, in_core.stats.brick_loads);
+    EXPECT_EQ(paged.stats.residency.evictions, 0u);
+    EXPECT_EQ(paged.stats.residency.reloads, 0u);
+    EXPECT_EQ(paged.stats.residency.loads, in_core.stats.residency.loads);
     EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
 }
 
@@ -200,8 +200,8 @@ TEST_F(PagerTest, FreePagesGoBackAtBatchEndsNearTheProcessLimitAlsoWithoutLoads)
     options.process_memory_bytes = 1;
     Rendered paged = RenderBallGrid("path", &options);
     ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
-    EXPECT_EQ(paged.stats.brick_evictions, 0u);
-    EXPECT_GT(paged.stats.memory_returns, paged.stats.brick_loads);
+    EXPECT_EQ(paged.stats.residency.evictions, 0u);
+    EXPECT_GT(paged.stats.residency.memory_returns, paged.stats.residency.loads);
 }
 
 TEST_F(PagerTest, CustomPickerWithPagingRendersTheSameImage) {

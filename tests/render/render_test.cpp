@@ -542,7 +542,7 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
         films.push_back(std::make_unique<Film>(32, 24, config->output));
         RenderStats stats;
         ASSERT_TRUE(RenderStreams(*scene, films.back().get(), &stats).ok());
-        EXPECT_EQ(stats.brick_loads, (*source)->brick_count());
+        EXPECT_EQ(stats.residency.loads, (*source)->brick_count());
         EXPECT_GT(stats.bytes_read, 0u);
     }
     EXPECT_GT(MeanY(*films[0]), 0.0);
