@@ -24,7 +24,7 @@
 
 namespace nave::render {
 
-/// A spectral material as the integrators use it: the physics engineer's Material (render/materials/
+/// A spectral material as the integrators use it: the physics library's Material (render/materials/
 /// materials.h) plus what the scene adds: emission, the portal flag, and black (absorbs everything).
 struct SurfaceMaterial {
     std::string name;

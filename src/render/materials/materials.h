@@ -1,6 +1,6 @@
 #pragma once
 // Materials: scene-level descriptions that own their spectra and build a Bxdf (bxdf.h) per hit for
-// the path's wavelengths. Value types; the render engineer maps scene material names to these (see
+// the path's wavelengths. Value types; scene configs map material names to these (see
 // BuiltinMaterial for the procedural abbey's names).
 
 #include <optional>
