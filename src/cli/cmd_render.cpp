@@ -239,20 +239,20 @@ Status RunRender(const RenderOptions& o) {
         const uint64_t minimum = std::max(reserve + need.min_bytes, writer);
         if (memory < minimum) {
             return ResourceExhaustedError(
-                "--memory {} ({} bytes) is too small for this model: its largest brick, brick {}, takes {} when "
-                "resident{}, the reserve for the film, ray queues and process is {} ({} bytes){}, and writing the "
-                "image afterwards takes {} ({} bytes, OpenImageIO included): at least {} ({} bytes) is needed (all {} "
-                "bricks resident at once take {}, {} bytes)",
-                o.memory, memory, need.largest_brick, FormatBytes(need.largest_bytes),
-                options.prefetch && need.second_bytes > 0
-                    ? fmt::format(", prefetching needs room for the next-largest, brick {} ({})", need.second_brick,
-                                  FormatBytes(need.second_bytes))
+                "--memory {} ({} bytes) is too small for this model: {}, the reserve for the film, "
+                "ray queues "
+                "and process is {} ({} bytes){}, and writing the image afterwards takes {} ({} "
+                "bytes, "
+                "OpenImageIO included): at least {} ({} bytes) is needed (all {} bricks resident "
+                "at once take "
+                "{}, {} bytes)",
+                o.memory, memory, need.DescribeLargest(options.prefetch), FormatBytes(reserve),
+                reserve,
+                texture_bytes > 0
+                    ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
                     : std::string(),
-                FormatBytes(reserve), reserve,
-                texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
-                                  : std::string(),
-                FormatBytes(writer), writer, FormatBytes(minimum), minimum,
-                source->brick_count(), FormatBytes(need.total_bytes), need.total_bytes);
+                FormatBytes(writer), writer, FormatBytes(minimum), minimum, source->brick_count(),
+                FormatBytes(need.total_bytes), need.total_bytes);
         }
         options.brick_budget_bytes = memory - reserve;
         if (options.in_core()) --options.brick_budget_bytes;

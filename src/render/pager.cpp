@@ -236,21 +236,25 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
     stats_.brick_budget_bytes = options.brick_budget_bytes;
 }
 
+std::string BrickBudgetMinimum::DescribeLargest(bool prefetch) const {
+    return fmt::format("its largest brick, brick {}, takes {} ({} bytes) when resident{}",
+                       largest_brick, FormatBytes(largest_bytes), largest_bytes,
+                       prefetch && second_bytes > 0
+                           ? fmt::format(", and prefetching needs room for the next-largest, "
+                                         "brick {} ({})",
+                                         second_brick, FormatBytes(second_bytes))
+                           : std::string());
+}
+
 StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerOptions& options,
                                                WaitingFn waiting) {
     BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
     if (source.brick_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
         return ResourceExhaustedError(
-            "brick memory budget {} ({} bytes) is too small for this model: its largest brick, "
-            "brick {}, takes {} "
-            "({} bytes) when resident{}; the minimum brick budget is {} ({} bytes)",
-            FormatBytes(options.brick_budget_bytes), options.brick_budget_bytes, need.largest_brick,
-            FormatBytes(need.largest_bytes), need.largest_bytes,
-            options.prefetch && need.second_bytes > 0
-                ? fmt::format(" and prefetching needs room for the next-largest, brick {} ({})",
-                              need.second_brick, FormatBytes(need.second_bytes))
-                : std::string(),
-            FormatBytes(need.min_bytes), need.min_bytes);
+            "brick memory budget {} ({} bytes) is too small for this model: {}; the minimum brick "
+            "budget is {} ({} bytes)",
+            FormatBytes(options.brick_budget_bytes), options.brick_budget_bytes,
+            need.DescribeLargest(options.prefetch), FormatBytes(need.min_bytes), need.min_bytes);
     }
     std::unique_ptr<Pager> pager(new Pager(source, options, std::move(waiting)));
     // Bricks an earlier render left resident: keep those that fit, drop the rest.

@@ -121,6 +121,11 @@ struct BrickBudgetMinimum {
         0;  ///< the next-largest brick (prefetch room); equal to largest if one brick
     uint64_t second_bytes = 0;
     uint64_t total_bytes = 0;  ///< all bricks resident at once (the in-core size)
+
+    /// "its largest brick, brick 12, takes 40.1 MiB (42049536 bytes) when resident[, and
+    /// prefetching needs room for the next-largest, brick 3 (38.0 MiB)]": why a budget is too
+    /// small, for the refusals of the pager and of `nave render --memory`.
+    std::string DescribeLargest(bool prefetch) const;
 };
 BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch);
 
