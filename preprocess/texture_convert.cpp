@@ -4,9 +4,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <map>
 #include <set>
 #include <utility>
+#include <vector>
 
 #include "core/file.h"
 #include "core/hash.h"
@@ -57,6 +59,27 @@ bool IsColourTextureSlot(const std::string& slot) {
     return kColour.count(slot) != 0;
 }
 
+namespace {
+
+// The checksum of a texture's source file and of how it is converted (colour or data, and this
+// version of the conversion), read in pieces.
+StatusOr<uint64_t> SourceChecksum(const std::filesystem::path& source, bool colour) {
+    std::ifstream in(source, std::ios::binary);
+    if (!in) return IoError("{}: cannot read the texture", source.string());
+    StreamingChecksum64 sum;
+    const std::string how = colour ? "nave texture 1: colour" : "nave texture 1: data";
+    sum.Update(how.data(), how.size());
+    std::vector<char> buffer(1 << 20);
+    while (in) {
+        in.read(buffer.data(), std::streamsize(buffer.size()));
+        sum.Update(buffer.data(), size_t(in.gcount()));
+    }
+    if (in.bad()) return IoError("{}: cannot read the texture", source.string());
+    return sum.Digest();
+}
+
+}  // namespace
+
 StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>* materials,
                                               const std::vector<std::filesystem::path>& source_dirs,
                                               const std::filesystem::path& store_path) {
@@ -96,10 +119,15 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
                                                  made.message(), result.first_user));
             continue;
         }
-        NAVE_ASSIGN_OR_RETURN(std::string bytes, ReadFileToString(temp));
+        // Named after what it was made from, not after its own bytes (OpenImageIO writes the time
+        // of conversion into them): preprocessing the same model into the same place again
+        // replaces each converted texture instead of adding another.
+        NAVE_ASSIGN_OR_RETURN(uint64_t source_checksum, SourceChecksum(source, colour));
+        std::error_code size_ec;
+        const uint64_t bytes_written = std::filesystem::file_size(temp, size_ec);
         std::string file_name =
             fmt::format("{}{}.{}.{}", source.stem().string(), colour ? "" : ".data",
-                        ChecksumHex(Checksum64(bytes.data(), bytes.size())), extension);
+                        ChecksumHex(source_checksum), extension);
         std::filesystem::rename(temp, folder / file_name, ec);
         if (ec) {
             std::filesystem::remove(temp, ec);
@@ -109,7 +137,7 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
         result.ok = true;
         result.relative = (folder.filename() / file_name).generic_string();
         ++stats.converted;
-        stats.bytes_written += bytes.size();
+        stats.bytes_written += size_ec ? 0 : bytes_written;
     }
     progress.Finish();
 
