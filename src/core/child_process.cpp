@@ -1,0 +1,117 @@
+#include "core/child_process.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace nave {
+namespace {
+
+// What is kept of the child's stderr: enough for a library's assertion message, not a flood.
+constexpr size_t kStderrTailBytes = 4096;
+
+// Both ends of a pipe, closed on destruction. O_CLOEXEC so that a program another thread starts
+// meanwhile does not inherit them (and keep the pipe open past the child's end).
+struct Pipe {
+    int fd[2] = {-1, -1};
+    Status Open() {
+        if (::pipe2(fd, O_CLOEXEC) != 0)
+            return IoError("cannot create a pipe: {}", std::strerror(errno));
+        return Status::Ok();
+    }
+    void Close(int end) {
+        if (fd[end] >= 0) ::close(fd[end]);
+        fd[end] = -1;
+    }
+    ~Pipe() {
+        Close(0);
+        Close(1);
+    }
+};
+
+}  // namespace
+
+bool WriteAllToFd(int fd, const void* data, size_t size) {
+    const char* p = static_cast<const char*>(data);
+    while (size > 0) {
+        const ssize_t n = ::write(fd, p, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n;
+        size -= size_t(n);
+    }
+    return true;
+}
+
+std::string DescribeSignal(int signal) {
+    const char* name = ::strsignal(signal);
+    return "signal " + std::to_string(signal) + ": " + (name != nullptr ? name : "unknown");
+}
+
+StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work) {
+    Pipe out, err;
+    NAVE_RETURN_IF_ERROR(out.Open());
+    NAVE_RETURN_IF_ERROR(err.Open());
+    const pid_t pid = ::fork();
+    if (pid < 0) return IoError("cannot start a child process: {}", std::strerror(errno));
+    if (pid == 0) {
+        ::close(out.fd[0]);
+        ::close(err.fd[0]);
+        ::dup2(err.fd[1], STDERR_FILENO);
+        int code = 125;
+        try {
+            code = work(out.fd[1]);
+        } catch (...) {
+            // An exception must not unwind into the parent's copy of the stack.
+        }
+        ::_exit(code);
+    }
+    out.Close(1);
+    err.Close(1);
+
+    ChildOutcome outcome;
+    pollfd fds[2] = {{out.fd[0], POLLIN, 0}, {err.fd[0], POLLIN, 0}};
+    int open_fds = 2;
+    char buffer[1 << 16];
+    while (open_fds > 0) {
+        if (::poll(fds, 2, -1) < 0) {
+            if (errno == EINTR) continue;
+            break;  // cannot happen with valid descriptors; waitpid below still reaps the child
+        }
+        for (int i = 0; i < 2; ++i) {
+            if (fds[i].fd < 0 || fds[i].revents == 0) continue;
+            const ssize_t n = ::read(fds[i].fd, buffer, sizeof(buffer));
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                fds[i].fd = -1;  // poll ignores negative descriptors; the Pipe closes it
+                --open_fds;
+                continue;
+            }
+            std::string& to = i == 0 ? outcome.output : outcome.stderr_tail;
+            to.append(buffer, size_t(n));
+            if (i == 1 && to.size() > 2 * kStderrTailBytes)
+                to.erase(0, to.size() - kStderrTailBytes);
+        }
+    }
+    if (outcome.stderr_tail.size() > kStderrTailBytes)
+        outcome.stderr_tail.erase(0, outcome.stderr_tail.size() - kStderrTailBytes);
+
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0) {
+        if (errno != EINTR)
+            return IoError("cannot wait for child process {}: {}", pid, std::strerror(errno));
+    }
+    if (WIFEXITED(status)) {
+        outcome.exited = true;
+        outcome.exit_code = WEXITSTATUS(status);
+    } else if (WIFSIGNALED(status)) {
+        outcome.signal = WTERMSIG(status);
+    }
+    return outcome;
+}
+
+}  // namespace nave
