@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 
 namespace nave {
@@ -62,6 +63,10 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         ::close(out.fd[0]);
         ::close(err.fd[0]);
         ::dup2(err.fd[1], STDERR_FILENO);
+        // The parent's handlers (a crash reporter, a sanitizer, libFuzzer's) must not turn the
+        // child's crash into an orderly exit: the parent learns of it from the signal.
+        for (int s : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGPIPE})
+            std::signal(s, SIG_DFL);
         int code = 125;
         try {
             code = work(out.fd[1]);
