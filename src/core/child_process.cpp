@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -67,6 +68,9 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         // child's crash into an orderly exit: the parent learns of it from the signal.
         for (int s : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGPIPE})
             std::signal(s, SIG_DFL);
+        // The parent reports the crash; a core file of it would only litter the user's directory.
+        const rlimit no_core = {0, 0};
+        ::setrlimit(RLIMIT_CORE, &no_core);
         int code = 125;
         try {
             code = work(out.fd[1]);

@@ -22,7 +22,9 @@ struct ChildOutcome {
 
 /// Forks; the child runs `work(output_fd)` and `_exit`s with its return value without running
 /// atexit handlers or static destructors (they belong to the parent's threads and state). The
-/// parent collects the child's output and stderr until both close, then waits for it.
+/// parent collects the child's output and stderr until both close, then waits for it. In the child
+/// the crash signals are reset to their defaults and core files are off, so a crash ends it at once
+/// and is seen by the parent as that signal.
 ///
 /// Safe to call from a process with other threads (TBB's workers) as long as `work` only uses what
 /// a freshly forked single thread may use: malloc (glibc and jemalloc reset their locks at fork),
