@@ -24,5 +24,14 @@ TEST(FuzzRegression, GltfUnknownComponentTypeIsAnError) {
                                  "componentType 5127"));
 }
 
+// A binary PLY whose header, damaged, declares an element of 8375319363688624582 records and no
+// properties: the importer skipped the records one by one, zero bytes each, and never ended (a
+// libFuzzer timeout). Such records are now skipped at once, and the file ends in an error.
+TEST(FuzzRegression, PlyElementWithoutPropertiesEnds) {
+    const std::string error =
+        testing::ReadError(Fixture("fuzz/ply_element_without_properties.ply"));
+    EXPECT_THAT(error, HasSubstr("ply_element_without_properties.ply"));
+}
+
 }  // namespace
 }  // namespace nave::preprocess
