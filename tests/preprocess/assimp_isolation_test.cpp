@@ -37,6 +37,27 @@ TEST(AssimpIsolation, AnAbortInAssimpIsAnErrorNamingTheFileAndTheSignal) {
     }
 }
 
+// Damaged OFF files on which fuzz_assimp_in_process found Assimp 5.2 crashing outright: a bus error
+// in its post-processing and a segmentation fault in its OFF reader.
+TEST(AssimpIsolation, ACrashInAssimpIsAnErrorNamingTheSignal) {
+    const std::pair<const char*, const char*> kCrashes[] = {
+        {"fuzz/assimp_bus_error.off", "crashed (signal 7: Bus error)"},
+        {"fuzz/assimp_segfault.off", "crashed (signal 11: Segmentation fault)"}};
+    for (const auto& [name, crashed] : kCrashes) {
+        SCOPED_TRACE(name);
+        auto source = OpenModel(Fixture(name));
+        ASSERT_FALSE(source.ok());
+        EXPECT_EQ(source.status().code(), StatusCode::kDataLoss);
+        EXPECT_THAT(source.status().message(),
+                    HasSubstr(Fixture(name).string() + ": the Assimp importer " + crashed));
+        const auto r =
+            test::RunNave("preprocess " + Fixture(name).string() + " -o " +
+                          (std::filesystem::temp_directory_path() / "never.nave").string());
+        EXPECT_EQ(r.exit_code, 1) << r.output;
+        EXPECT_THAT(r.output, HasSubstr(crashed));
+    }
+}
+
 TEST(AssimpIsolation, TheIsolatedImportStillReadsGoodFiles) {
     std::unique_ptr<TriangleSource> source;
     auto tris = testing::ReadModel(Fixture("square.off"), &source);
