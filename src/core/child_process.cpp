@@ -6,8 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 
 namespace nave {
@@ -35,7 +37,35 @@ struct Pipe {
     }
 };
 
+// The first number of /proc/self/statm (the process's virtual size, in pages) or MemAvailable of
+// /proc/meminfo, in bytes; 0 if unreadable.
+uint64_t VirtualSizeBytes() {
+    std::FILE* f = std::fopen("/proc/self/statm", "r");
+    if (f == nullptr) return 0;
+    unsigned long long pages = 0;
+    const int got = std::fscanf(f, "%llu", &pages);
+    std::fclose(f);
+    return got == 1 ? pages * uint64_t(::sysconf(_SC_PAGE_SIZE)) : 0;
+}
+
+uint64_t AvailableMemoryBytes() {
+    std::FILE* f = std::fopen("/proc/meminfo", "r");
+    if (f == nullptr) return 0;
+    char line[256];
+    unsigned long long kib = 0;
+    while (std::fgets(line, sizeof(line), f) != nullptr) {
+        if (std::sscanf(line, "MemAvailable: %llu kB", &kib) == 1) break;
+    }
+    std::fclose(f);
+    return kib * 1024;
+}
+
 }  // namespace
+
+uint64_t ChildAddressSpaceLimitBytes() {
+    const uint64_t available = AvailableMemoryBytes();
+    return available == 0 ? 0 : VirtualSizeBytes() + available;
+}
 
 bool WriteAllToFd(int fd, const void* data, size_t size) {
     const char* p = static_cast<const char*>(data);
@@ -58,6 +88,8 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
     Pipe out, err;
     NAVE_RETURN_IF_ERROR(out.Open());
     NAVE_RETURN_IF_ERROR(err.Open());
+    // Read before the fork: the child should only run its work.
+    const uint64_t address_space = ChildAddressSpaceLimitBytes();
     const pid_t pid = ::fork();
     if (pid < 0) return IoError("cannot start a child process: {}", std::strerror(errno));
     if (pid == 0) {
@@ -71,6 +103,14 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         // The parent reports the crash; a core file of it would only litter the user's directory.
         const rlimit no_core = {0, 0};
         ::setrlimit(RLIMIT_CORE, &no_core);
+        // A library that believes a damaged count (Assimp reserving 10^8 faces of a 40-byte OFF
+        // file) fails an allocation (bad_alloc, which Assimp reports as an error) instead of taking
+        // the machine's memory until the kernel's OOM killer picks a victim, maybe not this child.
+        rlimit as{};
+        if (address_space > 0 && ::getrlimit(RLIMIT_AS, &as) == 0) {
+            as.rlim_cur = std::min<rlim_t>(as.rlim_max, rlim_t(address_space));
+            ::setrlimit(RLIMIT_AS, &as);
+        }
         int code = 125;
         try {
             code = work(out.fd[1]);

@@ -4,16 +4,21 @@
 #include "core/child_process.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "core/memory.h"
 
 namespace nave {
 namespace {
@@ -71,6 +76,44 @@ TEST(ChildProcess, StderrIsCutToItsTail) {
     EXPECT_LE(outcome->stderr_tail.size(), 4096u);
     EXPECT_NE(outcome->stderr_tail.find("line 4999\nthe end\n"), std::string::npos);
     EXPECT_EQ(outcome->stderr_tail.find("line 0\n"), std::string::npos);
+}
+
+// The child may use what the machine has free, no more: its address space is capped between the
+// parent's current size and that plus the machine's physical memory.
+TEST(ChildProcess, AddressSpaceIsCappedByTheAvailableMemory) {
+    auto outcome = RunInChildProcess([](int fd) {
+        rlimit as{};
+        ::getrlimit(RLIMIT_AS, &as);
+        const uint64_t limit = as.rlim_cur;
+        return WriteAllToFd(fd, &limit, sizeof(limit)) ? 0 : 1;
+    });
+    ASSERT_TRUE(outcome.ok());
+    ASSERT_EQ(outcome->output.size(), sizeof(uint64_t));
+    uint64_t limit = 0;
+    std::memcpy(&limit, outcome->output.data(), sizeof(limit));
+    std::FILE* statm = std::fopen("/proc/self/statm", "r");
+    ASSERT_NE(statm, nullptr);
+    unsigned long long pages = 0;
+    ASSERT_EQ(std::fscanf(statm, "%llu", &pages), 1);
+    std::fclose(statm);
+    const uint64_t parent_size = pages * uint64_t(::sysconf(_SC_PAGE_SIZE));
+    EXPECT_NE(limit, uint64_t(RLIM_INFINITY));
+    EXPECT_GT(limit, parent_size);
+    EXPECT_LE(limit, parent_size + PhysicalMemoryBytes() + (uint64_t(64) << 20));  // + statm drift
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's allocator aborts on such a size instead of failing it
+    // And an allocation beyond it fails in the child instead of being granted.
+    auto greedy = RunInChildProcess([](int) {
+        try {
+            std::vector<char> huge(size_t(ChildAddressSpaceLimitBytes()) + (size_t(1) << 30));
+            return 1;
+        } catch (const std::bad_alloc&) {
+            return 3;
+        }
+    });
+    ASSERT_TRUE(greedy.ok());
+    EXPECT_TRUE(greedy->exited);
+    EXPECT_EQ(greedy->exit_code, 3);
+#endif
 }
 
 TEST(ChildProcess, WorksFromAProcessWithOtherThreadsRunning) {
