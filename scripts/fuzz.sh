@@ -33,8 +33,13 @@ if [[ -z $work ]]; then
   keep_work=0
 fi
 mkdir -p "$work"
-# The targets write every input to a file: on tmpfs when there is one.
-if [[ -d /dev/shm && -w /dev/shm ]]; then export TMPDIR=/dev/shm; fi
+# The targets write every input to a file: on tmpfs when there is one, in a directory of this run's
+# own, removed at the end (a target that crashed leaves its scratch files behind).
+scratch_parent=${TMPDIR:-/tmp}
+if [[ -d /dev/shm && -w /dev/shm ]]; then scratch_parent=/dev/shm; fi
+scratch=$(mktemp -d "$scratch_parent/nave_fuzz_inputs.XXXXXX")
+trap 'rm -rf "$scratch"' EXIT
+export TMPDIR=$scratch
 
 models=tests/fixtures/models
 # Seeds for one target, written into directory $2.
