@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -512,7 +513,19 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     const PlainAttribute positions(*pos);
     for (uint32_t p = 0; p < point_count; ++p) {
         const int32_t* g = positions.Value<int32_t>(p);
-        out.positions[p] = grid.Dequantize({base.x + g[0], base.y + g[1], base.z + g[2]});
+        // Summed in 64 bits: the writer keeps every point within int32 of the grid, so a sum beyond
+        // it is damage (a prefix or a Draco value), not a position.
+        int32_t q[3];
+        for (int a = 0; a < 3; ++a) {
+            const int64_t sum = int64_t(base[a]) + g[a];
+            if (sum < INT32_MIN || sum > INT32_MAX) {
+                return DataLossError(
+                    "{}: vertex {} at grid step {} + {} on axis {}: outside the int32 grid", what,
+                    p, base[a], g[a], "xyz"[a]);
+            }
+            q[a] = int32_t(sum);
+        }
+        out.positions[p] = grid.Dequantize({q[0], q[1], q[2]});
     }
     if (normal != nullptr) {
         NAVE_RETURN_IF_ERROR(CopyFloatValues<3>(*normal, point_count, what, "normal",

@@ -459,8 +459,11 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
         add("aisle roof", [=](Emitter& em) {
             double y_low = kAisleWall + kOuterWallT + 0.4, y_high = kArcadeY + kUpperWallT / 2;
             double z_low = kAisleWallTop, z_high = 19.5;
-            for (auto [x0, x1] : {std::pair{-1.5, kCrossingX0 - kOuterWallT},
-                                  std::pair{kCrossingX1 + kOuterWallT, kChoirX1}}) {
+            for (std::pair<double, double> span :
+                 {std::pair{-1.5, kCrossingX0 - kOuterWallT},
+                  std::pair{kCrossingX1 + kOuterWallT, kChoirX1}}) {
+                // Plain variables: clang before 16 cannot capture structured bindings.
+                const double x0 = span.first, x1 = span.second;
                 auto r = [=](double u, double t) {
                     return Vec3d(x0 + (x1 - x0) * u, s * (y_low + (y_high - y_low) * t),
                                  z_low + (z_high - z_low) * t);

@@ -1,14 +1,46 @@
 #include "preprocess/import/assimp_importer.h"
 
 #include <assimp/cimport.h>
-#include <assimp/material.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <fmt/format.h>
 
+#include "core/child_process.h"
+#include "preprocess/import/assimp_scene.h"
 #include "preprocess/import/indexed_mesh_source.h"
+#include "preprocess/import/model_wire.h"
 
 namespace nave::preprocess {
+namespace {
+
+// The child's exit codes: 0 sends the model; kErrorExitBase + a StatusCode sends Assimp's own error
+// message. Anything else (an abort, a segfault, a library calling exit) is a crash.
+constexpr int kErrorExitBase = 64;
+
+// The child: reads the model with Assimp and writes it, or the error, to `fd`.
+int ReadInChild(const std::filesystem::path& path, int fd) {
+    StatusOr<ImportedModel> model = ReadWithAssimpInProcess(path);
+    if (!model.ok()) {
+        const std::string& message = model.status().message();
+        WriteAllToFd(fd, message.data(), message.size());
+        return kErrorExitBase + int(model.status().code());
+    }
+    const std::string bytes = EncodeImportedModel(*model);
+    return WriteAllToFd(fd, bytes.data(), bytes.size())
+               ? 0
+               : kErrorExitBase + int(StatusCode::kIoError);
+}
+
+// The last non-empty line a crashed child printed (Assimp's assertion message), shortened.
+std::string LastLine(const std::string& text) {
+    size_t end = text.find_last_not_of(" \r\n");
+    if (end == std::string::npos) return {};
+    size_t begin = text.rfind('\n', end);
+    begin = begin == std::string::npos ? 0 : begin + 1;
+    std::string line = text.substr(begin, end + 1 - begin);
+    if (line.size() > 300) line = line.substr(0, 300) + "...";
+    return line;
+}
+
+}  // namespace
 
 bool AssimpSupports(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
@@ -18,79 +50,29 @@ bool AssimpSupports(const std::filesystem::path& path) {
 StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::path& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
-    // Triangulate polygons, bake node transforms into world-space meshes, drop points and lines.
-    const unsigned flags =
-        aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-    const aiScene* scene = aiImportFile(path.c_str(), flags);
-    if (scene == nullptr) {
-        return InvalidArgumentError("{}: Assimp cannot read it: {}", path.string(),
-                                    aiGetErrorString());
+    // Assimp runs in a child process: on some malformed files it aborts (ai_assert) or crashes, and
+    // that must end in an error naming the file, not take nave (and a half-written store) with it.
+    NAVE_ASSIGN_OR_RETURN(ChildOutcome child,
+                          RunInChildProcess([&](int fd) { return ReadInChild(path, fd); }));
+    if (!child.exited || child.exit_code != 0) {
+        const int code = child.exit_code - kErrorExitBase;
+        if (child.exited && code > int(StatusCode::kOk) && code <= int(StatusCode::kInternal)) {
+            return Status(StatusCode(code), child.output);
+        }
+        const std::string how = child.exited
+                                    ? fmt::format("exited with code {}", child.exit_code)
+                                    : fmt::format("crashed ({})", DescribeSignal(child.signal));
+        const std::string said = LastLine(child.stderr_tail);
+        return DataLossError(
+            "{}: the Assimp importer {} reading this file; the file is damaged or uses something "
+            "{} cannot read: repair or re-export it (glTF, OBJ and PLY are read by nave itself){}",
+            path.string(), how, AssimpVersion(),
+            said.empty() ? "" : " (Assimp said: " + said + ")");
     }
-    struct Release {
-        const aiScene* s;
-        ~Release() { aiReleaseImport(s); }
-    } release{scene};
-    std::string file = path.filename().string();
-    ImportWarnings warnings;
-    std::vector<store::MaterialRecord> materials;
-    for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
-        const aiMaterial* src = scene->mMaterials[i];
-        store::MaterialRecord m;
-        aiString name;
-        m.name = aiGetMaterialString(src, AI_MATKEY_NAME, &name) == AI_SUCCESS && name.length > 0
-                     ? std::string(name.C_Str())
-                     : fmt::format("material_{}", i);
-        aiColor4D c;
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_DIFFUSE, &c) == AI_SUCCESS)
-            m.diffuse = {c.r, c.g, c.b};
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_SPECULAR, &c) == AI_SUCCESS)
-            m.specular = {c.r, c.g, c.b};
-        if (aiGetMaterialColor(src, AI_MATKEY_COLOR_EMISSIVE, &c) == AI_SUCCESS)
-            m.emission = {c.r, c.g, c.b};
-        float f = 0;
-        if (aiGetMaterialFloat(src, AI_MATKEY_OPACITY, &f) == AI_SUCCESS) m.opacity = f;
-        if (aiGetMaterialFloat(src, AI_MATKEY_SHININESS, &f) == AI_SUCCESS) m.shininess = f;
-        if (aiGetMaterialFloat(src, AI_MATKEY_REFRACTI, &f) == AI_SUCCESS) m.ior = f;
-        aiString tex;
-        if (aiGetMaterialTexture(src, aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS)
-            m.textures["map_Kd"] = tex.C_Str();
-        if (aiGetMaterialTexture(src, aiTextureType_NORMALS, 0, &tex) == AI_SUCCESS)
-            m.textures["norm"] = tex.C_Str();
-        materials.push_back(std::move(m));
-    }
-    std::vector<IndexedMesh> meshes;
-    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
-        const aiMesh* src = scene->mMeshes[mi];
-        if ((src->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
-        IndexedMesh out;
-        out.where = fmt::format("{} mesh {}", file, mi);
-        out.material = src->mMaterialIndex;
-        out.positions.resize(src->mNumVertices);
-        for (unsigned v = 0; v < src->mNumVertices; ++v) {
-            out.positions[v] = Vec3f(src->mVertices[v].x, src->mVertices[v].y, src->mVertices[v].z);
-        }
-        if (src->mNormals != nullptr) {
-            out.normals.resize(src->mNumVertices);
-            for (unsigned v = 0; v < src->mNumVertices; ++v) {
-                out.normals[v] = Vec3f(src->mNormals[v].x, src->mNormals[v].y, src->mNormals[v].z);
-            }
-        }
-        if (src->mTextureCoords[0] != nullptr) {
-            out.uvs.resize(src->mNumVertices);
-            for (unsigned v = 0; v < src->mNumVertices; ++v) {
-                out.uvs[v] = {src->mTextureCoords[0][v].x, src->mTextureCoords[0][v].y};
-            }
-        }
-        for (unsigned f = 0; f < src->mNumFaces; ++f) {
-            const aiFace& face = src->mFaces[f];
-            if (face.mNumIndices != 3) continue;
-            out.indices.insert(out.indices.end(),
-                               {face.mIndices[0], face.mIndices[1], face.mIndices[2]});
-        }
-        meshes.push_back(std::move(out));
-    }
-    return std::unique_ptr<TriangleSource>(new IndexedMeshSource(
-        file, "unknown", std::move(meshes), std::move(materials), std::move(warnings)));
+    NAVE_ASSIGN_OR_RETURN(ImportedModel model, DecodeImportedModel(child.output, path.string()));
+    return std::unique_ptr<TriangleSource>(
+        new IndexedMeshSource(path.filename().string(), "unknown", std::move(model.meshes),
+                              std::move(model.materials), ImportWarnings()));
 }
 
 }  // namespace nave::preprocess

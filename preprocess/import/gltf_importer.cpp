@@ -204,11 +204,23 @@ class GltfReader {
                                         acc.bufferView, view.buffer);
         }
         const std::vector<unsigned char>& data = model_.buffers[view.buffer].data;
-        size_t elem = size_t(tinygltf::GetComponentSizeInBytes(acc.componentType)) *
-                      size_t(tinygltf::GetNumComponentsInType(acc.type));
-        size_t stride = view.byteStride > 0 ? view.byteStride : elem;
-        size_t start = view.byteOffset + acc.byteOffset;
-        if (acc.count > 0 && start + stride * (acc.count - 1) + elem > data.size()) {
+        const int component_bytes = tinygltf::GetComponentSizeInBytes(acc.componentType);
+        const int components = tinygltf::GetNumComponentsInType(acc.type);
+        if (component_bytes <= 0 || components <= 0) {
+            return DataLossError("{}: accessor {} has an invalid componentType {} or type {}",
+                                 file_, index, acc.componentType, acc.type);
+        }
+        const size_t elem = size_t(component_bytes) * size_t(components);
+        const size_t stride = view.byteStride > 0 ? view.byteStride : elem;
+        const size_t size = data.size();
+        // Each step checked against what is left, never summed first: offsets and counts near 2^64
+        // in a damaged file would wrap around and pass a summed check.
+        const bool fits =
+            view.byteOffset <= size && acc.byteOffset <= size - view.byteOffset &&
+            elem <= size - view.byteOffset - acc.byteOffset &&
+            acc.count - 1 <= (size - view.byteOffset - acc.byteOffset - elem) / stride;
+        const size_t start = view.byteOffset + acc.byteOffset;
+        if (acc.count > 0 && !fits) {
             return DataLossError(
                 "{}: accessor {} reads {} elements of {} bytes at offset {} of buffer {} "
                 "({} bytes): out of range",

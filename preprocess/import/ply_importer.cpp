@@ -1,5 +1,6 @@
 #include "preprocess/import/ply_importer.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstring>
@@ -109,6 +110,10 @@ class PlySource final : public TriangleSource {
                     NAVE_RETURN_IF_ERROR(ReadFaceRecord(e, e.name == "tristrips", batch));
                     ++record_;
                 }
+            } else if (e.properties.empty()) {
+                // Records of no properties take no bytes: skipped at once, whatever their count
+                // (a damaged count of 10^18 would otherwise loop for ever).
+                record_ = e.count;
             } else {
                 for (; record_ < e.count; ++record_) NAVE_RETURN_IF_ERROR(SkipRecord(e));
             }
@@ -228,6 +233,16 @@ class PlySource final : public TriangleSource {
         return uint64_t(count);
     }
 
+    // The fewest bytes one record of `e` can take: its binary sizes (a list, its count alone), or
+    // in ASCII a digit and a separator per value. At least 1.
+    size_t MinRecordBytes(const Element& e) const {
+        size_t bytes = 0;
+        for (const Property& p : e.properties) {
+            bytes += format_ == Format::kAscii ? 2 : TypeSize(p.is_list ? p.count_type : p.type);
+        }
+        return std::max<size_t>(bytes, 1);
+    }
+
     Status SkipRecord(const Element& e) {
         for (const Property& p : e.properties) {
             uint64_t n = 1;
@@ -254,9 +269,15 @@ class PlySource final : public TriangleSource {
         }
         bool normals = has[3] && has[4] && has[5];
         bool uvs = has[6] && has[7];
-        positions_.reserve(e.count);
-        if (normals) normals_.reserve(e.count);
-        if (uvs) uvs_.reserve(e.count);
+        // Room for as many vertices as the rest of the file can hold, not for what a damaged count
+        // claims: the vectors still grow if the count was right and the estimate short.
+        const uint64_t fit =
+            (reader_.file_size() - std::min(reader_.file_size(), reader_.offset())) /
+            MinRecordBytes(e);
+        const size_t expected = size_t(std::min(e.count, fit));
+        positions_.reserve(expected);
+        if (normals) normals_.reserve(expected);
+        if (uvs) uvs_.reserve(expected);
         for (; record_ < e.count; ++record_) {
             double v[kSlotCount] = {};
             for (size_t k = 0; k < e.properties.size(); ++k) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <utility>
@@ -29,7 +30,9 @@ StatusOr<StreamReader> StreamReader::Open(const std::filesystem::path& path) {
 
 StreamReader::StreamReader(std::filesystem::path path, std::FILE* file, uint64_t size)
     : path_(std::move(path)), file_(file), file_size_(size) {
-    buffer_.resize(kChunkBytes);
+    // A small file gets a buffer its size (plus the byte that finds the end), not a whole chunk:
+    // the buffer doubles anyway if a line or the file turns out longer.
+    buffer_.resize(size_t(std::clamp<uint64_t>(size + 1, 4096, kChunkBytes)));
 }
 
 StreamReader::StreamReader(StreamReader&& other) noexcept { *this = std::move(other); }

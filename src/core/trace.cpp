@@ -329,8 +329,9 @@ void TraceSpan::Finish() {
     TraceRecorder::Clock::time_point end = TraceRecorder::Clock::now();
     std::vector<TraceArg> views;
     views.reserve(args_.size());
-    for (const auto& [key, value] : args_) {
-        std::visit([&](const auto& v) { views.emplace_back(key, v); }, value);
+    // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one in a lambda.
+    for (const auto& arg : args_) {
+        std::visit([&](const auto& v) { views.emplace_back(arg.first, v); }, arg.second);
     }
     recorder_->RecordComplete(name_, category_, start_, end, views);
     recorder_ = nullptr;

@@ -222,10 +222,14 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         }
         scene.materials.push_back(std::move(m));
     }
-    for (const auto& [name, mc] : config.materials) {
+    for (const auto& entry : config.materials) {
+        // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
+        const std::string& name = entry.first;
         if (name == "default") continue;
         bool used = std::any_of(records.begin(), records.end(), [&](const auto& r) { return r.name == name; });
-        if (!used) log::Warning("{}: [materials.{}] maps no material of the model", mc.where, name);
+        if (!used)
+            log::Warning("{}: [materials.{}] maps no material of the model", entry.second.where,
+                         name);
     }
 
     if (config.sun.enabled) {

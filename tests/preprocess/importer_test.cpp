@@ -156,6 +156,23 @@ TEST(PlyImporter, ErrorsNameFileAndPlace) {
         ::testing::IsEmpty());
 }
 
+// A vertex count far beyond what the file holds (damage, or a header written before the data) is
+// not allocated up front: the file ends first, in an error naming it.
+TEST(PlyImporter, HugeVertexCountIsNotAllocated) {
+    const auto dir = testing::MakeTempDir("ply_huge_count");
+    {
+        std::ofstream(dir / "huge.ply", std::ios::binary)
+            << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float "
+               "x\n"
+               "property float y\nproperty float z\nelement face 1\n"
+               "property list uchar int vertex_indices\nend_header\n"
+            << std::string(12 * 3, '\0');
+    }
+    EXPECT_THAT(ReadError(dir / "huge.ply"), HasSubstr("huge.ply"));
+    EXPECT_THAT(ReadError(dir / "huge.ply"), HasSubstr("truncated"));
+    std::filesystem::remove_all(dir);
+}
+
 TEST(StlImporter, BinaryStartingWithSolidIsReadAsBinary) {
     auto tris = ReadModel(Fixture("solid_binary.stl"));
     ASSERT_EQ(tris.size(), 3u);

@@ -1,0 +1,11 @@
+// PLY importer: the input is the whole file.
+
+#include "drain.h"
+#include "fuzz_file.h"
+#include "preprocess/import/ply_importer.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    const auto path = nave::fuzz::WriteInput("fuzz.ply", nave::fuzz::AsView(data, size));
+    nave::fuzz::Drain(nave::preprocess::OpenPly(path));
+    return 0;
+}

@@ -1,0 +1,37 @@
+// Inputs on which a fuzz target (tests/fuzz, docs/fuzzing.md) found an importer crashing or
+// reporting undefined behaviour, each kept as found in tests/fixtures/models/fuzz/: they must now
+// give an error naming the file and the problem. Run under the asan preset, the sanitizers check
+// the rest.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "preprocess/import/importer.h"
+#include "test_util.h"
+
+namespace nave::preprocess {
+namespace {
+
+using testing::Fixture;
+using ::testing::HasSubstr;
+
+// node_transform.glb mutated: accessor 0's componentType 5126 (FLOAT) became 5127, which no glTF
+// type has. tinygltf gives -1 bytes per component; the importer's bounds check multiplied that into
+// a size near 2^64, wrapped around, passed, and read before the buffer.
+TEST(FuzzRegression, GltfUnknownComponentTypeIsAnError) {
+    const std::string error = testing::ReadError(Fixture("fuzz/gltf_component_type_5127.glb"));
+    EXPECT_THAT(error, HasSubstr("gltf_component_type_5127.glb: accessor 0 has an invalid "
+                                 "componentType 5127"));
+}
+
+// A binary PLY whose header, damaged, declares an element of 8375319363688624582 records and no
+// properties: the importer skipped the records one by one, zero bytes each, and never ended (a
+// libFuzzer timeout). Such records are now skipped at once, and the file ends in an error.
+TEST(FuzzRegression, PlyElementWithoutPropertiesEnds) {
+    const std::string error =
+        testing::ReadError(Fixture("fuzz/ply_element_without_properties.ply"));
+    EXPECT_THAT(error, HasSubstr("ply_element_without_properties.ply"));
+}
+
+}  // namespace
+}  // namespace nave::preprocess
