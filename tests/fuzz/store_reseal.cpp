@@ -33,7 +33,7 @@ Layout Learn() {
     Layout l;
     store::format::RawHeader h;
     h.file_bytes = 0x0123456789abcdefull;
-    store::format::TableRef* tables[4] = {&h.provenance, &h.directory, &h.tree, &h.materials};
+    store::SectionInfo* tables[4] = {&h.provenance, &h.directory, &h.tree, &h.materials};
     for (int t = 0; t < 4; ++t) tables[t]->checksum = 0x5eed000000000001ull + uint64_t(t);
     h.brick_count = 0x7a11b0c5u;
     h.directory_entry_bytes = 0x6e7b1e5u;

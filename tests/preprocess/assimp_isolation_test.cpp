@@ -64,7 +64,7 @@ TEST(AssimpIsolation, TheIsolatedImportStillReadsGoodFiles) {
     ASSERT_EQ(tris.size(), 2u);
     EXPECT_EQ(source->name(), "square.off");
     // A file Assimp refuses cleanly keeps Assimp's own message and the importer's code.
-    const std::filesystem::path dir = testing::MakeTempDir("assimp_refused");
+    const auto dir = testing::MakeTempDir("assimp_refused");
     { std::ofstream(dir / "empty_mesh.off") << "OFF\n0 0 0\n"; }
     auto refused = OpenWithAssimp(dir / "empty_mesh.off");
     EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
@@ -75,7 +75,7 @@ TEST(AssimpIsolation, TheIsolatedImportStillReadsGoodFiles) {
 }
 
 TEST(AssimpIsolation, NavePreprocessExitsNonZeroAndWritesNoStore) {
-    const std::filesystem::path dir = testing::MakeTempDir("assimp_isolation");
+    const auto dir = testing::MakeTempDir("assimp_isolation");
     for (const char* name : kAbortingOffFiles) {
         SCOPED_TRACE(name);
         const std::filesystem::path out = dir / "out.nave";
