@@ -1,6 +1,6 @@
-// Ray streams over bricks: rays per second for the same scene cut into 1, 8 and 64 bricks, all resident
-// (the cost of the decomposition itself: queueing, moving rays between bricks, per-brick Embree scenes),
-// and photons per second of the SPPM photon pass.
+// Ray streams over bricks: rays per second for the same scene cut into 1, 8 and 64 bricks, all
+// resident (the cost of the decomposition itself: queueing, moving rays between bricks, per-brick
+// Embree scenes), and photons per second of the SPPM photon pass.
 //   build/release/bench/bench_render --benchmark_counters_tabular=true
 
 #include <benchmark/benchmark.h>
@@ -22,8 +22,10 @@ store::BrickMesh BenchMesh() {
     AppendQuad(&m, {0, 0, 0}, {8, 0, 0}, {0, 8, 0}, 200, 0);
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
-            AppendSphere(&m, {-6 + 4.f * i, -6 + 4.f * j, 1.2f}, 1.0f, 96, 192, uint32_t((i + j) % 2 + 1));
-    for (int i = 0; i < 5; ++i) AppendBox(&m, Bounds3f({-7.5f + 3 * i, 6.5f, 0}, {-6.5f + 3 * i, 7.5f, 4.f}), 0);
+            AppendSphere(&m, {-6 + 4.f * i, -6 + 4.f * j, 1.2f}, 1.0f, 96, 192,
+                         uint32_t((i + j) % 2 + 1));
+    for (int i = 0; i < 5; ++i)
+        AppendBox(&m, Bounds3f({-7.5f + 3 * i, 6.5f, 0}, {-6.5f + 3 * i, 7.5f, 4.f}), 0);
     return m;
 }
 
@@ -71,7 +73,8 @@ std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
     f->source = std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
     f->config = ParseSceneConfig(fmt::format(fmt::runtime(kConfig), mode), "bench.toml").value();
     f->scene = BuildRenderScene(f->config, *f->source).value();
-    for (uint32_t b = 0; b < f->source->brick_count(); ++b) (void)f->source->Acquire(b);  // all resident
+    for (uint32_t b = 0; b < f->source->brick_count(); ++b)
+        (void)f->source->Acquire(b);  // all resident
     return f;
 }
 
@@ -92,7 +95,13 @@ void BM_PathRays(benchmark::State& state) {
     state.counters["moves/ray"] = double(moves) / double(std::max<uint64_t>(1, rays));
     state.counters["segments/ray"] = double(segments) / double(std::max<uint64_t>(1, rays));
 }
-BENCHMARK(BM_PathRays)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_PathRays)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(4)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 void BM_Photons(benchmark::State& state) {
     ProgressBar::SetEnabled(false);

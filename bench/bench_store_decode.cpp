@@ -29,7 +29,8 @@ struct Fixture {
     EncodedBrick encoded;
 };
 
-// `irregular`: jittered vertices and random quad diagonals, closer to a CAD tessellation than the grid.
+// `irregular`: jittered vertices and random quad diagonals, closer to a CAD tessellation than the
+// grid.
 BrickMesh Surface(int64_t triangles, bool irregular) {
     const uint32_t q = uint32_t(std::lround(std::sqrt(double(triangles) / 2.0)));
     testing::SurfaceOptions o;
@@ -145,10 +146,11 @@ BENCHMARK(BM_EncodeBrick)->Apply(Sizes)->Iterations(2);
 }  // namespace
 }  // namespace nave::store
 
-// glibc serves large blocks with fresh mmap()s until a free raises its threshold, and page faults on fresh
-// memory cost more than Draco's decoding itself on a virtual machine, so timings would depend on which
-// benchmark ran first. Unless NAVE_BENCH_DEFAULT_MALLOC is set, keep blocks up to 32 MiB on the heap and
-// never trim it: every configuration then decodes into warm memory, as a long-running renderer does.
+// glibc serves large blocks with fresh mmap()s until a free raises its threshold, and page faults
+// on fresh memory cost more than Draco's decoding itself on a virtual machine, so timings would
+// depend on which benchmark ran first. Unless NAVE_BENCH_DEFAULT_MALLOC is set, keep blocks up to
+// 32 MiB on the heap and never trim it: every configuration then decodes into warm memory, as a
+// long-running renderer does.
 int main(int argc, char** argv) {
     if (std::getenv("NAVE_BENCH_DEFAULT_MALLOC") == nullptr) {
         mallopt(M_MMAP_THRESHOLD, 32 << 20);

@@ -60,10 +60,11 @@ struct PreprocessStats {
     std::vector<std::string> warnings;
 };
 
-/// Memory that converting textures adds to the run and keeps until its end: loading the OpenImageIO plugin
-/// (libnave_oiio.so and its ~250 libraries) and its conversion buffers. Measured: the abbey's glass maps raised
-/// the peak RSS of `nave preprocess --memory 64M` by 145 MB; larger source images add their own float copy
-/// (width x height x channels x 4 bytes), which this does not cover (docs/preprocess.md).
+/// Memory that converting textures adds to the run and keeps until its end: loading the OpenImageIO
+/// plugin (libnave_oiio.so and its ~250 libraries) and its conversion buffers. Measured: the
+/// abbey's glass maps raised the peak RSS of `nave preprocess --memory 64M` by 145 MB; larger
+/// source images add their own float copy (width x height x channels x 4 bytes), which this does
+/// not cover (docs/preprocess.md).
 inline constexpr uint64_t kTextureConversionBytes = uint64_t(160) << 20;
 
 /// Runs the whole preprocess. Errors: bad input (with file and line), a budget too small (with the

@@ -105,18 +105,21 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
     for (auto& [key, result] : work) {
         const auto& [source, colour] = key;
         progress.Add(1);
-        // Colour, and data that comes as OpenEXR (spectral maps, whose band centres live in an EXR header
-        // attribute), are written as OpenEXR; other data as TIFF in its own pixel type.
+        // Colour, and data that comes as OpenEXR (spectral maps, whose band centres live in an EXR
+        // header attribute), are written as OpenEXR; other data as TIFF in its own pixel type.
         const char* extension = colour || source.extension() == ".exr" ? "exr" : "tx";
         std::filesystem::path temp =
             folder / fmt::format(".tmp-{}-{}.{}", getpid(), counter.fetch_add(1), extension);
         Status made = imaging::MakeTiledTexture(
-            source, temp, colour ? imaging::TextureContent::kColour : imaging::TextureContent::kData);
+            source, temp,
+            colour ? imaging::TextureContent::kColour : imaging::TextureContent::kData);
         if (!made.ok()) {
             std::filesystem::remove(temp, ec);
-            if (made.code() == StatusCode::kIoError) return made;  // the output side: nothing to fall back on
-            stats.warnings.push_back(fmt::format("texture {} (used by {}); its materials use their flat value",
-                                                 made.message(), result.first_user));
+            if (made.code() == StatusCode::kIoError)
+                return made;  // the output side: nothing to fall back on
+            stats.warnings.push_back(
+                fmt::format("texture {} (used by {}); its materials use their flat value",
+                            made.message(), result.first_user));
             continue;
         }
         // Named after what it was made from, not after its own bytes (OpenImageIO writes the time

@@ -8,11 +8,11 @@
 // data slots (alpha, normals, roughness) keep their values and pixel type.
 //
 // Files are content-addressed: "<source stem>[.data].<XXH64 of the file, 16 hex digits>.<exr|tx>"
-// (".data" for data slots; data from an OpenEXR source stays OpenEXR, so spectral maps keep their band
-// centres), written to a temporary name and renamed, so the reference in the
-// material table carries the checksum the renderer can verify (see docs/textures.md). A missing or
-// unreadable texture gives one warning naming it and its slot is dropped, so the material falls
-// back to its flat colour.
+// (".data" for data slots; data from an OpenEXR source stays OpenEXR, so spectral maps keep their
+// band centres), written to a temporary name and renamed, so the reference in the material table
+// carries the checksum the renderer can verify (see docs/textures.md). A missing or unreadable
+// texture gives one warning naming it and its slot is dropped, so the material falls back to its
+// flat colour.
 
 #include <cstdint>
 #include <filesystem>

@@ -57,8 +57,8 @@ class TriangleSource {
     /// Memory the source itself holds (OBJ and PLY vertex arrays grow with the input; glTF and
     /// Assimp hold the whole model), in bytes, for the memory budget and the summary.
     virtual uint64_t memory_bytes() const { return 0; }
-    /// Writes the image files a generated model's materials name (relative to `dir`), for the texture
-    /// conversion to pick up; importers name files that exist already and write nothing.
+    /// Writes the image files a generated model's materials name (relative to `dir`), for the
+    /// texture conversion to pick up; importers name files that exist already and write nothing.
     virtual Status WriteGeneratedTextures(const std::filesystem::path& dir) const {
         (void)dir;
         return Status::Ok();

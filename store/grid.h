@@ -1,7 +1,8 @@
 #pragma once
-// The store's global position grid. Every position is snapped to origin + step * (i, j, k) with integer
-// i, j, k before encoding, so a vertex shared by two bricks decodes to the same coordinates in both
-// (no cracks between bricks). The largest error per axis is step / 2, so at most step * sqrt(3) / 2 in length.
+// The store's global position grid. Every position is snapped to origin + step * (i, j, k) with
+// integer i, j, k before encoding, so a vertex shared by two bricks decodes to the same coordinates
+// in both (no cracks between bricks). The largest error per axis is step / 2, so at most step *
+// sqrt(3) / 2 in length.
 
 #include <cmath>
 #include <cstdint>
@@ -11,8 +12,8 @@
 namespace nave::store {
 
 struct GlobalGrid {
-    Vec3d origin;      ///< the grid point (0, 0, 0), in world units
-    double step = 0;   ///< grid spacing, in world units (metres for nave's models)
+    Vec3d origin;     ///< the grid point (0, 0, 0), in world units
+    double step = 0;  ///< grid spacing, in world units (metres for nave's models)
 
     Vec3i Quantize(const Vec3f& p) const {
         return {int32_t(std::llround((double(p.x) - origin.x) / step)),

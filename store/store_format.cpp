@@ -455,7 +455,8 @@ StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, co
             NAVE_RETURN_IF_ERROR(r.GetString(&path));
             m.textures[slot] = path;
         }
-        // Fields appended by later minor versions: absent in older records, which keep the defaults.
+        // Fields appended by later minor versions: absent in older records, which keep the
+        // defaults.
         if (r.remaining() >= sizeof(float)) NAVE_RETURN_IF_ERROR(r.Get(&m.alpha_cutoff));
     }
     if (table.remaining() != 0) {

@@ -23,29 +23,30 @@ inline constexpr uint16_t kOldestReadableMajor = 1;
 struct StoreProvenance {
     std::vector<std::string> source_files;  ///< inputs, as given on the command line
     std::string tool_version;               ///< "nave 0.1.0"
-    std::string options;                    ///< the creation options, as text ("brick-triangles=1000000 ...")
+    std::string options;  ///< the creation options, as text ("brick-triangles=1000000 ...")
 };
 
 /// One section of the file, where it is and its checksum: a table the header points to (provenance,
 /// directory, tree, materials) or a section of a brick (the Draco mesh, a side section).
 struct SectionInfo {
-    uint64_t offset = 0;     ///< byte offset from the start of the file
-    uint64_t length = 0;     ///< bytes on disk
-    uint64_t checksum = 0;   ///< XXH64 of those bytes
+    uint64_t offset = 0;    ///< byte offset from the start of the file
+    uint64_t length = 0;    ///< bytes on disk
+    uint64_t checksum = 0;  ///< XXH64 of those bytes
 };
 
 /// A brick as the directory describes it. Reading the directory never touches brick payloads.
 struct BrickInfo {
     uint32_t id = 0;
-    Bounds3f cell;             ///< the brick's cell in the brick tree (disjoint from every other cell)
-    Bounds3f geometry_bounds;  ///< box of the brick's triangles (may exceed `cell` for triangles that cross it)
+    Bounds3f cell;  ///< the brick's cell in the brick tree (disjoint from every other cell)
+    Bounds3f geometry_bounds;  ///< box of the brick's triangles (may exceed `cell` for triangles
+                               ///< that cross it)
     uint64_t triangle_count = 0;
     uint64_t vertex_count = 0;
-    uint64_t decoded_bytes = 0;    ///< BrickMesh::MemoryBytes() once decoded (for memory budgets)
-    bool has_normals = false;      ///< the decoded mesh has shading normals
-    bool has_uvs = false;          ///< the decoded mesh has texture coordinates
-    SectionInfo mesh;              ///< position base + Draco-encoded mesh (docs/store-format.md)
-    SectionInfo side;              ///< LZ4-compressed side section (see docs/store-format.md); length 0 if none
+    uint64_t decoded_bytes = 0;  ///< BrickMesh::MemoryBytes() once decoded (for memory budgets)
+    bool has_normals = false;    ///< the decoded mesh has shading normals
+    bool has_uvs = false;        ///< the decoded mesh has texture coordinates
+    SectionInfo mesh;            ///< position base + Draco-encoded mesh (docs/store-format.md)
+    SectionInfo side;  ///< LZ4-compressed side section (see docs/store-format.md); length 0 if none
     uint64_t BytesOnDisk() const { return mesh.length + side.length; }
 };
 
@@ -53,9 +54,11 @@ struct StoreHeader {
     uint16_t major = kFormatMajor;
     uint16_t minor = kFormatMinor;
     GlobalGrid grid;
-    Bounds3f bounds;              ///< box of all geometry
-    uint64_t triangle_count = 0;  ///< sum over bricks (triangles crossing cells counted once per brick)
-    uint64_t source_triangle_count = 0;  ///< triangles in the input before duplication across bricks
+    Bounds3f bounds;  ///< box of all geometry
+    uint64_t triangle_count =
+        0;  ///< sum over bricks (triangles crossing cells counted once per brick)
+    uint64_t source_triangle_count =
+        0;  ///< triangles in the input before duplication across bricks
     StoreProvenance provenance;
     /// XXH64 of the header's bytes as stored (which hold the checksums of every table): the
     /// store's identity, for render checkpoints.

@@ -1,8 +1,9 @@
 #pragma once
-// Reading a store. Open() reads the header, the directory, the brick tree and the material table only;
-// bricks are read on demand, their checksums verified, then decoded. Every error names the file, the brick
-// and the byte offset, with the expected and found values. Store is immutable after Open and thread-safe:
-// many threads may read bricks at once (positional reads, no shared file offset).
+// Reading a store. Open() reads the header, the directory, the brick tree and the material table
+// only; bricks are read on demand, their checksums verified, then decoded. Every error names the
+// file, the brick and the byte offset, with the expected and found values. Store is immutable after
+// Open and thread-safe: many threads may read bricks at once (positional reads, no shared file
+// offset).
 
 #include <filesystem>
 #include <memory>
@@ -18,7 +19,8 @@ namespace nave::store {
 
 class Store {
   public:
-    /// Opens and checks header, tables and their checksums. Refuses another major version (naming both).
+    /// Opens and checks header, tables and their checksums. Refuses another major version (naming
+    /// both).
     static StatusOr<std::unique_ptr<Store>> Open(const std::filesystem::path& path);
     ~Store();
 

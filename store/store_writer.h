@@ -1,8 +1,8 @@
 #pragma once
-// Writing a store. Encoding a brick (EncodeBrick) is thread-safe and independent of the writer, so that
-// preprocess encodes on many threads and appends the results as they finish. The file is written under a
-// temporary name; Finish() writes the tables last, then fsyncs and renames: an interrupted writer never
-// leaves a file that opens as a valid store.
+// Writing a store. Encoding a brick (EncodeBrick) is thread-safe and independent of the writer, so
+// that preprocess encodes on many threads and appends the results as they finish. The file is
+// written under a temporary name; Finish() writes the tables last, then fsyncs and renames: an
+// interrupted writer never leaves a file that opens as a valid store.
 
 #include <filesystem>
 #include <memory>
@@ -19,9 +19,9 @@ namespace nave::store {
 
 /// Encoder settings. Defaults and why: docs/store-format.md.
 struct EncodeOptions {
-    int draco_speed = 6;        ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
-    int normal_bits = 10;       ///< octahedral quantization of normals
-    int uv_bits = 14;           ///< quantization of texture coordinates
+    int draco_speed = 6;   ///< Draco encoder/decoder speed 0 (smallest) .. 10 (fastest)
+    int normal_bits = 10;  ///< octahedral quantization of normals
+    int uv_bits = 14;      ///< quantization of texture coordinates
     /// Draco's sequential connectivity coding instead of edgebreaker: larger, but decodes faster
     /// on meshes of many small parts with split vertices (bench_brick_load).
     bool sequential = false;
@@ -37,40 +37,45 @@ struct EncodeOptions {
 
 /// A brick ready to be appended: encoded bytes and the directory fields known before writing.
 struct EncodedBrick {
-    std::string mesh_bytes;       ///< mesh section: 16-byte position base, then the Draco bitstream
-    std::string side_bytes;       ///< LZ4 side section (empty in format 1.0; see docs/store-format.md)
+    std::string mesh_bytes;  ///< mesh section: 16-byte position base, then the Draco bitstream
+    std::string side_bytes;  ///< LZ4 side section (empty in format 1.0; see docs/store-format.md)
     Bounds3f cell;
     Bounds3f geometry_bounds;     ///< box of the grid-snapped positions, exactly as they decode
     uint64_t triangle_count = 0;  ///< stored triangles (input minus dropped_triangle_count)
-    uint64_t vertex_count = 0;    ///< vertices once decoded (Draco splits vertices at material borders)
+    uint64_t vertex_count =
+        0;  ///< vertices once decoded (Draco splits vertices at material borders)
     uint64_t decoded_bytes = 0;
     bool has_normals = false;
     bool has_uvs = false;
-    uint32_t max_material_id = 0;          ///< largest material id used (Finish checks it against the table)
-    uint64_t dropped_triangle_count = 0;   ///< input triangles whose corners collapsed onto <= 2 grid points
+    uint32_t max_material_id =
+        0;  ///< largest material id used (Finish checks it against the table)
+    uint64_t dropped_triangle_count =
+        0;  ///< input triangles whose corners collapsed onto <= 2 grid points
 };
 
 /// Checks BrickMesh invariants; errors say which index or count is wrong.
 Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count);
 
-/// Snaps positions to `grid` and encodes, then decodes the result once to check it. Thread-safe. Triangles
-/// that collapse on the grid (two corners on one grid point: zero area) are dropped and counted. Fails
-/// (InvalidArgument) on a mesh that breaks the invariants, a position outside the grid's int32 range or a
-/// brick spanning more than 2^29 grid steps.
-StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell, const GlobalGrid& grid,
-                                   const EncodeOptions& options);
+/// Snaps positions to `grid` and encodes, then decodes the result once to check it. Thread-safe.
+/// Triangles that collapse on the grid (two corners on one grid point: zero area) are dropped and
+/// counted. Fails (InvalidArgument) on a mesh that breaks the invariants, a position outside the
+/// grid's int32 range or a brick spanning more than 2^29 grid steps.
+StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
+                                   const GlobalGrid& grid, const EncodeOptions& options);
 
 class StoreWriter {
   public:
     /// Starts writing `path` (through a temporary file beside it).
-    static StatusOr<std::unique_ptr<StoreWriter>> Create(const std::filesystem::path& path, const GlobalGrid& grid,
+    static StatusOr<std::unique_ptr<StoreWriter>> Create(const std::filesystem::path& path,
+                                                         const GlobalGrid& grid,
                                                          StoreProvenance provenance);
     ~StoreWriter();  // abandons the temporary file unless Finish() succeeded
 
     /// Appends a brick and returns its id (ids count from 0 in append order). Not thread-safe.
     StatusOr<uint32_t> Append(const EncodedBrick& brick);
-    /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory and the
-    /// header, then commits the file. `source_triangle_count` is the input's count before duplication.
+    /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory
+    /// and the header, then commits the file. `source_triangle_count` is the input's count before
+    /// duplication.
     Status Finish(const std::vector<MaterialRecord>& materials, const BrickTree& tree,
                   uint64_t source_triangle_count);
 

@@ -19,8 +19,8 @@ void Emitter::Flush() {
     batch_.clear();
 }
 
-bool Emitter::Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material,
-                     Triangle* t, bool* flip) {
+bool Emitter::Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward,
+                     uint32_t material, Triangle* t, bool* flip) {
     Vec3d n = Cross(b - a, c - a);
     t->material = material;
     t->p[0] = Vec3f(a);
@@ -40,8 +40,8 @@ void Emitter::Tri(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& o
 }
 
 void Emitter::TriUv(const Vec3d& a, const Vec3d& b, const Vec3d& c, const std::array<float, 2>& ta,
-                    const std::array<float, 2>& tb, const std::array<float, 2>& tc, const Vec3d& outward,
-                    uint32_t material) {
+                    const std::array<float, 2>& tb, const std::array<float, 2>& tc,
+                    const Vec3d& outward, uint32_t material) {
     Triangle t;
     bool flip = false;
     if (!Orient(a, b, c, outward, material, &t, &flip)) return;

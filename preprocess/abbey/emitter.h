@@ -48,7 +48,8 @@ class Emitter {
     }
 
     void QuadUv(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d,
-                const std::array<std::array<float, 2>, 4>& uv, const Vec3d& outward, uint32_t material) {
+                const std::array<std::array<float, 2>, 4>& uv, const Vec3d& outward,
+                uint32_t material) {
         TriUv(a, b, c, uv[0], uv[1], uv[2], outward, material);
         TriUv(a, c, d, uv[0], uv[2], uv[3], outward, material);
     }
@@ -58,9 +59,10 @@ class Emitter {
     uint64_t emitted() const { return emitted_; }
 
   private:
-    /// Fills `t` with a b c, wound to face `outward` (`flip`: b and c swapped); false if degenerate.
-    static bool Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward, uint32_t material,
-                       Triangle* t, bool* flip);
+    /// Fills `t` with a b c, wound to face `outward` (`flip`: b and c swapped); false if
+    /// degenerate.
+    static bool Orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& outward,
+                       uint32_t material, Triangle* t, bool* flip);
     void Push(Triangle& t);
     std::function<void(std::vector<Triangle>&)> flush_;
     size_t batch_triangles_;

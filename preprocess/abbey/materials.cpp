@@ -34,8 +34,10 @@ std::vector<store::MaterialRecord> AbbeyMaterials() {
         m.diffuse = {d.r, d.g, d.b};
         m.opacity = d.opacity;
         m.ior = d.ior;
-        // Glass carries its spectral transmittance map, written beside the model by WriteGlassTextures.
-        if (std::string_view(d.name).rfind("glass_", 0) == 0) m.textures[kTransmittanceSlot] = GlassTextureName(d.name);
+        // Glass carries its spectral transmittance map, written beside the model by
+        // WriteGlassTextures.
+        if (std::string_view(d.name).rfind("glass_", 0) == 0)
+            m.textures[kTransmittanceSlot] = GlassTextureName(d.name);
         out.push_back(m);
     }
     return out;

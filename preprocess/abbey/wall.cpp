@@ -159,7 +159,8 @@ void EmitGlazing(Emitter& em, const WallGeom& g, const Opening& o, const Detail&
             // Texture coordinates span the whole window, origin top-left (glass_textures.h), so the
             // spectral transmittance map of each glass colour lies across the window.
             auto uv = [&](double x, double z) {
-                return std::array<float, 2>{float((x - a) / (b - a)), float((apex - z) / (apex - o.sill))};
+                return std::array<float, 2>{float((x - a) / (b - a)),
+                                            float((apex - z) / (apex - o.sill))};
             };
             em.QuadUv(g.P(x0, z0, mid), g.P(x1, z0, mid), g.P(x1, t1, mid), g.P(x0, t0, mid),
                       {uv(x0, z0), uv(x1, z0), uv(x1, t1), uv(x0, t0)}, -w.inward, m);

@@ -12,8 +12,9 @@ namespace nave::preprocess {
 
 /// True if Assimp has an importer for `path`'s extension.
 bool AssimpSupports(const std::filesystem::path& path);
-/// Reads `path` with Assimp in a child process. Errors: NotFound; InvalidArgument with Assimp's message
-/// when it refuses the file; DataLoss naming the file and the signal when Assimp crashed on it.
+/// Reads `path` with Assimp in a child process. Errors: NotFound; InvalidArgument with Assimp's
+/// message when it refuses the file; DataLoss naming the file and the signal when Assimp crashed on
+/// it.
 StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::path& path);
 
 }  // namespace nave::preprocess

@@ -114,12 +114,15 @@ Vec3f TransformNormal(const NormalMatrix& n, const Vec3f& v) {
 /// Encoded images the file carries inside it (GLB buffer views, data URIs), by image index.
 using EmbeddedImages = std::map<int, std::string>;
 
-/// tinygltf's image loader: nave does not decode images here (the texture conversion does). External files
-/// are kept by name; embedded images have no name (their uri is empty), so their encoded bytes are kept.
-bool KeepEmbeddedImageBytes(tinygltf::Image* image, const int image_index, std::string*, std::string*, int,
-                            int, const unsigned char* bytes, int size, void* user) {
+/// tinygltf's image loader: nave does not decode images here (the texture conversion does).
+/// External files are kept by name; embedded images have no name (their uri is empty), so their
+/// encoded bytes are kept.
+bool KeepEmbeddedImageBytes(tinygltf::Image* image, const int image_index, std::string*,
+                            std::string*, int, int, const unsigned char* bytes, int size,
+                            void* user) {
     if (image->uri.empty() && bytes != nullptr && size > 0) {
-        (*static_cast<EmbeddedImages*>(user))[image_index] = std::string(reinterpret_cast<const char*>(bytes), size_t(size));
+        (*static_cast<EmbeddedImages*>(user))[image_index] =
+            std::string(reinterpret_cast<const char*>(bytes), size_t(size));
     }
     return true;
 }
@@ -127,7 +130,8 @@ bool KeepEmbeddedImageBytes(tinygltf::Image* image, const int image_index, std::
 /// The file extension of encoded image bytes by their signature, or empty if not PNG or JPEG.
 std::string ImageExtension(const std::string& bytes) {
     if (bytes.size() >= 8 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return "png";
-    if (bytes.size() >= 3 && uint8_t(bytes[0]) == 0xFF && uint8_t(bytes[1]) == 0xD8 && uint8_t(bytes[2]) == 0xFF)
+    if (bytes.size() >= 3 && uint8_t(bytes[0]) == 0xFF && uint8_t(bytes[1]) == 0xD8 &&
+        uint8_t(bytes[2]) == 0xFF)
         return "jpg";
     return {};
 }
@@ -260,7 +264,8 @@ class GltfReader {
     std::string file_;
 };
 
-/// The file a texture's image is read from: its uri, or for an embedded image the name it is written under
+/// The file a texture's image is read from: its uri, or for an embedded image the name it is
+/// written under
 /// ("helmet.image3.png", see KeepEmbeddedImageBytes), or empty when it has neither.
 std::string TextureName(const tinygltf::Model& model, int texture, const EmbeddedImages& embedded,
                         const std::string& stem) {
@@ -312,12 +317,14 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
             std::string name = TextureName(model, index, embedded, path.stem().string());
             if (name.empty()) {
                 if (index >= 0) {
-                    warnings.Add("textures neither in a file nor embedded as PNG/JPEG (colour used)",
-                                 fmt::format("{} material {} {}", file, m.name, slot));
+                    warnings.Add(
+                        "textures neither in a file nor embedded as PNG/JPEG (colour used)",
+                        fmt::format("{} material {} {}", file, m.name, slot));
                 }
                 return;
             }
-            // A missing or unreadable file is reported once, by the texture conversion (texture_convert.h).
+            // A missing or unreadable file is reported once, by the texture conversion
+            // (texture_convert.h).
             m.textures[slot] = name;
         };
         add_texture("baseColorTexture", pbr.baseColorTexture.index);
@@ -325,8 +332,9 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         add_texture("normalTexture", src.normalTexture.index);
         add_texture("emissiveTexture", src.emissiveTexture.index);
         add_texture("occlusionTexture", src.occlusionTexture.index);
-        // alphaMode MASK (glTF 2.0 §3.9.4): cut out where base-colour alpha x baseColorFactor alpha is below
-        // alphaCutoff. The renderer reads the alpha from "alphaMask", the base-colour image kept as data.
+        // alphaMode MASK (glTF 2.0 §3.9.4): cut out where base-colour alpha x baseColorFactor alpha
+        // is below alphaCutoff. The renderer reads the alpha from "alphaMask", the base-colour
+        // image kept as data.
         if (src.alphaMode == "MASK") {
             m.alpha_cutoff = float(src.alphaCutoff);
             add_texture("alphaMask", pbr.baseColorTexture.index);
@@ -457,13 +465,15 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
         std::string ext = ImageExtension(bytes);
         if (ext.empty()) continue;
         std::string name = fmt::format("{}.image{}.{}", path.stem().string(), index, ext);
-        bool used = std::any_of(materials.begin(), materials.end(), [&](const store::MaterialRecord& m) {
-            return std::any_of(m.textures.begin(), m.textures.end(), [&](const auto& t) { return t.second == name; });
-        });
+        bool used =
+            std::any_of(materials.begin(), materials.end(), [&](const store::MaterialRecord& m) {
+                return std::any_of(m.textures.begin(), m.textures.end(),
+                                   [&](const auto& t) { return t.second == name; });
+            });
         if (used) images.emplace_back(std::move(name), bytes);
     }
-    auto source = std::make_unique<IndexedMeshSource>(file, "m", std::move(meshes), std::move(materials),
-                                                      std::move(warnings));
+    auto source = std::make_unique<IndexedMeshSource>(file, "m", std::move(meshes),
+                                                      std::move(materials), std::move(warnings));
     source->SetEmbeddedImages(std::move(images));
     return std::unique_ptr<TriangleSource>(std::move(source));
 }

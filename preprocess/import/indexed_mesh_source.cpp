@@ -1,9 +1,8 @@
 #include "preprocess/import/indexed_mesh_source.h"
 
-#include "core/file.h"
-
 #include <fmt/format.h>
 
+#include "core/file.h"
 #include "preprocess/import/triangle_check.h"
 
 namespace nave::preprocess {

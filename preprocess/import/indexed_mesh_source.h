@@ -36,8 +36,9 @@ class IndexedMeshSource final : public TriangleSource {
     const ImportWarnings& warnings() const override { return warnings_; }
     /// Writes the embedded images handed to SetEmbeddedImages under their names.
     Status WriteGeneratedTextures(const std::filesystem::path& dir) const override;
-    /// Images the model file carries inside it (glTF buffer views, data URIs): file name -> encoded bytes.
-    /// The materials name them; WriteGeneratedTextures puts them where the texture conversion finds them.
+    /// Images the model file carries inside it (glTF buffer views, data URIs): file name -> encoded
+    /// bytes. The materials name them; WriteGeneratedTextures puts them where the texture
+    /// conversion finds them.
     void SetEmbeddedImages(std::vector<std::pair<std::string, std::string>> images) {
         embedded_images_ = std::move(images);
     }

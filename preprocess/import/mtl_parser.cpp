@@ -70,7 +70,8 @@ StatusOr<std::vector<store::MaterialRecord>> ParseMtl(const std::filesystem::pat
             while (!(token = NextToken(rest)).empty()) name = token;
             if (name.empty()) continue;
             std::string texture(name);
-            // A missing or unreadable file is reported once, by the texture conversion (texture_convert.h).
+            // A missing or unreadable file is reported once, by the texture conversion
+            // (texture_convert.h).
             m.textures[std::string(keyword)] = texture;
         }
     }

@@ -52,9 +52,10 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
                     "Decode every N-th brick (and the first) again after encoding to check it; 1 "
                     "checks all (a third slower), 0 none (default 8; `nave verify` checks a store "
                     "whole)");
-    cmd->add_flag("--no-textures", opt->no_textures,
-                  "Do not convert textures (the store's materials keep their flat colours; OpenImageIO, "
-                  "~160 MB, is then never loaded)");
+    cmd->add_flag(
+        "--no-textures", opt->no_textures,
+        "Do not convert textures (the store's materials keep their flat colours; OpenImageIO, "
+        "~160 MB, is then never loaded)");
     cmd->callback([&run, opt] {
         run = [opt]() -> Status {
             preprocess::PreprocessOptions o;

@@ -1,5 +1,6 @@
-// `nave render MODEL.nave --config SCENE.toml -o OUT.exr`: spectral rendering with ray streams over the
-// bricks of a store. Writes OUT.exr (linear, with settings and statistics as metadata) and OUT.png beside it.
+// `nave render MODEL.nave --config SCENE.toml -o OUT.exr`: spectral rendering with ray streams over
+// the bricks of a store. Writes OUT.exr (linear, with settings and statistics as metadata) and
+// OUT.png beside it.
 
 #include <cmath>
 #include <cstdio>
@@ -48,10 +49,10 @@ struct RenderOptions {
 Status ParseResolution(const std::string& text, int* width, int* height) {
     int w = 0, h = 0;
     char x = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
-        h <= 0 || w > 32768 || h > 32768) {
-        return InvalidArgumentError("--resolution {}: expected WIDTHxHEIGHT with each in [1, 32768], as in 960x640",
-                                    text);
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
+        w <= 0 || h <= 0 || w > 32768 || h > 32768) {
+        return InvalidArgumentError(
+            "--resolution {}: expected WIDTHxHEIGHT with each in [1, 32768], as in 960x640", text);
     }
     *width = w;
     *height = h;
@@ -66,7 +67,8 @@ std::string ModeName(render::RenderSettings::Mode m) {
 /// under --memory).
 uint64_t MaxLoadScratchBytes(const render::BrickSource& source) {
     uint64_t most = 0;
-    for (uint32_t b = 0; b < source.brick_count(); ++b) most = std::max(most, source.LoadScratchBytes(b));
+    for (uint32_t b = 0; b < source.brick_count(); ++b)
+        most = std::max(most, source.LoadScratchBytes(b));
     return most;
 }
 
@@ -95,16 +97,19 @@ std::string NoiseLine(const render::RenderSettings& settings, const render::Rend
 
 Status RunRender(const RenderOptions& o) {
     if (o.model.empty() == o.procedural.empty()) {
-        return InvalidArgumentError("give either MODEL.nave or --procedural NAME (not both, not neither)");
+        return InvalidArgumentError(
+            "give either MODEL.nave or --procedural NAME (not both, not neither)");
     }
     std::filesystem::path out = o.output;
     if (out.extension() != ".exr") {
-        return InvalidArgumentError("-o {}: the output must end in .exr (the PNG is written beside it)", o.output);
+        return InvalidArgumentError(
+            "-o {}: the output must end in .exr (the PNG is written beside it)", o.output);
     }
     NAVE_RETURN_IF_ERROR(CheckCheckpointFlags(o.checkpoint));
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, render::LoadSceneConfig(o.config));
     if (!o.resolution.empty()) {
-        NAVE_RETURN_IF_ERROR(ParseResolution(o.resolution, &config.camera.width, &config.camera.height));
+        NAVE_RETURN_IF_ERROR(
+            ParseResolution(o.resolution, &config.camera.width, &config.camera.height));
     }
     if (o.spp) config.render.spp = *o.spp;
     if (o.iterations) config.render.iterations = *o.iterations;
@@ -126,8 +131,9 @@ Status RunRender(const RenderOptions& o) {
         memory_limit = bytes;
     }
 
-    // Huge pages for Embree's BVHs: a fresh 4 KiB page costs a fault, and on virtual machines faults
-    // took as long as the BVH builds themselves (in-core abbey: 42 s -> 35 s with huge pages).
+    // Huge pages for Embree's BVHs: a fresh 4 KiB page costs a fault, and on virtual machines
+    // faults took as long as the BVH builds themselves (in-core abbey: 42 s -> 35 s with huge
+    // pages).
     NAVE_ASSIGN_OR_RETURN(auto device, render::EmbreeDevice::Create("hugepages=1"));
     std::unique_ptr<render::BrickSource> source;
     uint64_t model_id = 0;  // what a checkpoint of this render must have been written for
@@ -160,33 +166,37 @@ Status RunRender(const RenderOptions& o) {
     // from.
     if (session->checkpoints()) session->options.stop_requested = InstallRenderInterruptHandlers();
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, *source));
-    // The model's textures, through a capped tile cache (docs/textures.md); only when some material has one,
-    // so that untextured models never load OpenImageIO's texture system.
+    // The model's textures, through a capped tile cache (docs/textures.md); only when some material
+    // has one, so that untextured models never load OpenImageIO's texture system.
     std::unique_ptr<render::TextureCache> textures;
-    const bool any_texture = std::any_of(source->materials().begin(), source->materials().end(),
-                                         [](const store::MaterialRecord& m) { return !m.textures.empty(); });
+    const bool any_texture =
+        std::any_of(source->materials().begin(), source->materials().end(),
+                    [](const store::MaterialRecord& m) { return !m.textures.empty(); });
     if (config.textures.enabled && any_texture) {
-        // Its cap: [textures] cache, or under --memory the share [textures] memory_share of the budget, which
-        // the pager then counts as reserved (below).
+        // Its cap: [textures] cache, or under --memory the share [textures] memory_share of the
+        // budget, which the pager then counts as reserved (below).
         uint64_t cap = config.textures.cache_bytes;
         if (memory_limit) cap = uint64_t(double(*memory_limit) * config.textures.memory_share);
         NAVE_ASSIGN_OR_RETURN(textures, render::TextureCache::Create(cap));
         std::filesystem::path base = std::filesystem::path(o.model).parent_path();
         std::vector<std::string> warnings;
-        NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures, &scene, &warnings));
+        NAVE_RETURN_IF_ERROR(render::AttachTextures(config, base.empty() ? "." : base, *textures,
+                                                    &scene, &warnings));
         for (const std::string& w : warnings) log::Warning("{}", w);
-        // A cap above what all the textures take decoded buys nothing and, under --memory, would only take
-        // room from the bricks.
-        // Twice what they take leaves room for the cache's own bookkeeping and for tiles in flight.
+        // A cap above what all the textures take decoded buys nothing and, under --memory, would
+        // only take room from the bricks. Twice what they take leaves room for the cache's own
+        // bookkeeping and for tiles in flight.
         const uint64_t enough = 2 * textures->opened_pixel_bytes() + (uint64_t(4) << 20);
-        if (enough < textures->max_memory_bytes()) NAVE_RETURN_IF_ERROR(textures->SetMaxMemoryBytes(enough));
+        if (enough < textures->max_memory_bytes())
+            NAVE_RETURN_IF_ERROR(textures->SetMaxMemoryBytes(enough));
     }
-    log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(), scene.materials.size(),
-              config.camera.width, config.camera.height, ModeName(config.render.mode),
+    log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source->brick_count(),
+              scene.materials.size(), config.camera.width, config.camera.height,
+              ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
 
-    // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process); the
-    // bricks get what is left (docs/pager.md).
+    // --memory covers the resident bricks plus a reserve for the rest (film, ray queues, process);
+    // the bricks get what is left (docs/pager.md).
     render::PagerOptions options;
     NAVE_RETURN_IF_ERROR(render::ParsePagerTunables(o.pager, &options).WithContext("--pager"));
     std::unique_ptr<TraceRecorder> trace;
@@ -205,7 +215,8 @@ Status RunRender(const RenderOptions& o) {
         if (options.queue_memory_bytes == render::PagerOptions::kAutoQueueMemory) {
             options.queue_memory_bytes = render::QueueMemoryBytes(memory);
         }
-        const render::BrickBudgetMinimum need = render::MinimumBrickBudget(*source, options.prefetch);
+        const render::BrickBudgetMinimum need =
+            render::MinimumBrickBudget(*source, options.prefetch);
         // Writing a checkpoint holds the film's and the guide's state beside them.
         const uint64_t checkpoint_bytes =
             session->checkpoints() ? render::CheckpointMemoryBytes(
@@ -223,19 +234,23 @@ Status RunRender(const RenderOptions& o) {
         // When the bricks will not all fit, one wave for the whole image unless the user chose
         // (WavePathsUnderPaging): its camera rays spill to disk as they are generated.
         if (options.queue_memory_bytes > 0 && memory < reserve + need.total_bytes) {
-            const uint32_t wave =
-                render::WavePathsUnderPaging(scene.settings, config.camera.width, config.camera.height);
+            const uint32_t wave = render::WavePathsUnderPaging(scene.settings, config.camera.width,
+                                                               config.camera.height);
             if (wave != scene.settings.wave_paths) {
                 scene.settings.wave_paths = wave;
                 reserve = reserve_for(scene.settings);
-                log::Info("render: waves of {} camera paths (--wave-paths); their rays beyond {} of queues spill "
-                          "to disk", wave, FormatBytes(options.queue_memory_bytes));
+                log::Info(
+                    "render: waves of {} camera paths (--wave-paths); their rays beyond {} of "
+                    "queues spill "
+                    "to disk",
+                    wave, FormatBytes(options.queue_memory_bytes));
             }
         }
-        // The image is written after the bricks are freed, but OpenImageIO must fit then (unless the
-        // texture cache loaded it already: the process's size counts it then).
-        const uint64_t writer = CurrentRssBytes() + (textures ? 0 : render::kImageWriterBytes) +
-                                render::Film::MemoryBytes(config.camera.width, config.camera.height);
+        // The image is written after the bricks are freed, but OpenImageIO must fit then (unless
+        // the texture cache loaded it already: the process's size counts it then).
+        const uint64_t writer =
+            CurrentRssBytes() + (textures ? 0 : render::kImageWriterBytes) +
+            render::Film::MemoryBytes(config.camera.width, config.camera.height);
         const uint64_t minimum = std::max(reserve + need.min_bytes, writer);
         if (memory < minimum) {
             return ResourceExhaustedError(
@@ -257,11 +272,16 @@ Status RunRender(const RenderOptions& o) {
         options.brick_budget_bytes = memory - reserve;
         if (options.in_core()) --options.brick_budget_bytes;
         options.process_memory_bytes = memory;
-        log::Info("render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} bytes) "
-                  "reserved{}", FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
-                  FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes, FormatBytes(reserve),
-                  reserve, texture_bytes > 0 ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
-                                             : std::string());
+        log::Info(
+            "render: --memory {}: {} for bricks ({} for all {} bricks at once, {} bytes), {} ({} "
+            "bytes) "
+            "reserved{}",
+            FormatBytes(memory), FormatBytes(options.brick_budget_bytes),
+            FormatBytes(need.total_bytes), source->brick_count(), need.total_bytes,
+            FormatBytes(reserve), reserve,
+            texture_bytes > 0
+                ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_bytes))
+                : std::string());
     }
 
     render::Film film(config.camera.width, config.camera.height, scene.output);
@@ -322,8 +342,9 @@ Status RunRender(const RenderOptions& o) {
     };
     if (scene.sun >= 0) metadata.push_back({"nave:sun", scene.sun_description});
     if (textures) {
-        metadata.push_back({"nave:textures", fmt::format("cache_cap={} bytes_read={}", textures->max_memory_bytes(),
-                                                         textures->bytes_read())});
+        metadata.push_back(
+            {"nave:textures", fmt::format("cache_cap={} bytes_read={}",
+                                          textures->max_memory_bytes(), textures->bytes_read())});
     }
     NAVE_RETURN_IF_ERROR(film.Write(out, metadata));
     if (trace) NAVE_RETURN_IF_ERROR(trace->Write(o.trace).WithContext("--trace"));
@@ -374,19 +395,26 @@ Status RunRender(const RenderOptions& o) {
                            .c_str()
                      : "");
     if (stats.spilled_rays > 0) {
-        std::fprintf(stderr, "  ray queues: %s rays spilled to disk (%s written, at most %s on disk at once)\n",
-                     FormatCount(double(stats.spilled_rays)).c_str(), FormatBytes(stats.spill_bytes_written).c_str(),
-                     FormatBytes(stats.spill_peak_disk_bytes).c_str());
+        std::fprintf(
+            stderr,
+            "  ray queues: %s rays spilled to disk (%s written, at most %s on disk at once)\n",
+            FormatCount(double(stats.spilled_rays)).c_str(),
+            FormatBytes(stats.spill_bytes_written).c_str(),
+            FormatBytes(stats.spill_peak_disk_bytes).c_str());
     }
     if (stats.cache_bricks_written > 0) {
-        std::fprintf(stderr, "  brick cache: %s bricks decoded once, %s reloads read back, %s on disk (%s decoded)\n",
+        std::fprintf(stderr,
+                     "  brick cache: %s bricks decoded once, %s reloads read back, %s on disk (%s "
+                     "decoded)\n",
                      FormatCount(double(stats.cache_bricks_written)).c_str(),
-                     FormatCount(double(stats.cache_reads)).c_str(), FormatBytes(stats.cache_disk_bytes).c_str(),
+                     FormatCount(double(stats.cache_reads)).c_str(),
+                     FormatBytes(stats.cache_disk_bytes).c_str(),
                      FormatBytes(stats.cache_mesh_bytes).c_str());
     }
     if (textures) {
         std::fprintf(stderr, "  textures: read %s through a %s tile cache (%s held at the end)\n",
-                     FormatBytes(textures->bytes_read()).c_str(), FormatBytes(textures->max_memory_bytes()).c_str(),
+                     FormatBytes(textures->bytes_read()).c_str(),
+                     FormatBytes(textures->max_memory_bytes()).c_str(),
                      FormatBytes(textures->memory_used_bytes()).c_str());
     }
     return Status::Ok();
@@ -397,16 +425,22 @@ Status RunRender(const RenderOptions& o) {
 void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     auto opts = std::make_shared<RenderOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "render", "Render a brick store with spectral ray streams over its bricks (path tracing or SPPM)");
+        "render",
+        "Render a brick store with spectral ray streams over its bricks (path tracing or SPPM)");
     cmd->add_option("model", opts->model, "The model (.nave store from `nave preprocess`)");
     cmd->add_option("--procedural", opts->procedural,
-                    "Render a built-in test model instead: furnace, caustic or clutter, with :bricks=N for N^3 bricks");
-    cmd->add_option("-c,--config", opts->config, "Scene config (TOML; keys in configs/README.md)")->required();
-    cmd->add_option("-o,--output", opts->output, "Output OpenEXR file; a tone-mapped PNG is written beside it")
+                    "Render a built-in test model instead: furnace, caustic or clutter, with "
+                    ":bricks=N for N^3 bricks");
+    cmd->add_option("-c,--config", opts->config, "Scene config (TOML; keys in configs/README.md)")
         ->required();
-    cmd->add_option("--resolution", opts->resolution, "Override camera.resolution, as WIDTHxHEIGHT (e.g. 960x640)");
+    cmd->add_option("-o,--output", opts->output,
+                    "Output OpenEXR file; a tone-mapped PNG is written beside it")
+        ->required();
+    cmd->add_option("--resolution", opts->resolution,
+                    "Override camera.resolution, as WIDTHxHEIGHT (e.g. 960x640)");
     cmd->add_option("--spp", opts->spp, "Override render.spp")->check(CLI::PositiveNumber);
-    cmd->add_option("--iterations", opts->iterations, "Override render.iterations")->check(CLI::PositiveNumber);
+    cmd->add_option("--iterations", opts->iterations, "Override render.iterations")
+        ->check(CLI::PositiveNumber);
     cmd->add_option("--noise", opts->noise,
                     "Override render.noise_target: stop once the estimated relMSE of the image is "
                     "at most this "
@@ -418,27 +452,35 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("--photons", opts->photons,
                     "Override render.photons_per_iteration (at most 4294967295)")
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
-    cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--threads", opts->threads, "Override render.threads (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option("--seed", opts->seed, "Override render.seed");
-    cmd->add_option("--mode", opts->mode, "Override render.mode")->check(CLI::IsMember({"path", "photon"}));
+    cmd->add_option("--mode", opts->mode, "Override render.mode")
+        ->check(CLI::IsMember({"path", "photon"}));
     cmd->add_option("--wave-paths", opts->wave_paths,
-                    "Camera paths (or photons) in flight at once (default 1048576; under --memory, when the bricks do "
-                    "not all fit, the whole image in path mode): more rays per brick visit, so fewer loads, for "
+                    "Camera paths (or photons) in flight at once (default 1048576; under --memory, "
+                    "when the bricks do "
+                    "not all fit, the whole image in path mode): more rays per brick visit, so "
+                    "fewer loads, for "
                     "more ray-queue memory or spilling")
         ->check(CLI::Range(uint64_t(1024), uint64_t(1) << 31));
     cmd->add_option("--memory", opts->memory,
-                    "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it (docs/pager.md). "
+                    "Memory budget (e.g. 2G, 300M): bricks are paged in and out to stay within it "
+                    "(docs/pager.md). "
                     "Default: every brick stays resident once loaded");
     cmd->add_option(
         "--pager", opts->pager,
         "Pager tunables, comma separated (docs/pager.md): " + std::string(render::kPagerTunables));
-    cmd->add_option("--temp-dir", opts->temp_dir,
-                    "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "
-                    "and vanish when nave exits. Default: beside the output");
-    cmd->add_option("--trace", opts->trace,
-                    "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
-                    "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
-    cmd->add_flag("--no-textures", opts->no_textures, "Ignore the model's textures (textures.enabled = false)");
+    cmd->add_option(
+        "--temp-dir", opts->temp_dir,
+        "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "
+        "and vanish when nave exits. Default: beside the output");
+    cmd->add_option(
+        "--trace", opts->trace,
+        "Write a timeline of the render's loads, evictions, stalls, batches and memory as Chrome "
+        "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
+    cmd->add_flag("--no-textures", opts->no_textures,
+                  "Ignore the model's textures (textures.enabled = false)");
     cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
                     "Write the render's state to FILE between passes (photon mode: iterations), at "
                     "most every "

@@ -1,11 +1,11 @@
 #pragma once
-// Each `nave` subcommand lives in its own cmd_*.cpp and registers itself here: it adds its options to the
-// CLI11 app and sets `run` to the work to do once parsing succeeded. Only main() turns a Status into an
-// exit code. CLI11 is expensive to compile, so it is a precompiled header of this target only.
-
-#include <functional>
+// Each `nave` subcommand lives in its own cmd_*.cpp and registers itself here: it adds its options
+// to the CLI11 app and sets `run` to the work to do once parsing succeeded. Only main() turns a
+// Status into an exit code. CLI11 is expensive to compile, so it is a precompiled header of this
+// target only.
 
 #include <CLI/CLI.hpp>
+#include <functional>
 
 #include "core/status.h"
 

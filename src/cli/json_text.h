@@ -1,5 +1,6 @@
 #pragma once
-// Small helpers for the commands' --json output (written by hand: the documents are flat and small).
+// Small helpers for the commands' --json output (written by hand: the documents are flat and
+// small).
 
 #include <string>
 

@@ -10,7 +10,8 @@ CheckFailure::CheckFailure(const char* file, int line, const std::string& what) 
 }
 
 CheckFailure::~CheckFailure() {
-    std::fprintf(stderr, "nave: internal error (a bug, please report it): %s\n", stream_.str().c_str());
+    std::fprintf(stderr, "nave: internal error (a bug, please report it): %s\n",
+                 stream_.str().c_str());
     std::fflush(stderr);
     std::abort();
 }

@@ -1,6 +1,7 @@
 #pragma once
 // Always-on assertions for bugs (never for bad input: that is a Status). A failed check prints the
-// expression, both operands for the comparison forms, the source location and a streamed message, then aborts.
+// expression, both operands for the comparison forms, the source location and a streamed message,
+// then aborts.
 //   NAVE_CHECK(ptr != nullptr) << "brick " << id;
 //   NAVE_CHECK_EQ(a.size(), b.size());
 
@@ -38,18 +39,18 @@ std::string FormatOperands(const char* expr, const A& a, const B& b) {
 
 }  // namespace nave::detail
 
-#define NAVE_CHECK(cond)                 \
-    (cond) ? (void)0                     \
+#define NAVE_CHECK(cond)                      \
+    (cond) ? (void)0                          \
            : ::nave::detail::CheckVoidify() & \
                  ::nave::detail::CheckFailure(__FILE__, __LINE__, "CHECK(" #cond ") failed")
 
-#define NAVE_CHECK_OP(a, b, op)                                                                   \
-    ((a)op(b)) ? (void)0                                                                          \
-               : ::nave::detail::CheckVoidify() &                                                 \
-                     ::nave::detail::CheckFailure(                                                \
-                         __FILE__, __LINE__,                                                      \
-                         ::nave::detail::FormatOperands("CHECK(" #a " " #op " " #b ") failed", (a), \
-                                                        (b)))
+#define NAVE_CHECK_OP(a, b, op)             \
+    ((a)op(b))                              \
+        ? (void)0                           \
+        : ::nave::detail::CheckVoidify() &  \
+              ::nave::detail::CheckFailure( \
+                  __FILE__, __LINE__,       \
+                  ::nave::detail::FormatOperands("CHECK(" #a " " #op " " #b ") failed", (a), (b)))
 
 #define NAVE_CHECK_EQ(a, b) NAVE_CHECK_OP(a, b, ==)
 #define NAVE_CHECK_NE(a, b) NAVE_CHECK_OP(a, b, !=)

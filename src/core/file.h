@@ -1,7 +1,8 @@
 #pragma once
-// Files written safely and read with errors that name them. Every output of nave goes through AtomicFile:
-// written under a temporary name beside the target, fsynced and renamed only when complete, so that an
-// interrupted or failed run never leaves a half-written file under the real name.
+// Files written safely and read with errors that name them. Every output of nave goes through
+// AtomicFile: written under a temporary name beside the target, fsynced and renamed only when
+// complete, so that an interrupted or failed run never leaves a half-written file under the real
+// name.
 
 #include <cstdint>
 #include <filesystem>
@@ -15,7 +16,8 @@ namespace nave {
 /// Writes `path` atomically. Not thread-safe. Move-only.
 class AtomicFile {
   public:
-    /// Creates `<path>.tmp-<pid>-<n>` next to `path`. Errors name the directory (missing, not writable).
+    /// Creates `<path>.tmp-<pid>-<n>` next to `path`. Errors name the directory (missing, not
+    /// writable).
     static StatusOr<AtomicFile> Create(const std::filesystem::path& path);
 
     AtomicFile(AtomicFile&& other) noexcept;
@@ -59,7 +61,8 @@ class ReadOnlyFile {
     ReadOnlyFile& operator=(const ReadOnlyFile&) = delete;
     ~ReadOnlyFile();
 
-    /// Reads exactly `size` bytes at `offset`; a short read is DataLoss ("truncated") naming file and offset.
+    /// Reads exactly `size` bytes at `offset`; a short read is DataLoss ("truncated") naming file
+    /// and offset.
     Status ReadAt(uint64_t offset, void* out, size_t size) const;
     uint64_t size() const { return size_; }
     const std::filesystem::path& path() const { return path_; }

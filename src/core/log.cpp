@@ -1,9 +1,9 @@
 #include "core/log.h"
 
-#include <atomic>
-
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+
+#include <atomic>
 
 namespace nave::log {
 namespace {
@@ -27,11 +27,20 @@ Level GetLevel() { return g_level.load(std::memory_order_relaxed); }
 
 void Write(Level level, const std::string& message) {
     switch (level) {
-        case Level::kDebug: Logger().debug(message); break;
-        case Level::kInfo: Logger().info(message); break;
-        case Level::kWarning: Logger().warn(message); break;
-        case Level::kError: Logger().error(message); break;
-        case Level::kOff: break;
+        case Level::kDebug:
+            Logger().debug(message);
+            break;
+        case Level::kInfo:
+            Logger().info(message);
+            break;
+        case Level::kWarning:
+            Logger().warn(message);
+            break;
+        case Level::kError:
+            Logger().error(message);
+            break;
+        case Level::kOff:
+            break;
     }
 }
 

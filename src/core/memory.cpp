@@ -22,24 +22,34 @@ namespace nave {
 
 StatusOr<uint64_t> ParseByteSize(std::string_view text) {
     auto bad = [&] {
-        return InvalidArgumentError("'{}' is not a size: expected a number with an optional unit, "
-                                    "as in 512M, 1.5G, 2GiB or 1048576", text);
+        return InvalidArgumentError(
+            "'{}' is not a size: expected a number with an optional unit, "
+            "as in 512M, 1.5G, 2GiB or 1048576",
+            text);
     };
     size_t i = 0;
-    while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
+    while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.'))
+        ++i;
     if (i == 0) return bad();
     double number = 0;
     auto [ptr, ec] = std::from_chars(text.data(), text.data() + i, number);
-    if (ec != std::errc() || ptr != text.data() + i || !std::isfinite(number) || number < 0) return bad();
+    if (ec != std::errc() || ptr != text.data() + i || !std::isfinite(number) || number < 0)
+        return bad();
     std::string unit;
     for (char c : text.substr(i)) unit += char(std::toupper(static_cast<unsigned char>(c)));
     double scale = 1;
-    if (unit.empty() || unit == "B") scale = 1;
-    else if (unit == "K" || unit == "KB" || unit == "KIB") scale = 1024.0;
-    else if (unit == "M" || unit == "MB" || unit == "MIB") scale = 1024.0 * 1024;
-    else if (unit == "G" || unit == "GB" || unit == "GIB") scale = 1024.0 * 1024 * 1024;
-    else if (unit == "T" || unit == "TB" || unit == "TIB") scale = 1024.0 * 1024 * 1024 * 1024;
-    else return bad();
+    if (unit.empty() || unit == "B")
+        scale = 1;
+    else if (unit == "K" || unit == "KB" || unit == "KIB")
+        scale = 1024.0;
+    else if (unit == "M" || unit == "MB" || unit == "MIB")
+        scale = 1024.0 * 1024;
+    else if (unit == "G" || unit == "GB" || unit == "GIB")
+        scale = 1024.0 * 1024 * 1024;
+    else if (unit == "T" || unit == "TB" || unit == "TIB")
+        scale = 1024.0 * 1024 * 1024 * 1024;
+    else
+        return bad();
     double bytes = number * scale;
     if (bytes > 9.0e18) return bad();
     return static_cast<uint64_t>(bytes);

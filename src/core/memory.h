@@ -11,8 +11,8 @@
 
 namespace nave {
 
-/// Parses "123", "64K", "512M", "1.5G", "2GiB", "300MB" (K/M/G/T are powers of 1024, as in `--memory 8G`).
-/// Errors name the text and the accepted forms.
+/// Parses "123", "64K", "512M", "1.5G", "2GiB", "300MB" (K/M/G/T are powers of 1024, as in
+/// `--memory 8G`). Errors name the text and the accepted forms.
 StatusOr<uint64_t> ParseByteSize(std::string_view text);
 /// "1.50 GiB", "512.0 MiB", "12 B".
 std::string FormatBytes(uint64_t bytes);

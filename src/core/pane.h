@@ -7,11 +7,12 @@
 
 namespace nave {
 
-/// The internal transmittance τ of one pass through a pane whose total normal-incidence transmittance
-/// (what a spectrophotometer reports) is `total_t`, each face reflecting `face_reflectance` R: the pane with
-/// multiple reflections between its faces transmits T = (1-R)² τ / (1 - R² τ²) (e.g. Born & Wolf, Principles
-/// of Optics, incoherent slab), solved for the positive root of R² T τ² + (1-R)² τ - T = 0. A total above
-/// what a lossless pane allows, (1 - R) / (1 + R), gives 1. In [0, 1].
+/// The internal transmittance τ of one pass through a pane whose total normal-incidence
+/// transmittance (what a spectrophotometer reports) is `total_t`, each face reflecting
+/// `face_reflectance` R: the pane with multiple reflections between its faces transmits T = (1-R)²
+/// τ / (1 - R² τ²) (e.g. Born & Wolf, Principles of Optics, incoherent slab), solved for the
+/// positive root of R² T τ² + (1-R)² τ - T = 0. A total above what a lossless pane allows, (1 - R)
+/// / (1 + R), gives 1. In [0, 1].
 inline float PaneInternalTransmittance(float total_t, double face_reflectance) {
     const double r = face_reflectance;
     const double t = std::clamp(double(total_t), 0.0, 1.0);

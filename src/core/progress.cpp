@@ -1,11 +1,10 @@
 #include "core/progress.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
-
-#include <fmt/format.h>
 
 #include "core/log.h"
 
@@ -18,8 +17,11 @@ constexpr int64_t kRedrawIntervalNs = 200'000'000;  // 5 redraws per second at m
 void ProgressBar::SetEnabled(bool enabled) { g_enabled.store(enabled); }
 
 ProgressBar::ProgressBar(std::string label, uint64_t total, std::string unit)
-    : label_(std::move(label)), unit_(std::move(unit)), total_(total),
-      start_(std::chrono::steady_clock::now()), tty_(isatty(STDERR_FILENO) != 0) {}
+    : label_(std::move(label)),
+      unit_(std::move(unit)),
+      total_(total),
+      start_(std::chrono::steady_clock::now()),
+      tty_(isatty(STDERR_FILENO) != 0) {}
 
 ProgressBar::~ProgressBar() { Finish(); }
 
@@ -33,7 +35,8 @@ void ProgressBar::Add(uint64_t n) {
     done_.fetch_add(n, std::memory_order_relaxed);
     if (!g_enabled.load(std::memory_order_relaxed)) return;
     int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                      std::chrono::steady_clock::now() - start_).count();
+                      std::chrono::steady_clock::now() - start_)
+                      .count();
     int64_t last = last_draw_ns_.load(std::memory_order_relaxed);
     if (now - last < kRedrawIntervalNs) return;
     if (!last_draw_ns_.compare_exchange_strong(last, now)) return;  // another thread draws
@@ -62,11 +65,12 @@ void ProgressBar::Draw(bool final_draw) {
     const uint64_t total = total_.load();
     const double elapsed = ElapsedSeconds();
     const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
-    std::string tail = fmt::format("{} {} | {}/s | {}", FormatCount(double(done)), unit_, FormatCount(rate),
-                                   FormatDuration(elapsed));
+    std::string tail = fmt::format("{} {} | {}/s | {}", FormatCount(double(done)), unit_,
+                                   FormatCount(rate), FormatDuration(elapsed));
     double fraction = total > 0 ? std::min(1.0, double(done) / double(total)) : 0.0;
     if (total > 0 && !final_draw && rate > 0) {
-        tail += fmt::format(" | ETA {}", FormatDuration(double(total - std::min(done, total)) / rate));
+        tail +=
+            fmt::format(" | ETA {}", FormatDuration(double(total - std::min(done, total)) / rate));
     }
     if (!note_.empty()) tail += " | " + note_;
     if (tty_) {
@@ -74,7 +78,8 @@ void ProgressBar::Draw(bool final_draw) {
         std::string bar;
         if (total > 0) {
             const int filled = std::clamp(int(fraction * kWidth), 0, kWidth);
-            bar = fmt::format("[{:#<{}}{:-<{}}] {:5.1f}% ", "", filled, "", kWidth - filled, 100.0 * fraction);
+            bar = fmt::format("[{:#<{}}{:-<{}}] {:5.1f}% ", "", filled, "", kWidth - filled,
+                              100.0 * fraction);
         }
         std::fprintf(stderr, "\r\033[K%s %s%s%s", label_.c_str(), bar.c_str(), tail.c_str(),
                      final_draw ? "\n" : "");

@@ -1,6 +1,7 @@
 #pragma once
-// A progress bar with rate and ETA for long work (preprocess phases, render passes). It draws on stderr
-// only when stderr is a terminal, at most a few times a second; otherwise it logs a line every ~10 %.
+// A progress bar with rate and ETA for long work (preprocess phases, render passes). It draws on
+// stderr only when stderr is a terminal, at most a few times a second; otherwise it logs a line
+// every ~10 %.
 
 #include <atomic>
 #include <chrono>
@@ -12,7 +13,8 @@ namespace nave {
 
 class ProgressBar {
   public:
-    /// `total` units of work named `unit` ("triangles", "rays"); 0 means unknown (no ETA, count only).
+    /// `total` units of work named `unit` ("triangles", "rays"); 0 means unknown (no ETA, count
+    /// only).
     ProgressBar(std::string label, uint64_t total, std::string unit);
     ~ProgressBar();
     ProgressBar(const ProgressBar&) = delete;

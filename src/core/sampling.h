@@ -47,8 +47,9 @@ inline Vec3f SampleCosineHemisphere(Point2f u) {
 }
 inline float CosineHemispherePdf(float cos_theta) { return cos_theta * kInvPi; }
 
-/// Barycentric weights of a point uniform on a triangle (Turk 1990's square-root parameterisation, "Generating
-/// random points in triangles", Graphics Gems): the point is b[0] v0 + b[1] v1 + b[2] v2; pdf 1/area.
+/// Barycentric weights of a point uniform on a triangle (Turk 1990's square-root parameterisation,
+/// "Generating random points in triangles", Graphics Gems): the point is b[0] v0 + b[1] v1 + b[2]
+/// v2; pdf 1/area.
 inline std::array<float, 3> SampleUniformTriangle(Point2f u) {
     const float su = std::sqrt(u.x);
     return {1.f - su, su * (1.f - u.y), su * u.y};

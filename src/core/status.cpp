@@ -4,15 +4,24 @@ namespace nave {
 
 const char* StatusCodeName(StatusCode code) {
     switch (code) {
-        case StatusCode::kOk: return "ok";
-        case StatusCode::kInvalidArgument: return "invalid argument";
-        case StatusCode::kNotFound: return "not found";
-        case StatusCode::kIoError: return "i/o error";
-        case StatusCode::kDataLoss: return "data loss";
-        case StatusCode::kUnsupported: return "unsupported";
-        case StatusCode::kResourceExhausted: return "resource exhausted";
-        case StatusCode::kCancelled: return "cancelled";
-        case StatusCode::kInternal: return "internal error";
+        case StatusCode::kOk:
+            return "ok";
+        case StatusCode::kInvalidArgument:
+            return "invalid argument";
+        case StatusCode::kNotFound:
+            return "not found";
+        case StatusCode::kIoError:
+            return "i/o error";
+        case StatusCode::kDataLoss:
+            return "data loss";
+        case StatusCode::kUnsupported:
+            return "unsupported";
+        case StatusCode::kResourceExhausted:
+            return "resource exhausted";
+        case StatusCode::kCancelled:
+            return "cancelled";
+        case StatusCode::kInternal:
+            return "internal error";
     }
     return "unknown";
 }

@@ -1,13 +1,14 @@
 #pragma once
-// Status and StatusOr<T>: how nave reports bad input (a malformed model, a corrupt store, a wrong config key).
-// Bugs are reported by the CHECK macros in check.h instead. Only main() turns a Status into an exit code.
+// Status and StatusOr<T>: how nave reports bad input (a malformed model, a corrupt store, a wrong
+// config key). Bugs are reported by the CHECK macros in check.h instead. Only main() turns a Status
+// into an exit code.
+
+#include <fmt/format.h>
 
 #include <optional>
 #include <string>
 #include <utility>
 #include <variant>
-
-#include <fmt/format.h>
 
 #include "core/check.h"
 
@@ -19,10 +20,10 @@ enum class StatusCode {
     kNotFound,         // a missing file, material, brick...
     kIoError,          // the operating system refused a read or write (full disk, permissions)
     kDataLoss,         // a corrupt or truncated file: checksum mismatch, short read
-    kUnsupported,      // a valid file this version cannot read (future major version, unknown format)
-    kResourceExhausted,// a memory budget that cannot hold the work
-    kCancelled,        // interrupted by the user
-    kInternal,         // a library failed in a way that is not the input's fault
+    kUnsupported,  // a valid file this version cannot read (future major version, unknown format)
+    kResourceExhausted,  // a memory budget that cannot hold the work
+    kCancelled,          // interrupted by the user
+    kInternal,           // a library failed in a way that is not the input's fault
 };
 
 /// The name of a code, as printed in messages ("data loss", "invalid argument"...).
@@ -91,9 +92,18 @@ class [[nodiscard]] StatusOr {
     bool ok() const { return status_.ok(); }
     const Status& status() const { return status_; }
 
-    T& value() & { CheckHasValue(); return *value_; }
-    const T& value() const& { CheckHasValue(); return *value_; }
-    T&& value() && { CheckHasValue(); return std::move(*value_); }
+    T& value() & {
+        CheckHasValue();
+        return *value_;
+    }
+    const T& value() const& {
+        CheckHasValue();
+        return *value_;
+    }
+    T&& value() && {
+        CheckHasValue();
+        return std::move(*value_);
+    }
     T& operator*() & { return value(); }
     const T& operator*() const& { return value(); }
     T* operator->() { return &value(); }
@@ -113,10 +123,10 @@ class [[nodiscard]] StatusOr {
 #define NAVE_STATUS_CONCAT(a, b) NAVE_STATUS_CONCAT_INNER(a, b)
 
 /// Returns the Status from the enclosing function if `expr` is not ok.
-#define NAVE_RETURN_IF_ERROR(expr)                  \
-    do {                                            \
-        ::nave::Status nave_status_ = (expr);       \
-        if (!nave_status_.ok()) return nave_status_;\
+#define NAVE_RETURN_IF_ERROR(expr)                   \
+    do {                                             \
+        ::nave::Status nave_status_ = (expr);        \
+        if (!nave_status_.ok()) return nave_status_; \
     } while (0)
 
 /// `NAVE_ASSIGN_OR_RETURN(auto x, F());` declares x from a StatusOr or returns its error.

@@ -1,5 +1,6 @@
 #pragma once
-// Small vector and box types shared by the store, preprocess and render. Header-only and dependency-free.
+// Small vector and box types shared by the store, preprocess and render. Header-only and
+// dependency-free.
 
 #include <algorithm>
 #include <cmath>
@@ -26,9 +27,24 @@ struct Vec3 {
     constexpr Vec3 operator*(T s) const { return {x * s, y * s, z * s}; }
     constexpr Vec3 operator/(T s) const { return {x / s, y / s, z / s}; }
     constexpr Vec3 operator*(const Vec3& o) const { return {x * o.x, y * o.y, z * o.z}; }
-    constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
-    constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-    constexpr Vec3& operator*=(T s) { x *= s; y *= s; z *= s; return *this; }
+    constexpr Vec3& operator+=(const Vec3& o) {
+        x += o.x;
+        y += o.y;
+        z += o.z;
+        return *this;
+    }
+    constexpr Vec3& operator-=(const Vec3& o) {
+        x -= o.x;
+        y -= o.y;
+        z -= o.z;
+        return *this;
+    }
+    constexpr Vec3& operator*=(T s) {
+        x *= s;
+        y *= s;
+        z *= s;
+        return *this;
+    }
     constexpr bool operator==(const Vec3& o) const = default;
 };
 
@@ -36,30 +52,49 @@ using Vec3f = Vec3<float>;
 using Vec3d = Vec3<double>;
 using Vec3i = Vec3<int32_t>;
 
-template <typename T> constexpr Vec3<T> operator*(T s, const Vec3<T>& v) { return v * s; }
-template <typename T> constexpr T Dot(const Vec3<T>& a, const Vec3<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-template <typename T> constexpr Vec3<T> Cross(const Vec3<T>& a, const Vec3<T>& b) {
+template <typename T>
+constexpr Vec3<T> operator*(T s, const Vec3<T>& v) {
+    return v * s;
+}
+template <typename T>
+constexpr T Dot(const Vec3<T>& a, const Vec3<T>& b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <typename T>
+constexpr Vec3<T> Cross(const Vec3<T>& a, const Vec3<T>& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-template <typename T> T Length(const Vec3<T>& v) { return std::sqrt(Dot(v, v)); }
-template <typename T> Vec3<T> Normalize(const Vec3<T>& v) { return v / Length(v); }
-template <typename T> constexpr Vec3<T> Min(const Vec3<T>& a, const Vec3<T>& b) {
+template <typename T>
+T Length(const Vec3<T>& v) {
+    return std::sqrt(Dot(v, v));
+}
+template <typename T>
+Vec3<T> Normalize(const Vec3<T>& v) {
+    return v / Length(v);
+}
+template <typename T>
+constexpr Vec3<T> Min(const Vec3<T>& a, const Vec3<T>& b) {
     return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
-template <typename T> constexpr Vec3<T> Max(const Vec3<T>& a, const Vec3<T>& b) {
+template <typename T>
+constexpr Vec3<T> Max(const Vec3<T>& a, const Vec3<T>& b) {
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-template <typename T> bool IsFinite(const Vec3<T>& v) {
+template <typename T>
+bool IsFinite(const Vec3<T>& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-template <typename T> std::ostream& operator<<(std::ostream& os, const Vec3<T>& v) {
+template <typename T>
+std::ostream& operator<<(std::ostream& os, const Vec3<T>& v) {
     return os << "(" << v.x << ", " << v.y << ", " << v.z << ")";
 }
 
-/// An axis-aligned box. A default-constructed box is empty (min > max) and absorbs the first point added.
+/// An axis-aligned box. A default-constructed box is empty (min > max) and absorbs the first point
+/// added.
 template <typename T>
 struct Bounds3 {
-    Vec3<T> min{std::numeric_limits<T>::max(), std::numeric_limits<T>::max(), std::numeric_limits<T>::max()};
+    Vec3<T> min{std::numeric_limits<T>::max(), std::numeric_limits<T>::max(),
+                std::numeric_limits<T>::max()};
     Vec3<T> max{std::numeric_limits<T>::lowest(), std::numeric_limits<T>::lowest(),
                 std::numeric_limits<T>::lowest()};
 
@@ -67,12 +102,19 @@ struct Bounds3 {
     constexpr Bounds3(const Vec3<T>& lo, const Vec3<T>& hi) : min(lo), max(hi) {}
 
     constexpr bool Empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
-    constexpr void Extend(const Vec3<T>& p) { min = Min(min, p); max = Max(max, p); }
-    constexpr void Extend(const Bounds3& b) { min = Min(min, b.min); max = Max(max, b.max); }
+    constexpr void Extend(const Vec3<T>& p) {
+        min = Min(min, p);
+        max = Max(max, p);
+    }
+    constexpr void Extend(const Bounds3& b) {
+        min = Min(min, b.min);
+        max = Max(max, b.max);
+    }
     constexpr Vec3<T> Diagonal() const { return max - min; }
     constexpr Vec3<T> Center() const { return (min + max) * T(0.5); }
     constexpr bool Contains(const Vec3<T>& p) const {
-        return p.x >= min.x && p.x <= max.x && p.y >= min.y && p.y <= max.y && p.z >= min.z && p.z <= max.z;
+        return p.x >= min.x && p.x <= max.x && p.y >= min.y && p.y <= max.y && p.z >= min.z &&
+               p.z <= max.z;
     }
     constexpr bool Overlaps(const Bounds3& b) const {
         return min.x <= b.max.x && max.x >= b.min.x && min.y <= b.max.y && max.y >= b.min.y &&
@@ -89,7 +131,8 @@ struct Bounds3 {
 using Bounds3f = Bounds3<float>;
 using Bounds3d = Bounds3<double>;
 
-template <typename T> std::ostream& operator<<(std::ostream& os, const Bounds3<T>& b) {
+template <typename T>
+std::ostream& operator<<(std::ostream& os, const Bounds3<T>& b) {
     return os << "[" << b.min << " - " << b.max << "]";
 }
 

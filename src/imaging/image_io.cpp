@@ -10,8 +10,8 @@
 namespace nave::imaging {
 namespace {
 
-/// Writes through the plugin to a temporary name, then renames into place; the temporary file never outlives
-/// a failure.
+/// Writes through the plugin to a temporary name, then renames into place; the temporary file never
+/// outlives a failure.
 Status WriteAtomically(const std::filesystem::path& path, const ImageWriteRequest& request) {
     NAVE_ASSIGN_OR_RETURN(const OiioPlugin* plugin, LoadOiioPlugin());
     const std::filesystem::path temp = TemporaryImagePath(path);
@@ -23,7 +23,8 @@ Status WriteAtomically(const std::filesystem::path& path, const ImageWriteReques
     std::filesystem::rename(temp, path, ec);
     if (ec) {
         std::filesystem::remove(temp, ec);
-        return IoError("{}: cannot rename {} into place: {}", path.string(), temp.string(), ec.message());
+        return IoError("{}: cannot rename {} into place: {}", path.string(), temp.string(),
+                       ec.message());
     }
     return Status::Ok();
 }
@@ -54,7 +55,8 @@ std::filesystem::path TemporaryImagePath(const std::filesystem::path& path) {
     return p;
 }
 
-Status WriteExr(const std::filesystem::path& path, const FloatImage& image, const ImageMetadata& metadata) {
+Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
+                const ImageMetadata& metadata) {
     ImageWriteRequest request = FloatRequest(image, metadata);
     // Depth needs float's range and precision; colours are fine in half, as EXR viewers expect.
     for (const std::string& c : image.channels)
@@ -70,8 +72,8 @@ Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image,
     return WriteAtomically(path, request);
 }
 
-Status WriteRgb8(const std::filesystem::path& path, int width, int height, const std::vector<uint8_t>& rgb,
-                 const ImageMetadata& metadata) {
+Status WriteRgb8(const std::filesystem::path& path, int width, int height,
+                 const std::vector<uint8_t>& rgb, const ImageMetadata& metadata) {
     NAVE_CHECK_EQ(rgb.size(), size_t(width) * height * 3);
     ImageWriteRequest request;
     request.width = width;

@@ -1,7 +1,8 @@
 #pragma once
-// Reading and writing images through OpenImageIO (in nave's plugin, imaging/oiio_plugin.h). Every OIIO error
-// comes back as a Status naming the file. Files are written under a temporary name in the target's directory
-// and renamed when complete, so an interrupted write never leaves a half-written image under the real name.
+// Reading and writing images through OpenImageIO (in nave's plugin, imaging/oiio_plugin.h). Every
+// OIIO error comes back as a Status naming the file. Files are written under a temporary name in
+// the target's directory and renamed when complete, so an interrupted write never leaves a
+// half-written image under the real name.
 
 #include <cstdint>
 #include <filesystem>
@@ -22,26 +23,30 @@ struct FloatImage {
 
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
-/// The header attribute of a spectral texture (one channel per wavelength band) holding the band centres,
-/// comma-separated, in nm, strictly increasing ("400,420,440").
+/// The header attribute of a spectral texture (one channel per wavelength band) holding the band
+/// centres, comma-separated, in nm, strictly increasing ("400,420,440").
 inline constexpr char kBandCentresAttribute[] = "nave:band_centres_nm";
-/// The channel name of band `b` of a spectral texture: "band00", "band01"... OpenEXR stores channels sorted
-/// by name, so the names are zero-padded to keep the file's channel order the band order (at most 100 bands).
+/// The channel name of band `b` of a spectral texture: "band00", "band01"... OpenEXR stores
+/// channels sorted by name, so the names are zero-padded to keep the file's channel order the band
+/// order (at most 100 bands).
 std::string BandChannelName(int b);
 
-/// Writes a linear float OpenEXR file (half float for colour, float for depth "Z") with string metadata.
-Status WriteExr(const std::filesystem::path& path, const FloatImage& image, const ImageMetadata& metadata);
+/// Writes a linear float OpenEXR file (half float for colour, float for depth "Z") with string
+/// metadata.
+Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
+                const ImageMetadata& metadata);
 /// Writes a tiled (tile_size x tile_size), half-float OpenEXR file, as textures are read best.
 Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image, int tile_size,
                      const ImageMetadata& metadata);
-/// Writes an 8-bit RGB image (PNG or anything OIIO knows by extension); `rgb` is width * height * 3 bytes.
-Status WriteRgb8(const std::filesystem::path& path, int width, int height, const std::vector<uint8_t>& rgb,
-                 const ImageMetadata& metadata);
+/// Writes an 8-bit RGB image (PNG or anything OIIO knows by extension); `rgb` is width * height * 3
+/// bytes.
+Status WriteRgb8(const std::filesystem::path& path, int width, int height,
+                 const std::vector<uint8_t>& rgb, const ImageMetadata& metadata);
 /// Reads an image's first subimage as floats.
 StatusOr<FloatImage> ReadImage(const std::filesystem::path& path);
 
-/// `dir/name.tmp-PID-N.ext` beside `path`: same directory (so the rename is atomic), same extension (so
-/// OpenImageIO picks the same format).
+/// `dir/name.tmp-PID-N.ext` beside `path`: same directory (so the rename is atomic), same extension
+/// (so OpenImageIO picks the same format).
 std::filesystem::path TemporaryImagePath(const std::filesystem::path& path);
 
 }  // namespace nave::imaging

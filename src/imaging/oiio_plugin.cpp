@@ -22,24 +22,29 @@ StatusOr<const OiioPlugin*> LoadOiioPlugin() {
         candidates.push_back("libnave_oiio.so");
         std::string tried;
         for (const std::string& c : candidates) {
-            // Kept loaded for the life of the process: textures and caches it made may live until exit.
+            // Kept loaded for the life of the process: textures and caches it made may live until
+            // exit.
             void* handle = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
             if (handle == nullptr) {
                 tried += "\n  " + c + ": " + dlerror();
                 continue;
             }
-            auto create = reinterpret_cast<OiioPlugin* (*)(int)>(dlsym(handle, "NaveCreateOiioPlugin"));
+            auto create =
+                reinterpret_cast<OiioPlugin* (*)(int)>(dlsym(handle, "NaveCreateOiioPlugin"));
             if (create == nullptr) {
                 tried += "\n  " + c + ": no NaveCreateOiioPlugin (not a nave plugin, or too old)";
                 continue;
             }
             plugin = create(kOiioPluginVersion);
             if (plugin != nullptr) return;
-            tried += fmt::format("\n  {}: built for another version of nave (expected plugin version {})", c,
-                                 kOiioPluginVersion);
+            tried += fmt::format(
+                "\n  {}: built for another version of nave (expected plugin version {})", c,
+                kOiioPluginVersion);
         }
-        status = InternalError("cannot load the OpenImageIO plugin libnave_oiio.so (set NAVE_OIIO_PLUGIN); "
-                               "tried:{}", tried);
+        status = InternalError(
+            "cannot load the OpenImageIO plugin libnave_oiio.so (set NAVE_OIIO_PLUGIN); "
+            "tried:{}",
+            tried);
     });
     if (plugin == nullptr) return status;
     return plugin;

@@ -49,8 +49,8 @@ struct TextureInfo {
     int width = 0, height = 0, channels = 0;
     int mip_levels = 1;
     bool tiled = false;
-    /// What caching the whole texture takes, every MIP level included (whole tiles of floats: an upper
-    /// bound).
+    /// What caching the whole texture takes, every MIP level included (whole tiles of floats: an
+    /// upper bound).
     uint64_t pixel_bytes = 0;
 };
 
@@ -83,9 +83,11 @@ class TextureCache {
 
     /// The effective cap of the tile cache in bytes.
     virtual size_t max_memory_bytes() const = 0;
-    /// Changes the cap (OpenImageIO's floor of 10 MiB applies); tiles beyond it are evicted as lookups go.
+    /// Changes the cap (OpenImageIO's floor of 10 MiB applies); tiles beyond it are evicted as
+    /// lookups go.
     virtual Status SetMaxMemoryBytes(size_t max_memory_bytes) = 0;
-    /// Sum of TextureInfo::pixel_bytes over the textures opened so far: a cap above it buys nothing.
+    /// Sum of TextureInfo::pixel_bytes over the textures opened so far: a cap above it buys
+    /// nothing.
     virtual uint64_t opened_pixel_bytes() const = 0;
     /// Bytes of tiles held now (OpenImageIO "stat:cache_memory_used").
     virtual size_t memory_used_bytes() const = 0;

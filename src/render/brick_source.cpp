@@ -10,7 +10,6 @@
 #include "core/trace.h"
 #include "render/brick_mesh_cache.h"
 
-
 namespace nave::render {
 uint64_t BvhSettings::BytesPerTriangle() const {
     // Embree's own count of its allocations (its memory monitor) after building abbey bricks of
@@ -18,14 +17,17 @@ uint64_t BvhSettings::BytesPerTriangle() const {
     // Measured on brick 63 (700 k triangles): low 85.8, low compact 46.9, medium and high 65.9,
     // medium and high compact 34.2.
     switch (quality) {
-        case Quality::kLow: return compact ? 50 : 90;
+        case Quality::kLow:
+            return compact ? 50 : 90;
         case Quality::kMedium:
-        case Quality::kHigh: return compact ? 38 : 70;
+        case Quality::kHigh:
+            return compact ? 38 : 70;
     }
     return 90;
 }
 
-// ---------------------------------------------------------------------------------------------- Embree
+// ----------------------------------------------------------------------------------------------
+// Embree
 
 StatusOr<std::shared_ptr<EmbreeDevice>> EmbreeDevice::Create(const std::string& config) {
     std::shared_ptr<EmbreeDevice> device(new EmbreeDevice());
@@ -52,9 +54,10 @@ void EmbreeDevice::ErrorCallback(void* user, int code, const char* message) {
     auto* self = static_cast<EmbreeDevice*>(user);
     std::lock_guard<std::mutex> lock(self->mutex_);
     if (self->error_.ok()) {
-        self->error_ = Status(code == RTC_ERROR_OUT_OF_MEMORY ? StatusCode::kResourceExhausted
-                                                              : StatusCode::kInternal,
-                              fmt::format("Embree error {}: {}", code, message ? message : "(no message)"));
+        self->error_ =
+            Status(code == RTC_ERROR_OUT_OF_MEMORY ? StatusCode::kResourceExhausted
+                                                   : StatusCode::kInternal,
+                   fmt::format("Embree error {}: {}", code, message ? message : "(no message)"));
     }
 }
 
@@ -65,7 +68,8 @@ Status EmbreeDevice::TakeError(const std::string& context) {
     return s.ok() ? s : s.WithContext(context);
 }
 
-// ---------------------------------------------------------------------------------------------- ResidentBrick
+// ----------------------------------------------------------------------------------------------
+// ResidentBrick
 
 ResidentBrick::ResidentBrick(uint32_t id, Bounds3f cell, ResidentMesh mesh)
     : id_(id), cell_(cell), mesh_(std::move(mesh)) {}
@@ -76,15 +80,16 @@ ResidentBrick::~ResidentBrick() {
 
 namespace {
 
-/// Embree's intersection and occlusion filter for bricks with cut-outs: a hit where the material's alpha mask
-/// says the surface is absent is rejected, and the ray goes on to the next surface (Embree 3
-/// RTCFilterFunctionN: clear valid[i] to reject hit i).
+/// Embree's intersection and occlusion filter for bricks with cut-outs: a hit where the material's
+/// alpha mask says the surface is absent is rejected, and the ray goes on to the next surface
+/// (Embree 3 RTCFilterFunctionN: clear valid[i] to reject hit i).
 void AlphaFilter(const RTCFilterFunctionNArguments* args) {
     const auto* brick = static_cast<const ResidentBrick*>(args->geometryUserPtr);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
         const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
-        if (!brick->SurfacePresent(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i)))
+        if (!brick->SurfacePresent(prim, RTCHitN_u(args->hit, args->N, i),
+                                   RTCHitN_v(args->hit, args->N, i)))
             args->valid[i] = 0;
     }
 }
@@ -106,11 +111,13 @@ bool NeedsAlphaFilter(const ResidentMesh& m, const AlphaMasks* masks) {
 
 bool ResidentBrick::SurfacePresent(uint32_t triangle, float u, float v) const {
     const uint32_t material = mesh_.material_ids[triangle];
-    if (masks_ == nullptr || material >= masks_->size() || (*masks_)[material] == nullptr) return true;
+    if (masks_ == nullptr || material >= masks_->size() || (*masks_)[material] == nullptr)
+        return true;
     const uint32_t* tri = &mesh_.indices[3 * size_t(triangle)];
     const float w = 1.f - u - v;
     std::array<float, 2> uv;
-    for (int k = 0; k < 2; ++k) uv[k] = mesh_.uvs[tri[0]][k] * w + mesh_.uvs[tri[1]][k] * u + mesh_.uvs[tri[2]][k] * v;
+    for (int k = 0; k < 2; ++k)
+        uv[k] = mesh_.uvs[tri[0]][k] * w + mesh_.uvs[tri[1]][k] * u + mesh_.uvs[tri[2]][k] * v;
     return (*masks_)[material]->Present(uv);
 }
 
@@ -125,19 +132,20 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     brick->scene_ = scene;
     const std::string context = fmt::format("building the Embree scene of brick {}", id);
     if (scene == nullptr) return device.TakeError(context);
-    rtcSetSceneFlags(scene,
-                     RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | (bvh.compact ? RTC_SCENE_FLAG_COMPACT : 0)));
-    const RTCBuildQuality quality = bvh.quality == BvhSettings::Quality::kLow      ? RTC_BUILD_QUALITY_LOW
-                                    : bvh.quality == BvhSettings::Quality::kMedium ? RTC_BUILD_QUALITY_MEDIUM
-                                                                                   : RTC_BUILD_QUALITY_HIGH;
+    rtcSetSceneFlags(
+        scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | (bvh.compact ? RTC_SCENE_FLAG_COMPACT : 0)));
+    const RTCBuildQuality quality =
+        bvh.quality == BvhSettings::Quality::kLow      ? RTC_BUILD_QUALITY_LOW
+        : bvh.quality == BvhSettings::Quality::kMedium ? RTC_BUILD_QUALITY_MEDIUM
+                                                       : RTC_BUILD_QUALITY_HIGH;
     rtcSetSceneBuildQuality(scene, quality);
     if (m.TriangleCount() > 0) {
         RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
         rtcSetGeometryBuildQuality(geom, quality);
-        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0,
-                                   sizeof(Vec3f), m.positions.size());
-        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0,
-                                   3 * sizeof(uint32_t), m.TriangleCount());
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   m.positions.data(), 0, sizeof(Vec3f), m.positions.size());
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                   m.indices.data(), 0, 3 * sizeof(uint32_t), m.TriangleCount());
         if (NeedsAlphaFilter(m, masks)) {
             brick->masks_ = masks;
             rtcSetGeometryUserData(geom, brick.get());
@@ -163,13 +171,15 @@ StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& devi
     return Build(device, id, cell, std::move(copy), masks, bvh);
 }
 
-uint64_t ResidentBrick::EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                                            bool has_uvs, const BvhSettings& bvh) {
+uint64_t ResidentBrick::EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count,
+                                            bool has_normals, bool has_uvs,
+                                            const BvhSettings& bvh) {
     return ResidentMesh::MemoryBytesFor({vertex_count, triangle_count, has_normals, has_uvs}) +
            bvh.BytesPerTriangle() * triangle_count;
 }
 
-bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const {
+bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1,
+                              BrickHit* hit) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
@@ -217,7 +227,8 @@ bool ResidentBrick::Occluded(const Vec3f& origin, const Vec3f& dir, float t0, fl
     return ray.tfar == -std::numeric_limits<float>::infinity();
 }
 
-// ---------------------------------------------------------------------------------------------- handles
+// ----------------------------------------------------------------------------------------------
+// handles
 
 BrickHandle& BrickHandle::operator=(BrickHandle&& o) noexcept {
     if (this != &o) {
@@ -236,10 +247,12 @@ void BrickHandle::Reset() {
     brick_ = nullptr;
 }
 
-// ---------------------------------------------------------------------------------------------- BrickSource
+// ----------------------------------------------------------------------------------------------
+// BrickSource
 
-BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
-                         std::vector<store::MaterialRecord> materials, Bounds3f bounds)
+BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                         std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
+                         Bounds3f bounds)
     : device_(std::move(device)),
       tree_(std::move(tree)),
       cells_(std::move(cells)),
@@ -253,15 +266,18 @@ BrickSource::~BrickSource() = default;
 
 StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     if (id >= slots_.size()) {
-        return InvalidArgumentError("brick {} requested but the model has {} bricks", id, slots_.size());
+        return InvalidArgumentError("brick {} requested but the model has {} bricks", id,
+                                    slots_.size());
     }
     acquires_.fetch_add(1, std::memory_order_relaxed);
     Slot& slot = *slots_[id];
     // Pin first, then check: an evictor takes the slot lock and refuses while pins > 0.
     slot.pins.fetch_add(1, std::memory_order_acq_rel);
-    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire)) return BrickHandle(this, b);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
+        return BrickHandle(this, b);
     std::lock_guard<std::mutex> lock(slot.mutex);
-    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire)) return BrickHandle(this, b);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
+        return BrickHandle(this, b);
     if (!slot.error.ok()) {
         slot.pins.fetch_sub(1, std::memory_order_acq_rel);
         return slot.error;
@@ -304,10 +320,12 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     load.AddArg({"bytes_read", bytes});
     TraceSpan build(trace_, "bvh build", "pager");
     StatusOr<std::unique_ptr<ResidentBrick>> built =
-        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(), &alpha_masks_, bvh_)
+        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(),
+                                         &alpha_masks_, bvh_)
                   : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     build.End();
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
         slot.error = built.status().WithContext(fmt::format("loading brick {}", id));
         slot.pins.fetch_sub(1, std::memory_order_acq_rel);
@@ -336,8 +354,9 @@ Status BrickSource::SetBvhSettings(const BvhSettings& bvh) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     if (bvh == bvh_) return Status::Ok();
     if (stats_.resident_bytes != 0) {
-        return InvalidArgumentError("the BVH settings of a brick source cannot change while {} of bricks are resident",
-                                       stats_.resident_bytes);
+        return InvalidArgumentError(
+            "the BVH settings of a brick source cannot change while {} of bricks are resident",
+            stats_.resident_bytes);
     }
     bvh_ = bvh;
     return Status::Ok();
@@ -358,7 +377,8 @@ bool BrickSource::Evict(uint32_t id) {
     std::lock_guard<std::mutex> lock(slot.mutex);
     if (slot.brick == nullptr || slot.pins.load(std::memory_order_acquire) != 0) return false;
     slot.ready.store(nullptr, std::memory_order_release);
-    // A reader that pinned between our check and the store above would hold a dangling pointer; re-check.
+    // A reader that pinned between our check and the store above would hold a dangling pointer;
+    // re-check.
     if (slot.pins.load(std::memory_order_acquire) != 0) {
         slot.ready.store(slot.brick.get(), std::memory_order_release);
         return false;
@@ -378,7 +398,8 @@ BrickSourceStats BrickSource::stats() const {
     return s;
 }
 
-// ---------------------------------------------------------------------------------------------- memory source
+// ----------------------------------------------------------------------------------------------
+// memory source
 
 namespace {
 Bounds3f MeshesBounds(const std::vector<store::BrickMesh>& meshes) {
@@ -393,14 +414,14 @@ Bounds3f MeshesBounds(const std::vector<store::BrickMesh>& meshes) {
 MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
                                      std::vector<store::BrickMesh> meshes,
                                      std::vector<store::MaterialRecord> materials)
-    : BrickSource(std::move(device), tree, tree.BrickCells(uint32_t(meshes.size())), std::move(materials),
-                  MeshesBounds(meshes)),
+    : BrickSource(std::move(device), tree, tree.BrickCells(uint32_t(meshes.size())),
+                  std::move(materials), MeshesBounds(meshes)),
       meshes_(std::move(meshes)) {}
 
 uint64_t MemoryBrickSource::EstimatedResidentBytes(uint32_t id) const {
     const store::BrickMesh& m = meshes_[id];
-    return ResidentBrick::EstimateMemoryBytes(m.VertexCount(), m.TriangleCount(), m.HasNormals(), m.HasUvs(),
-                                              bvh_settings());
+    return ResidentBrick::EstimateMemoryBytes(m.VertexCount(), m.TriangleCount(), m.HasNormals(),
+                                              m.HasUvs(), bvh_settings());
 }
 
 StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
@@ -408,7 +429,8 @@ StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* by
     return meshes_[id];
 }
 
-// ---------------------------------------------------------------------------------------------- grid split
+// ----------------------------------------------------------------------------------------------
+// grid split
 
 GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int nz) {
     Bounds3f box;
@@ -420,7 +442,8 @@ GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int
     std::vector<float> planes[3];
     for (int a = 0; a < 3; ++a) {
         for (int i = 0; i <= n[a]; ++i) {
-            planes[a].push_back(i == n[a] ? box.max[a] : box.min[a] + box.Diagonal()[a] * float(i) / float(n[a]));
+            planes[a].push_back(
+                i == n[a] ? box.max[a] : box.min[a] + box.Diagonal()[a] * float(i) / float(n[a]));
         }
     }
     auto cell_index = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
@@ -438,7 +461,8 @@ GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int
         }
         for (int k = lo[2]; k <= hi[2]; ++k)
             for (int j = lo[1]; j <= hi[1]; ++j)
-                for (int i = lo[0]; i <= hi[0]; ++i) cell_tris[cell_index(i, j, k)].push_back(uint32_t(t));
+                for (int i = lo[0]; i <= hi[0]; ++i)
+                    cell_tris[cell_index(i, j, k)].push_back(uint32_t(t));
     }
     GridBricks out;
     std::vector<uint32_t> brick_of_cell(cell_tris.size(), store::kNoBrick);

@@ -1,9 +1,10 @@
 #pragma once
-// Access to the bricks of a model through pinned handles. The renderer never holds a brick except through a
-// BrickHandle, and never assumes that a brick it does not hold is resident: which bricks stay in memory is
-// the source's policy (StoreBrickSource keeps every brick it has loaded; the out-of-core pager replaces that
-// policy under a memory budget). A resident brick carries its decoded mesh and its Embree scene, built when
-// the brick is loaded. Embree types stay in brick_source.cpp.
+// Access to the bricks of a model through pinned handles. The renderer never holds a brick except
+// through a BrickHandle, and never assumes that a brick it does not hold is resident: which bricks
+// stay in memory is the source's policy (StoreBrickSource keeps every brick it has loaded; the
+// out-of-core pager replaces that policy under a memory budget). A resident brick carries its
+// decoded mesh and its Embree scene, built when the brick is loaded. Embree types stay in
+// brick_source.cpp.
 
 #include <array>
 #include <atomic>
@@ -32,8 +33,9 @@ namespace nave::render {
 
 class EmbreeDevice;
 
-/// A cut-out (alpha-masked leaves, chains, lead cames): whether the surface of one material is there at mesh
-/// texture coordinates `uv`. Called by Embree's intersection filters from any thread, so thread-safe.
+/// A cut-out (alpha-masked leaves, chains, lead cames): whether the surface of one material is
+/// there at mesh texture coordinates `uv`. Called by Embree's intersection filters from any thread,
+/// so thread-safe.
 class AlphaMask {
   public:
     virtual ~AlphaMask() = default;
@@ -43,7 +45,8 @@ class AlphaMask {
 using AlphaMasks = std::vector<std::shared_ptr<const AlphaMask>>;
 
 /// How Embree builds a brick's BVH. Quality trades build time for trace speed; compact nodes trade
-/// trace speed for memory. Measured on abbey bricks by bench_brick_load (docs/pager.md, "Brick loads").
+/// trace speed for memory. Measured on abbey bricks by bench_brick_load (docs/pager.md, "Brick
+/// loads").
 struct BvhSettings {
     enum class Quality : uint8_t { kLow, kMedium, kHigh };
     // Low quality, compact nodes: on the detail-110 abbey the whole in-core render took 42 s
@@ -51,31 +54,32 @@ struct BvhSettings {
     // instead of 9.1 GiB (docs/pager.md, "Brick loads").
     Quality quality = Quality::kLow;
     bool compact = true;
-    /// Bytes Embree's BVH takes per triangle with these settings (measured upper bound, for budgets).
+    /// Bytes Embree's BVH takes per triangle with these settings (measured upper bound, for
+    /// budgets).
     uint64_t BytesPerTriangle() const;
     bool operator==(const BvhSettings&) const = default;
 };
 
 /// The nearest hit of a ray inside one brick.
 struct BrickHit {
-    float t = 0;          ///< ray parameter of the hit
-    float u = 0, v = 0;   ///< barycentrics of vertices 1 and 2 (Embree's convention)
+    float t = 0;         ///< ray parameter of the hit
+    float u = 0, v = 0;  ///< barycentrics of vertices 1 and 2 (Embree's convention)
     uint32_t triangle = 0;
-    Vec3f ng;             ///< geometric normal, unnormalised, (v1 - v0) x (v2 - v0): front side is CCW
+    Vec3f ng;  ///< geometric normal, unnormalised, (v1 - v0) x (v2 - v0): front side is CCW
 };
 
-/// A brick in memory: its cell, its mesh (shading data) and its Embree scene. Immutable once built, so any
-/// number of threads may trace it at once. Built and destroyed only by a BrickSource.
+/// A brick in memory: its cell, its mesh (shading data) and its Embree scene. Immutable once built,
+/// so any number of threads may trace it at once. Built and destroyed only by a BrickSource.
 class ResidentBrick {
   public:
     ~ResidentBrick();
     ResidentBrick(const ResidentBrick&) = delete;
     ResidentBrick& operator=(const ResidentBrick&) = delete;
 
-    /// Builds the Embree scene over `mesh` (shared buffers: the mesh is not copied). Embree errors (out of
-    /// memory, invalid geometry) come back as a Status naming the brick. With `masks`, hits on masked
-    /// materials where the mask says the surface is absent are skipped by every query (the masks must outlive
-    /// the brick).
+    /// Builds the Embree scene over `mesh` (shared buffers: the mesh is not copied). Embree errors
+    /// (out of memory, invalid geometry) come back as a Status naming the brick. With `masks`, hits
+    /// on masked materials where the mask says the surface is absent are skipped by every query
+    /// (the masks must outlive the brick).
     static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id,
                                                           Bounds3f cell, ResidentMesh mesh,
                                                           const AlphaMasks* masks = nullptr,
@@ -94,15 +98,17 @@ class ResidentBrick {
     uint64_t memory_bytes() const { return memory_bytes_; }
     /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory
     /// says). Exact: the pager checks it.
-    static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count, bool has_normals,
-                                        bool has_uvs, const BvhSettings& bvh = {});
+    static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count,
+                                        bool has_normals, bool has_uvs,
+                                        const BvhSettings& bvh = {});
 
     /// The nearest hit with t in [t0, t1], or false. Thread-safe.
     bool Intersect(const Vec3f& origin, const Vec3f& dir, float t0, float t1, BrickHit* hit) const;
     /// Whether any triangle is hit with t in [t0, t1]. Thread-safe.
     bool Occluded(const Vec3f& origin, const Vec3f& dir, float t0, float t1) const;
 
-    /// Whether the surface of `triangle` is there at barycentrics (u, v) (its material's alpha mask).
+    /// Whether the surface of `triangle` is there at barycentrics (u, v) (its material's alpha
+    /// mask).
     bool SurfacePresent(uint32_t triangle, float u, float v) const;
 
   private:
@@ -118,13 +124,16 @@ class ResidentBrick {
 class BrickSource;
 class BrickMeshCache;
 
-/// A pin on a resident brick: while a handle lives, its brick stays in memory. Move-only; releasing (or
-/// destroying) the handle unpins it.
+/// A pin on a resident brick: while a handle lives, its brick stays in memory. Move-only; releasing
+/// (or destroying) the handle unpins it.
 class BrickHandle {
   public:
     BrickHandle() = default;
     BrickHandle(BrickSource* source, const ResidentBrick* brick) : source_(source), brick_(brick) {}
-    BrickHandle(BrickHandle&& o) noexcept : source_(o.source_), brick_(o.brick_) { o.source_ = nullptr; o.brick_ = nullptr; }
+    BrickHandle(BrickHandle&& o) noexcept : source_(o.source_), brick_(o.brick_) {
+        o.source_ = nullptr;
+        o.brick_ = nullptr;
+    }
     BrickHandle& operator=(BrickHandle&& o) noexcept;
     BrickHandle(const BrickHandle&) = delete;
     BrickHandle& operator=(const BrickHandle&) = delete;
@@ -149,12 +158,12 @@ struct BrickSourceStats {
     uint64_t bytes_read = 0;      ///< payload bytes read from disk
     uint64_t resident_bytes = 0;  ///< bytes of the bricks in memory now
     uint64_t peak_resident_bytes = 0;
-    double load_seconds = 0;      ///< time spent reading, decoding and building Embree scenes
+    double load_seconds = 0;  ///< time spent reading, decoding and building Embree scenes
 };
 
-/// Where bricks come from, and which stay resident. Thread-safe: many workers may acquire at once; loading
-/// one brick never blocks acquiring another that is already resident (one lock per brick, double-checked
-/// as in OpenVDB's LeafBuffer).
+/// Where bricks come from, and which stay resident. Thread-safe: many workers may acquire at once;
+/// loading one brick never blocks acquiring another that is already resident (one lock per brick,
+/// double-checked as in OpenVDB's LeafBuffer).
 class BrickSource {
   public:
     virtual ~BrickSource();
@@ -167,21 +176,23 @@ class BrickSource {
     /// Box of all geometry.
     const Bounds3f& bounds() const { return bounds_; }
 
-    /// Pins brick `id`, loading it first if it is not resident. Errors (corrupt brick, Embree failure) name
-    /// the brick and are returned to every caller that asks for it.
+    /// Pins brick `id`, loading it first if it is not resident. Errors (corrupt brick, Embree
+    /// failure) name the brick and are returned to every caller that asks for it.
     StatusOr<BrickHandle> Acquire(uint32_t id);
     /// Whether brick `id` is in memory now (a hint: it may be evicted right after unless pinned).
     bool IsResident(uint32_t id) const;
-    /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's tool;
-    /// the default policy never calls it.
+    /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's
+    /// tool; the default policy never calls it.
     bool Evict(uint32_t id);
-    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes), known without loading it.
+    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes), known without
+    /// loading it.
     virtual uint64_t EstimatedResidentBytes(uint32_t id) const = 0;
     BrickSourceStats stats() const;
-    /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon portals).
+    /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
+    /// portals).
     EmbreeDevice& device() const { return *device_; }
-    /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is loaded
-    /// (checked): a resident brick keeps the masks it was built with.
+    /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is
+    /// loaded (checked): a resident brick keeps the masks it was built with.
     void SetAlphaMasks(AlphaMasks masks);
     /// How bricks build their BVH (and what EstimatedResidentBytes assumes). FailedPrecondition if
     /// bricks built otherwise are resident (they would not match the estimates).
@@ -205,8 +216,9 @@ class BrickSource {
     }
 
   protected:
-    BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree, std::vector<Bounds3f> cells,
-                std::vector<store::MaterialRecord> materials, Bounds3f bounds);
+    BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
+                Bounds3f bounds);
     /// Reads and decodes brick `id` (no caching: the base class caches). Adds to `bytes_read`.
     virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
 
@@ -215,11 +227,11 @@ class BrickSource {
     void Release(uint32_t id);
 
     struct Slot {
-        std::mutex mutex;                       // held while loading this brick
+        std::mutex mutex;  // held while loading this brick
         std::atomic<const ResidentBrick*> ready{nullptr};
         std::unique_ptr<ResidentBrick> brick;
         std::atomic<uint32_t> pins{0};
-        Status error;                           // sticky load error
+        Status error;  // sticky load error
     };
     std::shared_ptr<EmbreeDevice> device_;
     store::BrickTree tree_;
@@ -262,7 +274,8 @@ class StoreBrickSource final : public BrickSource {
 class MemoryBrickSource final : public BrickSource {
   public:
     MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
-                      std::vector<store::BrickMesh> meshes, std::vector<store::MaterialRecord> materials);
+                      std::vector<store::BrickMesh> meshes,
+                      std::vector<store::MaterialRecord> materials);
     uint64_t EstimatedResidentBytes(uint32_t id) const override;
 
   protected:
@@ -272,16 +285,17 @@ class MemoryBrickSource final : public BrickSource {
     std::vector<store::BrickMesh> meshes_;
 };
 
-/// Cuts `mesh` into an nx * ny * nz grid of bricks over its bounds (slightly enlarged), as preprocess does:
-/// every triangle goes to every cell its box overlaps. For tests and benchmarks that compare brick counts.
+/// Cuts `mesh` into an nx * ny * nz grid of bricks over its bounds (slightly enlarged), as
+/// preprocess does: every triangle goes to every cell its box overlaps. For tests and benchmarks
+/// that compare brick counts.
 struct GridBricks {
     store::BrickTree tree;
     std::vector<store::BrickMesh> meshes;
 };
 GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int nz);
 
-/// The process's Embree device. Embree errors reported through its callback are kept and turned into a
-/// Status by the call that caused them.
+/// The process's Embree device. Embree errors reported through its callback are kept and turned
+/// into a Status by the call that caused them.
 class EmbreeDevice {
   public:
     /// `config` is Embree's device configuration string ("threads=4"); empty for the defaults.

@@ -17,7 +17,8 @@ Camera::Camera(const CameraConfig& c)
     focus_distance_ = c.focus_distance_m > 0 ? c.focus_distance_m : Length(c.look_at - c.position);
 }
 
-void Camera::GenerateRay(float x, float y, float u_lens0, float u_lens1, Vec3f* origin, Vec3f* dir) const {
+void Camera::GenerateRay(float x, float y, float u_lens0, float u_lens1, Vec3f* origin,
+                         Vec3f* dir) const {
     float sx = (2.f * x / float(width_) - 1.f) * tan_half_fov_ * aspect_;
     float sy = (1.f - 2.f * y / float(height_)) * tan_half_fov_;
     Vec3f d = Normalize(forward_ + right_ * sx + up_ * sy);

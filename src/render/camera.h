@@ -1,5 +1,6 @@
 #pragma once
-// A perspective camera with an optional thin lens. Raster (0, 0) is the top-left corner of the image.
+// A perspective camera with an optional thin lens. Raster (0, 0) is the top-left corner of the
+// image.
 
 #include <cmath>
 
@@ -16,12 +17,14 @@ class Camera {
     int height() const { return height_; }
     const Vec3f& position() const { return position_; }
     const Vec3f& forward() const { return forward_; }
-    /// The angle one pixel subtends at the centre of the image, in radians (the spread of a pixel's ray cone).
+    /// The angle one pixel subtends at the centre of the image, in radians (the spread of a pixel's
+    /// ray cone).
     float PixelSpreadAngle() const { return 2.f * tan_half_fov_ / float(height_); }
 
-    /// The primary ray through raster point (x, y) (continuous: pixel (i, j) spans [i, i+1) x [j, j+1)),
-    /// with `u_lens` in [0,1)^2 choosing the point on the lens. `dir` is unit length.
-    void GenerateRay(float x, float y, float u_lens0, float u_lens1, Vec3f* origin, Vec3f* dir) const;
+    /// The primary ray through raster point (x, y) (continuous: pixel (i, j) spans [i, i+1) x [j,
+    /// j+1)), with `u_lens` in [0,1)^2 choosing the point on the lens. `dir` is unit length.
+    void GenerateRay(float x, float y, float u_lens0, float u_lens1, Vec3f* origin,
+                     Vec3f* dir) const;
 
   private:
     Vec3f position_, forward_, right_, up_;

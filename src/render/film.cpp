@@ -24,9 +24,11 @@ Mat3d OutputMatrix(const OutputConfig& output) {
             << "white_balance = scene without the scene's white";
         return WhiteBalancedXyzToRgb(srgb, *output.scene_white, output.adaptation);
     }
-    double cct = white_balance == "D65" ? 6504.0 : white_balance == "D50" ? 5003.0
-                                                                          : std::stod(white_balance);
-    Chromaticity white = XYZToChromaticity(SpectrumToXYZ(Spectrum::CieIlluminantD(std::clamp(cct, 4000.0, 25000.0))));
+    double cct = white_balance == "D65"   ? 6504.0
+                 : white_balance == "D50" ? 5003.0
+                                          : std::stod(white_balance);
+    Chromaticity white = XYZToChromaticity(
+        SpectrumToXYZ(Spectrum::CieIlluminantD(std::clamp(cct, 4000.0, 25000.0))));
     return WhiteBalancedXyzToRgb(srgb, white, output.adaptation);
 }
 
@@ -89,7 +91,8 @@ Film::Film(int width, int height, const OutputConfig& output)
         aov_.reset(new std::atomic<float>[pixel_count() * 7]);
         aov_count_.reset(new std::atomic<uint32_t>[pixel_count()]);
         for (size_t i = 0; i < pixel_count() * 7; ++i) aov_[i].store(0, std::memory_order_relaxed);
-        for (size_t i = 0; i < pixel_count(); ++i) aov_count_[i].store(0, std::memory_order_relaxed);
+        for (size_t i = 0; i < pixel_count(); ++i)
+            aov_count_[i].store(0, std::memory_order_relaxed);
     }
 }
 
@@ -186,8 +189,10 @@ Status Film::Write(const std::filesystem::path& exr_path,
     image.height = height_;
     image.channels = {"R", "G", "B"};
     if (aov_) {
-        if (output_.aov_albedo) image.channels.insert(image.channels.end(), {"albedo.R", "albedo.G", "albedo.B"});
-        if (output_.aov_normal) image.channels.insert(image.channels.end(), {"normal.X", "normal.Y", "normal.Z"});
+        if (output_.aov_albedo)
+            image.channels.insert(image.channels.end(), {"albedo.R", "albedo.G", "albedo.B"});
+        if (output_.aov_normal)
+            image.channels.insert(image.channels.end(), {"normal.X", "normal.Y", "normal.Z"});
         if (output_.aov_depth) image.channels.push_back("Z");
     }
     const size_t nc = image.channels.size();
@@ -198,8 +203,11 @@ Status Film::Write(const std::filesystem::path& exr_path,
         if (!aov_) continue;
         size_t k = 3;
         uint32_t n = std::max(1u, aov_count_[p].load(std::memory_order_relaxed));
-        auto aov = [&](int c) { return aov_[7 * p + c].load(std::memory_order_relaxed) / float(n); };
-        if (output_.aov_albedo) for (int c = 0; c < 3; ++c) out[k++] = aov(c);
+        auto aov = [&](int c) {
+            return aov_[7 * p + c].load(std::memory_order_relaxed) / float(n);
+        };
+        if (output_.aov_albedo)
+            for (int c = 0; c < 3; ++c) out[k++] = aov(c);
         if (output_.aov_normal) {
             Vec3f nrm(aov(3), aov(4), aov(5));
             float len = Length(nrm);

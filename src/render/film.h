@@ -101,7 +101,7 @@ class Film {
     double spp_ = 1;
     std::unique_ptr<std::atomic<double>[]> xyz_;
     std::unique_ptr<std::atomic<double>[]> y_half_;  // per pixel, the luminance of each half
-    std::unique_ptr<std::atomic<float>[]> aov_;  // albedo rgb, normal xyz, depth: 7 per pixel
+    std::unique_ptr<std::atomic<float>[]> aov_;      // albedo rgb, normal xyz, depth: 7 per pixel
     std::unique_ptr<std::atomic<uint32_t>[]> aov_count_;
 };
 

@@ -29,7 +29,8 @@ PortalProjection::PortalProjection(const std::vector<std::array<Vec3f, 3>>& tria
 }
 
 Vec3f PortalProjection::Sample(float u_choice, float u0, float u1) const {
-    size_t i = size_t(std::upper_bound(cdf_.begin() + 1, cdf_.end(), double(u_choice)) - (cdf_.begin() + 1));
+    size_t i = size_t(std::upper_bound(cdf_.begin() + 1, cdf_.end(), double(u_choice)) -
+                      (cdf_.begin() + 1));
     i = std::min(i, tris_.size() - 1);
     const std::array<Vec3f, 3>& t = tris_[i];
     // Uniform on the triangle; an affine projection keeps it uniform on the projection.

@@ -14,7 +14,8 @@ void AppendSphere(store::BrickMesh* mesh, Vec3f center, float radius, int rings,
         float theta = kPi * float(i) / float(rings);
         for (int j = 0; j <= segments; ++j) {
             float phi = 2 * kPi * float(j) / float(segments);
-            Vec3f n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+            Vec3f n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                    std::cos(theta));
             mesh->positions.push_back(center + n * radius);
             if (with_normals) mesh->normals.push_back(inward ? -n : n);
         }
@@ -34,7 +35,8 @@ void AppendSphere(store::BrickMesh* mesh, Vec3f center, float radius, int rings,
     }
 }
 
-void AppendQuad(store::BrickMesh* mesh, Vec3f center, Vec3f half_u, Vec3f half_v, int n, uint32_t material) {
+void AppendQuad(store::BrickMesh* mesh, Vec3f center, Vec3f half_u, Vec3f half_v, int n,
+                uint32_t material) {
     const uint32_t base = uint32_t(mesh->positions.size());
     const bool with_normals = mesh->positions.empty() || mesh->HasNormals();
     Vec3f normal = Normalize(Cross(half_u, half_v));
@@ -48,8 +50,10 @@ void AppendQuad(store::BrickMesh* mesh, Vec3f center, Vec3f half_u, Vec3f half_v
     auto vid = [&](int i, int j) { return base + uint32_t(i * (n + 1) + j); };
     for (int i = 0; i < n; ++i) {
         for (int j = 0; j < n; ++j) {
-            mesh->indices.insert(mesh->indices.end(), {vid(i, j), vid(i + 1, j), vid(i + 1, j + 1)});
-            mesh->indices.insert(mesh->indices.end(), {vid(i, j), vid(i + 1, j + 1), vid(i, j + 1)});
+            mesh->indices.insert(mesh->indices.end(),
+                                 {vid(i, j), vid(i + 1, j), vid(i + 1, j + 1)});
+            mesh->indices.insert(mesh->indices.end(),
+                                 {vid(i, j), vid(i + 1, j + 1), vid(i, j + 1)});
             mesh->material_ids.push_back(material);
             mesh->material_ids.push_back(material);
         }

@@ -21,23 +21,25 @@ StatusOr<ProceduralModel> MakeProceduralModel(const std::string& name) {
         AppendBox(&m.mesh, Bounds3f({1.0f, -2.5f, 0.01f}, {2.5f, -1.2f, 1.8f}), 0);
         m.material_names = {"floor", "ball", "chrome"};
     } else {
-        return InvalidArgumentError("--procedural: unknown model '{}' (expected furnace, caustic or clutter)", name);
+        return InvalidArgumentError(
+            "--procedural: unknown model '{}' (expected furnace, caustic or clutter)", name);
     }
     return m;
 }
 
-StatusOr<std::unique_ptr<MemoryBrickSource>> OpenProceduralSource(const std::string& spec,
-                                                                  std::shared_ptr<EmbreeDevice> device) {
+StatusOr<std::unique_ptr<MemoryBrickSource>> OpenProceduralSource(
+    const std::string& spec, std::shared_ptr<EmbreeDevice> device) {
     std::string name = spec;
     int bricks = 1;
     size_t colon = spec.find(':');
     if (colon != std::string::npos) {
         name = spec.substr(0, colon);
         std::string opt = spec.substr(colon + 1);
-        if (opt.rfind("bricks=", 0) != 0 || std::sscanf(opt.c_str() + 7, "%d", &bricks) != 1 || bricks < 1 ||
-            bricks > 64) {
-            return InvalidArgumentError("--procedural {}: expected NAME[:bricks=N] with N in [1, 64], found '{}'",
-                                        spec, opt);
+        if (opt.rfind("bricks=", 0) != 0 || std::sscanf(opt.c_str() + 7, "%d", &bricks) != 1 ||
+            bricks < 1 || bricks > 64) {
+            return InvalidArgumentError(
+                "--procedural {}: expected NAME[:bricks=N] with N in [1, 64], found '{}'", spec,
+                opt);
         }
     }
     NAVE_ASSIGN_OR_RETURN(ProceduralModel model, MakeProceduralModel(name));

@@ -1,7 +1,7 @@
 #pragma once
-// The compact record of a ray in flight. Everything a worker needs to continue the ray in whichever brick it
-// lands in travels with it: geometry, the segment in the current brick, the path's identity (for the
-// counter-based random numbers), its throughput and wavelengths.
+// The compact record of a ray in flight. Everything a worker needs to continue the ray in whichever
+// brick it lands in travels with it: geometry, the segment in the current brick, the path's
+// identity (for the counter-based random numbers), its throughput and wavelengths.
 
 #include <cstdint>
 
@@ -26,27 +26,30 @@ enum RayFlags : uint8_t {
 
 struct RayRecord {
     Vec3f origin;
-    float t_max = 0;       ///< end of the ray (infinity, or just short of a point light)
-    Vec3f dir;             ///< unit length
-    float t_enter = 0;     ///< start of the segment in the current brick's cell
-    float t_exit = 0;      ///< end of the segment in the current brick's cell
-    uint32_t pixel = 0;    ///< pixel index (y * width + x), or photon index
-    uint32_t sample = 0;   ///< sample index within the pixel
-    uint16_t depth = 0;    ///< scatterings so far (straight passes through thin glass do not count)
+    float t_max = 0;      ///< end of the ray (infinity, or just short of a point light)
+    Vec3f dir;            ///< unit length
+    float t_enter = 0;    ///< start of the segment in the current brick's cell
+    float t_exit = 0;     ///< end of the segment in the current brick's cell
+    uint32_t pixel = 0;   ///< pixel index (y * width + x), or photon index
+    uint32_t sample = 0;  ///< sample index within the pixel
+    uint16_t depth = 0;   ///< scatterings so far (straight passes through thin glass do not count)
     uint8_t kind = kPathRay;
     uint8_t flags = 0;
-    uint16_t vertex = 0;   ///< surfaces met so far, passes through thin glass included (keys the random numbers)
+    uint16_t vertex =
+        0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's surface
-    float prev_pdf = 0;    ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
-    float since_vertex = 0;  ///< distance from the last scattering vertex to `origin` (passes through thin
-                             ///< glass move the origin along the ray; the sky's MIS needs the vertex)
+    float prev_pdf = 0;  ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
+    float since_vertex =
+        0;  ///< distance from the last scattering vertex to `origin` (passes through thin
+            ///< glass move the origin along the ray; the sky's MIS needs the vertex)
     uint32_t guide_credit =
         0xffffffffu;  ///< shadow rays of guided paths: PathGuide::CreditKey of the path's
                       ///< previous vertex and direction (PathGuide::kNoCredit: none)
     float guide_scale =
         0;  ///< shadow rays of guided paths: the contribution's luminance times this is the
             ///< credit (1 / (throughput at the vertex * pdf of the direction from the previous))
-    SampledSpectrum beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
+    SampledSpectrum
+        beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };
 

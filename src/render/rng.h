@@ -1,14 +1,15 @@
 #pragma once
-// Counter-based random numbers for the ray streams. Every random decision of a ray is a pure function of
-// (seed, pixel, sample, depth, iteration, dimension), hashed, never of thread state or of the order in which
-// bricks are processed: this is what makes an image independent of the brick count and the thread count.
+// Counter-based random numbers for the ray streams. Every random decision of a ray is a pure
+// function of (seed, pixel, sample, depth, iteration, dimension), hashed, never of thread state or
+// of the order in which bricks are processed: this is what makes an image independent of the brick
+// count and the thread count.
 
 #include <cstdint>
 
 namespace nave::render {
 
-/// SplitMix64 finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators", OOPSLA 2014):
-/// a bijective 64-bit mix with full avalanche.
+/// SplitMix64 finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators",
+/// OOPSLA 2014): a bijective 64-bit mix with full avalanche.
 inline constexpr uint64_t MixBits(uint64_t v) {
     v ^= v >> 30;
     v *= 0xbf58476d1ce4e5b9ull;
@@ -23,8 +24,8 @@ inline constexpr uint64_t HashCombine(uint64_t h, uint64_t v) {
     return MixBits(h ^ (v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2)));
 }
 
-/// The identity of one ray's random stream: which path (pixel, sample) or photon, at which depth and
-/// iteration. Two rays with the same key draw the same numbers.
+/// The identity of one ray's random stream: which path (pixel, sample) or photon, at which depth
+/// and iteration. Two rays with the same key draw the same numbers.
 struct RngKey {
     uint64_t seed = 0;
     uint32_t pixel = 0;      ///< pixel index, or photon index for photons
@@ -34,8 +35,8 @@ struct RngKey {
     uint32_t stream = 0;     ///< 0 camera paths, 1 photons, 2 wavelengths...
 };
 
-/// Draws uniform numbers in [0, 1) for one ray vertex: `Uniform(d)` for dimension d is the same whichever
-/// thread asks, and different dimensions are independent.
+/// Draws uniform numbers in [0, 1) for one ray vertex: `Uniform(d)` for dimension d is the same
+/// whichever thread asks, and different dimensions are independent.
 class VertexRng {
   public:
     explicit VertexRng(const RngKey& k) {

@@ -11,8 +11,10 @@
 namespace nave::render {
 
 Spectrum ToSpectrum(const SpectrumSpec& spec) {
-    if (spec.kind == SpectrumSpec::Kind::kConstant) return Spectrum::Constant(spec.value * spec.scale);
-    return Spectrum::FromFunction([&](double lambda_nm) { return spec.Evaluate(float(lambda_nm)); });
+    if (spec.kind == SpectrumSpec::Kind::kConstant)
+        return Spectrum::Constant(spec.value * spec.scale);
+    return Spectrum::FromFunction(
+        [&](double lambda_nm) { return spec.Evaluate(float(lambda_nm)); });
 }
 
 float SurfaceMaterial::AlbedoForAov() const {
@@ -64,11 +66,13 @@ Spectrum GlassK(const MaterialConfig& mc) {
 StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name) {
     if (!mc.builtin.empty()) {
         StatusOr<Material> m = BuiltinMaterial(mc.builtin);
-        if (!m.ok()) return m.status().WithContext(fmt::format("{}: materials.{}.builtin", mc.where, name));
+        if (!m.ok())
+            return m.status().WithContext(fmt::format("{}: materials.{}.builtin", mc.where, name));
         return m;
     }
     switch (mc.kind) {
-        case MaterialConfig::Kind::kDiffuse: return Material(DiffuseMaterial{ToSpectrum(mc.reflectance)});
+        case MaterialConfig::Kind::kDiffuse:
+            return Material(DiffuseMaterial{ToSpectrum(mc.reflectance)});
         case MaterialConfig::Kind::kConductor: {
             float a = RoughnessToAlpha(mc.roughness);
             return Material(ConductorMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.k), a, a});
@@ -91,11 +95,12 @@ StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name)
                                       })});
             }
             if (mc.total_transmittance) {
-                return Material(ThinGlassMaterial::FromTotalTransmittance(ToSpectrum(mc.eta),
-                                                                          ToSpectrum(*mc.total_transmittance)));
+                return Material(ThinGlassMaterial::FromTotalTransmittance(
+                    ToSpectrum(mc.eta), ToSpectrum(*mc.total_transmittance)));
             }
             return Material(ThinGlassMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.transmittance)});
-        case MaterialConfig::Kind::kBlack: break;
+        case MaterialConfig::Kind::kBlack:
+            break;
     }
     return Material(DiffuseMaterial{Spectrum::Constant(0.f)});
 }
@@ -113,16 +118,21 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
         if (sun.radiance) {
             s.radiance = ToSpectrum(*sun.radiance);
         } else {
-            // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for that
-            // zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490) spread over the
-            // disc, i.e. the sun without an atmosphere.
+            // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for
+            // that zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490)
+            // spread over the disc, i.e. the sun without an atmosphere.
             const double omega = ConeSolidAngle(s.angular_radius_rad);
             s.radiance = ExtraterrestrialSolarSpectrum() * float(1.0 / omega);
         }
     } else {
         SunInput in;
-        in.time = CivilTime{sun.when.year, sun.when.month, sun.when.day, sun.when.hour, sun.when.minute,
-                            sun.when.second, sun.when.utc_offset_minutes / 60.0};
+        in.time = CivilTime{sun.when.year,
+                            sun.when.month,
+                            sun.when.day,
+                            sun.when.hour,
+                            sun.when.minute,
+                            sun.when.second,
+                            sun.when.utc_offset_minutes / 60.0};
         in.latitude_deg = sun.latitude_deg;
         in.longitude_deg = sun.longitude_deg;
         in.elevation_m = sun.elevation_m;
@@ -145,7 +155,8 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
 namespace {
 
 /// The config mapping of a model material: its own, else "default", else null.
-const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config, const std::string& name) {
+const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config,
+                                                                const std::string& name) {
     auto it = config.materials.find(name);
     if (it == config.materials.end()) it = config.materials.find("default");
     return it == config.materials.end() ? nullptr : &*it;
@@ -153,8 +164,8 @@ const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfi
 
 }  // namespace
 
-Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir, TextureCache& cache,
-                      RenderScene* scene, std::vector<std::string>* warnings) {
+Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir,
+                      TextureCache& cache, RenderScene* scene, std::vector<std::string>* warnings) {
     if (!config.textures.enabled) return Status::Ok();
     const auto& records = scene->source->materials();
     NAVE_CHECK_EQ(records.size(), scene->materials.size());
@@ -171,9 +182,11 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
         SurfaceTextureOptions options;
         options.use_albedo = std::holds_alternative<DiffuseMaterial>(m.material);
         options.use_transmittance = std::holds_alternative<ThinGlassMaterial>(m.material);
-        options.use_emission = !mc.emission;  // the config's emission overrides the model's, texture included
+        options.use_emission =
+            !mc.emission;  // the config's emission overrides the model's, texture included
         options.emission_scale = mc.emission_scale;
-        std::shared_ptr<const SurfaceTextures> t = OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
+        std::shared_ptr<const SurfaceTextures> t =
+            OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
         if (t == nullptr) continue;
         if (t->emission) m.emissive = true;
         if (t->alpha) {
@@ -200,9 +213,10 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         const store::MaterialRecord& rec = records[i];
         const auto* it = FindMapping(config, rec.name);
         if (it == nullptr) {
-            return InvalidArgumentError("{}: the model's material '{}' has no mapping: add [materials.{}] or "
-                                        "[materials.default]",
-                                        file, rec.name, rec.name);
+            return InvalidArgumentError(
+                "{}: the model's material '{}' has no mapping: add [materials.{}] or "
+                "[materials.default]",
+                file, rec.name, rec.name);
         }
         const MaterialConfig& mc = it->second;
         SurfaceMaterial m;
@@ -214,11 +228,13 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
             m.emissive = true;
             m.emission = ToSpectrum(*mc.emission);
         } else if (rec.emission[0] > 0 || rec.emission[1] > 0 || rec.emission[2] > 0) {
-            // [texture] The model's own emission (MTL Ke, glTF emissiveFactor) is linear sRGB: lifted to a
-            // spectrum with its chromaticity (core/rgb_to_spectrum.h, Jakob & Hanika 2019 times the D65
-            // white), whose luminance is the Rec. 709 luma of the RGB; a config emission overrides it.
+            // [texture] The model's own emission (MTL Ke, glTF emissiveFactor) is linear sRGB:
+            // lifted to a spectrum with its chromaticity (core/rgb_to_spectrum.h, Jakob & Hanika
+            // 2019 times the D65 white), whose luminance is the Rec. 709 luma of the RGB; a config
+            // emission overrides it.
             m.emissive = true;
-            m.emission = RgbEmission(Vec3f(rec.emission[0], rec.emission[1], rec.emission[2])).ToSpectrum();
+            m.emission =
+                RgbEmission(Vec3f(rec.emission[0], rec.emission[1], rec.emission[2])).ToSpectrum();
         }
         scene.materials.push_back(std::move(m));
     }
@@ -226,7 +242,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
         const std::string& name = entry.first;
         if (name == "default") continue;
-        bool used = std::any_of(records.begin(), records.end(), [&](const auto& r) { return r.name == name; });
+        bool used = std::any_of(records.begin(), records.end(),
+                                [&](const auto& r) { return r.name == name; });
         if (!used)
             log::Warning("{}: [materials.{}] maps no material of the model", entry.second.where,
                          name);
@@ -234,7 +251,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
 
     if (config.sun.enabled) {
         NAVE_ASSIGN_OR_RETURN(SunState sun, ResolveSun(config.sun, file));
-        if (!sun.above_horizon) log::Warning("{}: the sun is below the horizon at that date and place", file);
+        if (!sun.above_horizon)
+            log::Warning("{}: the sun is below the horizon at that date and place", file);
         Light l;
         l.kind = Light::Kind::kSun;
         l.to_light = sun.to_sun;
@@ -242,8 +260,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         l.spectrum = sun.radiance;
         scene.sun = int(scene.lights.size());
         scene.lights.push_back(std::move(l));
-        scene.sun_description = fmt::format("azimuth {:.2f} deg, elevation {:.2f} deg", sun.azimuth_deg,
-                                            90.0 - sun.zenith_deg);
+        scene.sun_description = fmt::format("azimuth {:.2f} deg, elevation {:.2f} deg",
+                                            sun.azimuth_deg, 90.0 - sun.zenith_deg);
     }
     for (const LightConfig& lc : config.lights) {
         Light l;
@@ -272,7 +290,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         scene.sky_radiance = ToSpectrum(config.sky.radiance);
     } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
         scene.sky = true;
-        double turbidity = std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
+        double turbidity =
+            std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
         const Light& sun = scene.lights[size_t(scene.sun)];
         scene.preetham = std::make_shared<PreethamSky>(sun.to_light, float(turbidity));
         scene.sky_scale = config.sky.scale;

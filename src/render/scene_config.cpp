@@ -15,7 +15,8 @@ namespace nave::render {
 
 float SpectrumSpec::Evaluate(float lambda_nm) const {
     switch (kind) {
-        case Kind::kConstant: return value * scale;
+        case Kind::kConstant:
+            return value * scale;
         case Kind::kTable: {
             if (wavelengths_nm.empty()) return 0.f;
             if (lambda_nm <= wavelengths_nm.front()) return values.front() * scale;
@@ -40,20 +41,31 @@ std::string Where(const std::string& file, const toml::source_region& r) {
 
 const char* TypeName(const toml::node& n) {
     switch (n.type()) {
-        case toml::node_type::table: return "table";
-        case toml::node_type::array: return "array";
-        case toml::node_type::string: return "string";
-        case toml::node_type::integer: return "integer";
-        case toml::node_type::floating_point: return "float";
-        case toml::node_type::boolean: return "boolean";
-        case toml::node_type::date: return "date";
-        case toml::node_type::time: return "time";
-        case toml::node_type::date_time: return "date-time";
-        default: return "nothing";
+        case toml::node_type::table:
+            return "table";
+        case toml::node_type::array:
+            return "array";
+        case toml::node_type::string:
+            return "string";
+        case toml::node_type::integer:
+            return "integer";
+        case toml::node_type::floating_point:
+            return "float";
+        case toml::node_type::boolean:
+            return "boolean";
+        case toml::node_type::date:
+            return "date";
+        case toml::node_type::time:
+            return "time";
+        case toml::node_type::date_time:
+            return "date-time";
+        default:
+            return "nothing";
     }
 }
 
-/// Reads the keys of one table and remembers which were read, so that Finish() can reject the others.
+/// Reads the keys of one table and remembers which were read, so that Finish() can reject the
+/// others.
 class TableReader {
   public:
     TableReader(const toml::table& table, std::string prefix, const std::string& file)
@@ -74,7 +86,8 @@ class TableReader {
     bool Has(std::string_view key) const { return table_.get(key) != nullptr; }
 
     Status TypeError(std::string_view key, const toml::node& n, const char* expected) const {
-        return InvalidArgumentError("{}: {}: expected {}, found {}", WhereIs(n), Name(key), expected, TypeName(n));
+        return InvalidArgumentError("{}: {}: expected {}, found {}", WhereIs(n), Name(key),
+                                    expected, TypeName(n));
     }
     Status RangeError(std::string_view key, const toml::node& n, const std::string& what) const {
         return InvalidArgumentError("{}: {}: {}", WhereIs(n), Name(key), what);
@@ -103,7 +116,8 @@ class TableReader {
         if (n == nullptr) return Status::Ok();
         if (!n->is_integer()) return TypeError(key, *n, "an integer");
         int64_t v = *n->value<int64_t>();
-        if (v < lo || v > hi) return RangeError(key, *n, fmt::format("{} is out of range [{}, {}]", v, lo, hi));
+        if (v < lo || v > hi)
+            return RangeError(key, *n, fmt::format("{} is out of range [{}, {}]", v, lo, hi));
         *out = I(v);
         return Status::Ok();
     }
@@ -123,7 +137,8 @@ class TableReader {
     }
     /// A string naming one of `choices`; anything else is an error listing them.
     template <typename E>
-    Status Choice(std::string_view key, std::initializer_list<std::pair<const char*, E>> choices, E* out) {
+    Status Choice(std::string_view key, std::initializer_list<std::pair<const char*, E>> choices,
+                  E* out) {
         const toml::node* n = Take(key);
         if (n == nullptr) return Status::Ok();
         if (!n->is_string()) return TypeError(key, *n, "a string");
@@ -136,7 +151,8 @@ class TableReader {
             }
             names.push_back(fmt::format("\"{}\"", name));
         }
-        return RangeError(key, *n, fmt::format("'{}' (expected {})", value, fmt::join(names, " or ")));
+        return RangeError(key, *n,
+                          fmt::format("'{}' (expected {})", value, fmt::join(names, " or ")));
     }
     Status Vec3(std::string_view key, Vec3f* out) {
         const toml::node* n = Take(key);
@@ -170,10 +186,10 @@ class TableReader {
         for (auto&& [k, v] : table_) {
             if (used_.count(std::string(k.str())) == 0) {
                 std::vector<std::string> known(used_.begin(), used_.end());
-                return InvalidArgumentError("{}: unknown key '{}'{}", Where(file_, k.source()), Name(k.str()),
-                                            used_.empty() ? std::string()
-                                                          : fmt::format(" (keys read here: {})",
-                                                                        fmt::join(known, ", ")));
+                return InvalidArgumentError(
+                    "{}: unknown key '{}'{}", Where(file_, k.source()), Name(k.str()),
+                    used_.empty() ? std::string()
+                                  : fmt::format(" (keys read here: {})", fmt::join(known, ", ")));
             }
         }
         return Status::Ok();
@@ -193,7 +209,8 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
         *out = SpectrumSpec::Constant(float(*n->value<double>()));
         return Status::Ok();
     }
-    if (!n->is_table()) return TypeError(key, *n, "a number or a table {wavelengths_nm, values} / {blackbody_k}");
+    if (!n->is_table())
+        return TypeError(key, *n, "a number or a table {wavelengths_nm, values} / {blackbody_k}");
     TableReader t(*n->as_table(), Name(key), file_);
     SpectrumSpec s;
     NAVE_RETURN_IF_ERROR(t.Float("scale", &s.scale));
@@ -202,12 +219,14 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
         NAVE_RETURN_IF_ERROR(t.Float("blackbody_k", &s.temperature_k, 100, 1e6));
     } else if (t.Has("wavelengths_nm") || t.Has("values")) {
         s.kind = SpectrumSpec::Kind::kTable;
-        for (auto [name, vec] : {std::pair<const char*, std::vector<float>*>{"wavelengths_nm", &s.wavelengths_nm},
-                                 {"values", &s.values}}) {
+        for (auto [name, vec] :
+             {std::pair<const char*, std::vector<float>*>{"wavelengths_nm", &s.wavelengths_nm},
+              {"values", &s.values}}) {
             const toml::node* a = t.Take(name);
             if (a == nullptr) {
-                return InvalidArgumentError("{}: {}: a spectrum table needs both wavelengths_nm and values",
-                                            WhereIs(*n), Name(key));
+                return InvalidArgumentError(
+                    "{}: {}: a spectrum table needs both wavelengths_nm and values", WhereIs(*n),
+                    Name(key));
             }
             if (!a->is_array()) return t.TypeError(name, *a, "an array of numbers");
             for (const toml::node& e : *a->as_array()) {
@@ -216,17 +235,20 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
             }
         }
         if (s.wavelengths_nm.size() != s.values.size() || s.values.empty()) {
-            return InvalidArgumentError("{}: {}: wavelengths_nm has {} entries and values {} (expected equal, > 0)",
-                                        WhereIs(*n), Name(key), s.wavelengths_nm.size(), s.values.size());
+            return InvalidArgumentError(
+                "{}: {}: wavelengths_nm has {} entries and values {} (expected equal, > 0)",
+                WhereIs(*n), Name(key), s.wavelengths_nm.size(), s.values.size());
         }
         for (size_t i = 1; i < s.wavelengths_nm.size(); ++i) {
             if (!(s.wavelengths_nm[i] > s.wavelengths_nm[i - 1])) {
-                return InvalidArgumentError("{}: {}.wavelengths_nm must increase (entry {}: {} after {})",
-                                            WhereIs(*n), Name(key), i, s.wavelengths_nm[i], s.wavelengths_nm[i - 1]);
+                return InvalidArgumentError(
+                    "{}: {}.wavelengths_nm must increase (entry {}: {} after {})", WhereIs(*n),
+                    Name(key), i, s.wavelengths_nm[i], s.wavelengths_nm[i - 1]);
             }
         }
     } else if (t.Has("csv")) {
-        // A column of a CSV spectra file, looked up beside the config, then in nave's data directory.
+        // A column of a CSV spectra file, looked up beside the config, then in nave's data
+        // directory.
         s.kind = SpectrumSpec::Kind::kTable;
         std::string csv, column;
         NAVE_RETURN_IF_ERROR(t.String("csv", &csv));
@@ -235,12 +257,14 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
         if (!std::filesystem::exists(path)) path = std::filesystem::path(NAVE_DATA_DIR) / csv;
         StatusOr<SpectraTable> table = LoadSpectraCsv(path);
         if (!table.ok()) {
-            return InvalidArgumentError("{}: {}.csv: {}", WhereIs(*n), Name(key), table.status().message());
+            return InvalidArgumentError("{}: {}.csv: {}", WhereIs(*n), Name(key),
+                                        table.status().message());
         }
         auto it = std::find(table->names.begin(), table->names.end(), column);
         if (it == table->names.end()) {
-            return InvalidArgumentError("{}: {}.column: '{}' is not a column of {} (columns: {})", WhereIs(*n),
-                                        Name(key), column, path.string(), fmt::join(table->names, ", "));
+            return InvalidArgumentError("{}: {}.column: '{}' is not a column of {} (columns: {})",
+                                        WhereIs(*n), Name(key), column, path.string(),
+                                        fmt::join(table->names, ", "));
         }
         const auto& values = table->columns[size_t(it - table->names.begin())];
         for (size_t i = 0; i < values.size(); ++i) {
@@ -250,8 +274,10 @@ Status TableReader::Spectrum(std::string_view key, SpectrumSpec* out) {
     } else if (t.Has("value")) {
         NAVE_RETURN_IF_ERROR(t.Float("value", &s.value));
     } else {
-        return InvalidArgumentError("{}: {}: a spectrum table needs value, wavelengths_nm + values, csv + column, or blackbody_k",
-                                    WhereIs(*n), Name(key));
+        return InvalidArgumentError(
+            "{}: {}: a spectrum table needs value, wavelengths_nm + values, csv + column, or "
+            "blackbody_k",
+            WhereIs(*n), Name(key));
     }
     NAVE_RETURN_IF_ERROR(t.Finish());
     *out = std::move(s);
@@ -277,7 +303,9 @@ Status ParseCamera(TableReader& r, CameraConfig* c) {
         c->width = int(*(*a)[0].value<int64_t>());
         c->height = int(*(*a)[1].value<int64_t>());
         if (c->width < 1 || c->height < 1 || c->width > 65536 || c->height > 65536) {
-            return r.RangeError("resolution", *n, fmt::format("{}x{} is out of range [1, 65536]", c->width, c->height));
+            return r.RangeError(
+                "resolution", *n,
+                fmt::format("{}x{} is out of range [1, 65536]", c->width, c->height));
         }
     }
     NAVE_RETURN_IF_ERROR(r.Float("lens_radius_m", &c->lens_radius_m, 0, 1e3));
@@ -286,7 +314,8 @@ Status ParseCamera(TableReader& r, CameraConfig* c) {
         return InvalidArgumentError("{}: camera.look_at equals camera.position", r.WhereTable());
     }
     if (Length(Cross(c->look_at - c->position, c->up)) == 0) {
-        return InvalidArgumentError("{}: camera.up is parallel to the view direction", r.WhereTable());
+        return InvalidArgumentError("{}: camera.up is parallel to the view direction",
+                                    r.WhereTable());
     }
     return r.Finish();
 }
@@ -297,19 +326,26 @@ Status ParseSun(TableReader& r, SunConfig* s) {
     if (const toml::node* n = r.Take("datetime")) {
         if (n->is_string()) {
             StatusOr<DateTime> dt = ParseDateTime(*n->value<std::string>());
-            if (!dt.ok()) return InvalidArgumentError("{}: sun.datetime: {}", r.WhereIs(*n), dt.status().message());
+            if (!dt.ok())
+                return InvalidArgumentError("{}: sun.datetime: {}", r.WhereIs(*n),
+                                            dt.status().message());
             s->when = *dt;
         } else if (const auto* v = n->as_date_time()) {
             const toml::date_time& d = v->get();
-            if (!d.offset) return r.RangeError("datetime", *n, "needs a UTC offset (e.g. +02:00 or Z)");
-            s->when = DateTime{d.date.year, d.date.month, d.date.day, d.time.hour, d.time.minute,
-                               d.time.second + d.time.nanosecond * 1e-9, d.offset->minutes};
+            if (!d.offset)
+                return r.RangeError("datetime", *n, "needs a UTC offset (e.g. +02:00 or Z)");
+            s->when =
+                DateTime{d.date.year,      d.date.month,  d.date.day,
+                         d.time.hour,      d.time.minute, d.time.second + d.time.nanosecond * 1e-9,
+                         d.offset->minutes};
         } else {
-            return r.TypeError("datetime", *n, "a date-time with offset (2025-06-21T08:00:00+02:00)");
+            return r.TypeError("datetime", *n,
+                               "a date-time with offset (2025-06-21T08:00:00+02:00)");
         }
     } else if (s->enabled && !r.Has("direction")) {
-        return InvalidArgumentError("{}: sun: needs datetime (and latitude_deg, longitude_deg) or direction",
-                                    r.WhereTable());
+        return InvalidArgumentError(
+            "{}: sun: needs datetime (and latitude_deg, longitude_deg) or direction",
+            r.WhereTable());
     }
     NAVE_RETURN_IF_ERROR(r.Double("latitude_deg", &s->latitude_deg, -90, 90));
     NAVE_RETURN_IF_ERROR(r.Double("longitude_deg", &s->longitude_deg, -180, 180));
@@ -322,7 +358,8 @@ Status ParseSun(TableReader& r, SunConfig* s) {
     if (r.Has("direction")) {
         Vec3f d;
         NAVE_RETURN_IF_ERROR(r.Vec3("direction", &d));
-        if (Length(d) == 0) return InvalidArgumentError("{}: sun.direction must not be zero", r.WhereTable());
+        if (Length(d) == 0)
+            return InvalidArgumentError("{}: sun.direction must not be zero", r.WhereTable());
         s->direction = Normalize(d);
     }
     NAVE_ASSIGN_OR_RETURN(s->radiance, r.OptionalSpectrum("radiance"));
@@ -362,7 +399,9 @@ Status ParseSky(TableReader& r, SkyConfig* s) {
     } else if (type == "none") {
         s->kind = SkyConfig::Kind::kNone;
     } else {
-        return r.RangeError("type", *tn, fmt::format("'{}' is not a sky type (expected uniform, preetham or none)", type));
+        return r.RangeError(
+            "type", *tn,
+            fmt::format("'{}' is not a sky type (expected uniform, preetham or none)", type));
     }
     return r.Finish();
 }
@@ -371,7 +410,9 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     l->where = r.WhereTable();
     std::string type;
     const toml::node* tn = r.Take("type");
-    if (tn == nullptr) return InvalidArgumentError("{}: {}: missing 'type' (directional, point or spot)", l->where, r.Name(""));
+    if (tn == nullptr)
+        return InvalidArgumentError("{}: {}: missing 'type' (directional, point or spot)", l->where,
+                                    r.Name(""));
     if (!tn->is_string()) return r.TypeError("type", *tn, "a string");
     type = *tn->value<std::string>();
     if (type == "directional") {
@@ -381,14 +422,17 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     } else if (type == "spot") {
         l->kind = LightConfig::Kind::kSpot;
     } else {
-        return r.RangeError("type", *tn, fmt::format("'{}' is not a light type (directional, point, spot)", type));
+        return r.RangeError(
+            "type", *tn, fmt::format("'{}' is not a light type (directional, point, spot)", type));
     }
     if (l->kind != LightConfig::Kind::kPoint) {
         NAVE_RETURN_IF_ERROR(r.Vec3("direction", &l->direction));
-        if (Length(l->direction) == 0) return InvalidArgumentError("{}: {}.direction must not be zero", l->where, r.Name(""));
+        if (Length(l->direction) == 0)
+            return InvalidArgumentError("{}: {}.direction must not be zero", l->where, r.Name(""));
         l->direction = Normalize(l->direction);
     }
-    if (l->kind != LightConfig::Kind::kDirectional) NAVE_RETURN_IF_ERROR(r.Vec3("position", &l->position));
+    if (l->kind != LightConfig::Kind::kDirectional)
+        NAVE_RETURN_IF_ERROR(r.Vec3("position", &l->position));
     if (l->kind == LightConfig::Kind::kSpot) {
         NAVE_RETURN_IF_ERROR(r.Float("cone_deg", &l->cone_deg, 0.01, 90));
         l->falloff_start_deg = l->cone_deg;
@@ -411,7 +455,8 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     if (r.Has("builtin")) {
         // A named material of nave's physics library (limestone, glass_blue, gold, bk7...).
         if (r.Has("type")) {
-            return InvalidArgumentError("{}: {}: give either 'builtin' or 'type', not both", m->where, r.Name(""));
+            return InvalidArgumentError("{}: {}: give either 'builtin' or 'type', not both",
+                                        m->where, r.Name(""));
         }
         NAVE_RETURN_IF_ERROR(r.String("builtin", &m->builtin));
         NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
@@ -436,7 +481,8 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
         NAVE_RETURN_IF_ERROR(r.Spectrum("k", &m->k));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
     } else if (type == "dielectric" || type == "thin_dielectric") {
-        m->kind = type == "dielectric" ? MaterialConfig::Kind::kDielectric : MaterialConfig::Kind::kThinDielectric;
+        m->kind = type == "dielectric" ? MaterialConfig::Kind::kDielectric
+                                       : MaterialConfig::Kind::kThinDielectric;
         NAVE_RETURN_IF_ERROR(r.Spectrum("eta", &m->eta));
         NAVE_RETURN_IF_ERROR(r.Float("roughness", &m->roughness, 0, 1));
         // The absorbing part of the index: k, or the paper's κ (ñ = n(1 + iκ)), not both.
@@ -463,18 +509,22 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
         }
         if (m->kind == MaterialConfig::Kind::kThinDielectric) {
             if (r.Has("transmittance") && r.Has("total_transmittance")) {
-                return InvalidArgumentError("{}: {}: give either transmittance (internal) or total_transmittance",
-                                            m->where, r.Name(""));
+                return InvalidArgumentError(
+                    "{}: {}: give either transmittance (internal) or total_transmittance", m->where,
+                    r.Name(""));
             }
             NAVE_RETURN_IF_ERROR(r.Spectrum("transmittance", &m->transmittance));
-            NAVE_ASSIGN_OR_RETURN(m->total_transmittance, r.OptionalSpectrum("total_transmittance"));
+            NAVE_ASSIGN_OR_RETURN(m->total_transmittance,
+                                  r.OptionalSpectrum("total_transmittance"));
         }
     } else if (type == "black") {
         m->kind = MaterialConfig::Kind::kBlack;
     } else {
-        return r.RangeError("type", *tn,
-                            fmt::format("'{}' is not a material type (diffuse, conductor, dielectric, "
-                                        "thin_dielectric, black)", type));
+        return r.RangeError(
+            "type", *tn,
+            fmt::format("'{}' is not a material type (diffuse, conductor, dielectric, "
+                        "thin_dielectric, black)",
+                        type));
     }
     NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
     NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
@@ -502,7 +552,8 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     } else if (mode == "photon") {
         s->mode = RenderSettings::Mode::kPhoton;
     } else {
-        return InvalidArgumentError("{}: render.mode: '{}' (expected \"path\" or \"photon\")", r.WhereTable(), mode);
+        return InvalidArgumentError("{}: render.mode: '{}' (expected \"path\" or \"photon\")",
+                                    r.WhereTable(), mode);
     }
     NAVE_RETURN_IF_ERROR(r.Int("spp", &s->spp, 1, 1 << 20));
     NAVE_RETURN_IF_ERROR(r.Double("time_limit_s", &s->time_limit_s, 0, 1e7));
@@ -519,11 +570,13 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
     NAVE_RETURN_IF_ERROR(r.Int("threads", &s->threads, 0, 4096));
     s->wave_paths_chosen = r.Has("wave_paths");
     NAVE_RETURN_IF_ERROR(r.Int("wave_paths", &s->wave_paths, 1024, int64_t(1) << 30));
-    NAVE_RETURN_IF_ERROR(r.Choice("photon_target", {{"bounds", RenderSettings::PhotonTarget::kBounds},
-                                                    {"portals", RenderSettings::PhotonTarget::kPortals}},
+    NAVE_RETURN_IF_ERROR(r.Choice("photon_target",
+                                  {{"bounds", RenderSettings::PhotonTarget::kBounds},
+                                   {"portals", RenderSettings::PhotonTarget::kPortals}},
                                   &s->photon_target));
-    NAVE_RETURN_IF_ERROR(r.Choice("sky_sampling", {{"uniform", RenderSettings::SkySampling::kUniform},
-                                                   {"portals", RenderSettings::SkySampling::kPortals}},
+    NAVE_RETURN_IF_ERROR(r.Choice("sky_sampling",
+                                  {{"uniform", RenderSettings::SkySampling::kUniform},
+                                   {"portals", RenderSettings::SkySampling::kPortals}},
                                   &s->sky_sampling));
     NAVE_RETURN_IF_ERROR(r.Choice("sky_direct",
                                   {{"sampled", RenderSettings::SkyDirect::kSampled},
@@ -538,8 +591,9 @@ Status ParseOutput(TableReader& r, OutputConfig* o) {
         if (!n->is_string()) return r.TypeError("white_balance", *n, "a string");
         o->white_balance = *n->value<std::string>();
         const std::string& w = o->white_balance;
-        bool kelvin = w.size() > 1 && w.back() == 'K' &&
-                      std::all_of(w.begin(), w.end() - 1, [](char c) { return c >= '0' && c <= '9'; });
+        bool kelvin =
+            w.size() > 1 && w.back() == 'K' &&
+            std::all_of(w.begin(), w.end() - 1, [](char c) { return c >= '0' && c <= '9'; });
         if (w != "none" && w != "D65" && w != "D50" && w != "scene" && !kelvin) {
             return r.RangeError(
                 "white_balance", *n,
@@ -585,7 +639,8 @@ Status ParseOutput(TableReader& r, OutputConfig* o) {
             } else if (*s == "depth") {
                 o->aov_depth = true;
             } else {
-                return r.RangeError("aovs", *n, fmt::format("'{}' is not an AOV (albedo, normal, depth)", *s));
+                return r.RangeError("aovs", *n,
+                                    fmt::format("'{}' is not an AOV (albedo, normal, depth)", *s));
             }
         }
     }
@@ -601,7 +656,13 @@ StatusOr<DateTime> ParseDateTime(std::string_view text) {
         return InvalidArgumentError("'{}': day {} is not in 1..{} for {:04d}-{:02d}", text, t.day,
                                     DaysInMonth(t.year, t.month), t.year, t.month);
     }
-    return DateTime{t.year, t.month, t.day, t.hour, t.minute, t.second, int(std::lround(t.utc_offset_hours * 60))};
+    return DateTime{t.year,
+                    t.month,
+                    t.day,
+                    t.hour,
+                    t.minute,
+                    t.second,
+                    int(std::lround(t.utc_offset_hours * 60))};
 }
 
 StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string& name) {
@@ -647,8 +708,8 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
         for (auto&& [k, v] : *materials) {
             std::string key(k.str());
             if (!v.is_table()) {
-                return InvalidArgumentError("{}: materials.{}: expected a table, found {}", Where(name, v.source()),
-                                            key, TypeName(v));
+                return InvalidArgumentError("{}: materials.{}: expected a table, found {}",
+                                            Where(name, v.source()), key, TypeName(v));
             }
             TableReader t(*v.as_table(), "materials." + key, name);
             MaterialConfig m;
@@ -662,7 +723,8 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
         NAVE_RETURN_IF_ERROR(ParseRender(t, &config.render));
     }
     if (config.sky.kind == SkyConfig::Kind::kPreetham && !config.sun.enabled) {
-        return InvalidArgumentError("{}: sky.type = \"preetham\" needs an enabled [sun] (the sky follows it)", name);
+        return InvalidArgumentError(
+            "{}: sky.type = \"preetham\" needs an enabled [sun] (the sky follows it)", name);
     }
     NAVE_ASSIGN_OR_RETURN(const toml::table* output, r.Table("output"));
     if (output != nullptr) {

@@ -1,8 +1,9 @@
 #pragma once
-// The scene description a render reads besides the model: camera, sun, sky, lights, the mapping from the
-// model's material names to spectral materials, render and output settings. Parsed from TOML; every key is
-// documented in configs/README.md. Like Mitsuba's "unused parameters" check, a key that nothing reads is an
-// error naming it with its file, line and column, so a misspelt key never passes silently.
+// The scene description a render reads besides the model: camera, sun, sky, lights, the mapping
+// from the model's material names to spectral materials, render and output settings. Parsed from
+// TOML; every key is documented in configs/README.md. Like Mitsuba's "unused parameters" check, a
+// key that nothing reads is an error naming it with its file, line and column, so a misspelt key
+// never passes silently.
 
 #include <array>
 #include <cstdint>
@@ -18,17 +19,21 @@
 
 namespace nave::render {
 
-/// A spectral quantity as written in a config: a constant, a table of (wavelength, value) pairs linearly
-/// interpolated, or a blackbody normalised to 1 at its peak, each times `scale`.
+/// A spectral quantity as written in a config: a constant, a table of (wavelength, value) pairs
+/// linearly interpolated, or a blackbody normalised to 1 at its peak, each times `scale`.
 struct SpectrumSpec {
     enum class Kind { kConstant, kTable, kBlackbody };
     Kind kind = Kind::kConstant;
-    float value = 0.f;                   ///< kConstant
-    std::vector<float> wavelengths_nm;   ///< kTable, increasing
-    std::vector<float> values;           ///< kTable
-    float temperature_k = 0.f;           ///< kBlackbody
+    float value = 0.f;                  ///< kConstant
+    std::vector<float> wavelengths_nm;  ///< kTable, increasing
+    std::vector<float> values;          ///< kTable
+    float temperature_k = 0.f;          ///< kBlackbody
     float scale = 1.f;
-    static SpectrumSpec Constant(float v) { SpectrumSpec s; s.value = v; return s; }
+    static SpectrumSpec Constant(float v) {
+        SpectrumSpec s;
+        s.value = v;
+        return s;
+    }
     /// The value at `lambda_nm` (tables are clamped at their ends).
     float Evaluate(float lambda_nm) const;
 };
@@ -37,10 +42,10 @@ struct CameraConfig {
     Vec3f position{0, 0, 0};
     Vec3f look_at{1, 0, 0};
     Vec3f up{0, 0, 1};
-    float fov_deg = 60.f;            ///< vertical field of view
+    float fov_deg = 60.f;  ///< vertical field of view
     int width = 640, height = 480;
-    float lens_radius_m = 0.f;       ///< thin lens aperture radius; 0 is a pinhole
-    float focus_distance_m = 0.f;    ///< 0: the distance to look_at
+    float lens_radius_m = 0.f;     ///< thin lens aperture radius; 0 is a pinhole
+    float focus_distance_m = 0.f;  ///< 0: the distance to look_at
 };
 
 /// A civil date and time with its UTC offset (the sun's position needs all three).
@@ -57,17 +62,19 @@ struct SunConfig {
     double pressure_mbar = 1013.25, temperature_c = 15.0;
     double turbidity = 3.0;          ///< Linke/Angstrom-style haze factor handed to the sun model
     float scale = 1.f;               ///< multiplies the sun's radiance
-    std::optional<Vec3f> direction; ///< toward the sun; overrides date/place (tests, studios)
-    float angular_radius_deg = 0.2666f;  ///< apparent radius of the disc with `direction` (the model computes its own)
-    std::optional<SpectrumSpec> radiance;  ///< overrides the atmospheric model's spectrum (W m^-2 sr^-1 nm^-1)
+    std::optional<Vec3f> direction;  ///< toward the sun; overrides date/place (tests, studios)
+    float angular_radius_deg =
+        0.2666f;  ///< apparent radius of the disc with `direction` (the model computes its own)
+    std::optional<SpectrumSpec>
+        radiance;  ///< overrides the atmospheric model's spectrum (W m^-2 sr^-1 nm^-1)
 };
 
 struct SkyConfig {
     enum class Kind { kNone, kUniform, kPreetham };
     Kind kind = Kind::kNone;
-    SpectrumSpec radiance;           ///< kUniform: radiance of every direction above and below
-    std::optional<double> turbidity; ///< kPreetham: default the sun's turbidity
-    float scale = 1.f;               ///< kPreetham: multiplies the model's radiance
+    SpectrumSpec radiance;            ///< kUniform: radiance of every direction above and below
+    std::optional<double> turbidity;  ///< kPreetham: default the sun's turbidity
+    float scale = 1.f;                ///< kPreetham: multiplies the model's radiance
     /// kPreetham: the albedo of the ground below the horizon, a Lambertian plane lit by the sun and
     /// the sky (none: the sky below the horizon is black).
     std::optional<SpectrumSpec> ground_albedo;
@@ -76,21 +83,22 @@ struct SkyConfig {
 struct LightConfig {
     enum class Kind { kDirectional, kPoint, kSpot };
     Kind kind = Kind::kDirectional;
-    Vec3f direction{0, 0, -1};       ///< directional and spot: the direction light travels
-    Vec3f position{0, 0, 0};         ///< point and spot
-    SpectrumSpec spectrum;           ///< irradiance (directional, W m^-2 nm^-1) or intensity (W sr^-1 nm^-1)
+    Vec3f direction{0, 0, -1};  ///< directional and spot: the direction light travels
+    Vec3f position{0, 0, 0};    ///< point and spot
+    SpectrumSpec spectrum;  ///< irradiance (directional, W m^-2 nm^-1) or intensity (W sr^-1 nm^-1)
     float cone_deg = 30.f, falloff_start_deg = 25.f;  ///< spot
-    std::string where;               ///< "scene.toml:12" for messages
+    std::string where;                                ///< "scene.toml:12" for messages
 };
 
 struct MaterialConfig {
     enum class Kind { kDiffuse, kConductor, kDielectric, kThinDielectric, kBlack };
     Kind kind = Kind::kDiffuse;
-    SpectrumSpec reflectance = SpectrumSpec::Constant(0.5f);   ///< diffuse albedo
-    SpectrumSpec eta = SpectrumSpec::Constant(1.5f);           ///< dielectric index, conductor eta
-    SpectrumSpec k = SpectrumSpec::Constant(0.f);              ///< conductor absorption
-    SpectrumSpec transmittance = SpectrumSpec::Constant(1.f);  ///< internal transmittance of thin glass per pass
-    std::optional<SpectrumSpec> total_transmittance;           ///< measured total transmittance of a pane
+    SpectrumSpec reflectance = SpectrumSpec::Constant(0.5f);  ///< diffuse albedo
+    SpectrumSpec eta = SpectrumSpec::Constant(1.5f);          ///< dielectric index, conductor eta
+    SpectrumSpec k = SpectrumSpec::Constant(0.f);             ///< conductor absorption
+    SpectrumSpec transmittance =
+        SpectrumSpec::Constant(1.f);  ///< internal transmittance of thin glass per pass
+    std::optional<SpectrumSpec> total_transmittance;  ///< measured total transmittance of a pane
     /// Glass (dielectric, thin_dielectric): the extinction coefficient k of the complex index
     /// n + ik, given as `k` or as the ellipsometric κ of ñ = n(1 + iκ) (`kappa`, k = nκ); with a
     /// pane's `thickness_mm` it sets the internal transmittance exp(-4π k d / λ) per pass, in solid
@@ -98,14 +106,16 @@ struct MaterialConfig {
     std::optional<SpectrumSpec> glass_k;
     bool glass_k_is_kappa = false;
     float thickness_mm = 0.f;
-    std::string builtin;             ///< a named material of the physics library (BuiltinMaterial)
+    std::string builtin;  ///< a named material of the physics library (BuiltinMaterial)
     float roughness = 0.f;
-    std::optional<SpectrumSpec> emission;                      ///< radiance emitted by the surface
-    bool portal = false;             ///< with render.photon_target = "portals", sun photons aim at it
-    /// Use the model's textures for this material (albedo of a diffuse material, alpha cut-outs, emission).
+    std::optional<SpectrumSpec> emission;  ///< radiance emitted by the surface
+    bool portal = false;  ///< with render.photon_target = "portals", sun photons aim at it
+    /// Use the model's textures for this material (albedo of a diffuse material, alpha cut-outs,
+    /// emission).
     bool textures = true;
-    /// Multiplies the radiance lifted from the model's emission texture (map_Ke, emissiveTexture): an RGB
-    /// texel of luminance 1 emits a spectrum of luminance `emission_scale` (W m^-2 sr^-1 nm^-1 units).
+    /// Multiplies the radiance lifted from the model's emission texture (map_Ke, emissiveTexture):
+    /// an RGB texel of luminance 1 emits a spectrum of luminance `emission_scale` (W m^-2 sr^-1
+    /// nm^-1 units).
     float emission_scale = 1.f;
     std::string where;
 };
@@ -113,16 +123,16 @@ struct MaterialConfig {
 struct RenderSettings {
     enum class Mode { kPath, kPhoton };
     Mode mode = Mode::kPath;
-    int spp = 16;                    ///< path mode: samples per pixel; photon mode: camera samples per iteration
-    double time_limit_s = 0;         ///< 0: none
+    int spp = 16;  ///< path mode: samples per pixel; photon mode: camera samples per iteration
+    double time_limit_s = 0;  ///< 0: none
     /// 0: none. Otherwise passes (path mode) or iterations (photon mode) stop once the render's own
     /// estimate of its relative mean squared error (docs/render.md, "Noise") is at most this; spp
     /// and iterations are then the most it does.
     double noise_target = 0;
-    int iterations = 16;             ///< photon mode
+    int iterations = 16;  ///< photon mode
     uint64_t photons_per_iteration = 200000;
-    float initial_radius_m = 0.f;    ///< 0: chosen from the model size
-    float alpha = 2.f / 3.f;         ///< photon mode radius reduction (Knaus & Zwicker 2011 eq. 16)
+    float initial_radius_m = 0.f;  ///< 0: chosen from the model size
+    float alpha = 2.f / 3.f;       ///< photon mode radius reduction (Knaus & Zwicker 2011 eq. 16)
     int max_depth = 8;
     uint64_t seed = 1;
     int threads = 0;                 ///< 0: all cores
@@ -130,12 +140,12 @@ struct RenderSettings {
     /// Whether the config or the command line set wave_paths; if not, `nave render --memory` may
     /// choose it (WavePathsUnderPaging, pager.h).
     bool wave_paths_chosen = false;
-    /// Where photons from the sun and directional lights are aimed: the model's bounds projected onto the
-    /// light's direction, or the triangles of materials marked `portal` (windows) only.
+    /// Where photons from the sun and directional lights are aimed: the model's bounds projected
+    /// onto the light's direction, or the triangles of materials marked `portal` (windows) only.
     enum class PhotonTarget { kBounds, kPortals };
     PhotonTarget photon_target = PhotonTarget::kBounds;
-    /// How next-event estimation picks sky directions: uniformly over the sphere, or mostly toward the
-    /// triangles of `portal` materials (windows), which an interior sees the sky through.
+    /// How next-event estimation picks sky directions: uniformly over the sphere, or mostly toward
+    /// the triangles of `portal` materials (windows), which an interior sees the sky through.
     enum class SkySampling { kUniform, kPortals };
     SkySampling sky_sampling = SkySampling::kUniform;
     /// Photon mode: where the sky's direct light at the visible points comes from: next-event
@@ -159,7 +169,7 @@ struct OutputConfig {
     /// With white_balance "scene": the chromaticity of the scene's light (BuildRenderScene fills it
     /// in RenderScene::output).
     std::optional<Chromaticity> scene_white;
-    float exposure_ev = 0.f;              ///< PNG only; EXR stays linear
+    float exposure_ev = 0.f;  ///< PNG only; EXR stays linear
     /// PNG exposure: kAuto maps the log-average luminance to middle grey; kPhysical exposes like a
     /// camera at `ev100` (metered from the log-average luminance in cd/m² when not given).
     enum class Exposure { kAuto, kPhysical };
@@ -174,9 +184,10 @@ struct OutputConfig {
 
 /// The model's image textures (docs/textures.md).
 struct TextureConfig {
-    bool enabled = true;                        ///< false: every material keeps its flat config colour
-    uint64_t cache_bytes = uint64_t(256) << 20; ///< tile cache cap when `nave render` has no --memory
-    double memory_share = 0.2;                  ///< with --memory: the cache's share of the budget
+    bool enabled = true;  ///< false: every material keeps its flat config colour
+    uint64_t cache_bytes = uint64_t(256)
+                           << 20;  ///< tile cache cap when `nave render` has no --memory
+    double memory_share = 0.2;     ///< with --memory: the cache's share of the budget
 };
 
 struct SceneConfig {
@@ -185,7 +196,8 @@ struct SceneConfig {
     SunConfig sun;
     SkyConfig sky;
     std::vector<LightConfig> lights;
-    std::map<std::string, MaterialConfig> materials;  ///< by model material name; "default" for the rest
+    std::map<std::string, MaterialConfig>
+        materials;  ///< by model material name; "default" for the rest
     RenderSettings render;
     OutputConfig output;
     TextureConfig textures;
@@ -196,7 +208,8 @@ StatusOr<SceneConfig> LoadSceneConfig(const std::filesystem::path& path);
 /// Same from text (`name` is used in messages).
 StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string& name);
 
-/// Parses "2025-06-21T08:00+02:00" (seconds optional, "Z" for UTC). Errors say which field is wrong.
+/// Parses "2025-06-21T08:00+02:00" (seconds optional, "Z" for UTC). Errors say which field is
+/// wrong.
 StatusOr<DateTime> ParseDateTime(std::string_view text);
 
 }  // namespace nave::render

@@ -131,7 +131,8 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
                     for (int x = lo[0]; x <= hi[0]; ++x) {
-                        Vec3f c((float(x) + 0.5f) * g.cell, (float(y) + 0.5f) * g.cell, (float(z) + 0.5f) * g.cell);
+                        Vec3f c((float(x) + 0.5f) * g.cell, (float(y) + 0.5f) * g.cell,
+                                (float(z) + 0.5f) * g.cell);
                         g.cells[CellKey(c, g.cell)].push_back(uint32_t(i));
                     }
         }

@@ -92,7 +92,8 @@ class VisiblePoints {
              const SurfaceMaterial& material, const std::array<float, 2>* uv,
              const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
              const SampledWavelengths& lambda);
-    /// Registers every visible point in the bricks its gather sphere overlaps (after the camera pass).
+    /// Registers every visible point in the bricks its gather sphere overlaps (after the camera
+    /// pass).
     void BuildBrickGrids(const store::BrickTree& tree);
     /// A photon of power `beta` at its wavelengths `lambda` arriving from direction `wi` (pointing
     /// away from the surface) at `p`, on a surface of geometric normal `ng`, in brick `brick`: adds

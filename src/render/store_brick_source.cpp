@@ -3,25 +3,29 @@
 
 namespace nave::render {
 
-// ---------------------------------------------------------------------------------------------- store source
+// ----------------------------------------------------------------------------------------------
+// store source
 
-StoreBrickSource::StoreBrickSource(std::unique_ptr<store::Store> st, std::shared_ptr<EmbreeDevice> device)
-    : BrickSource(std::move(device), st->tree(), st->tree().BrickCells(uint32_t(st->bricks().size())),
-                  st->materials(), st->header().bounds),
+StoreBrickSource::StoreBrickSource(std::unique_ptr<store::Store> st,
+                                   std::shared_ptr<EmbreeDevice> device)
+    : BrickSource(std::move(device), st->tree(),
+                  st->tree().BrickCells(uint32_t(st->bricks().size())), st->materials(),
+                  st->header().bounds),
       store_(std::move(st)) {}
 
 StoreBrickSource::~StoreBrickSource() = default;
 
-StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(const std::filesystem::path& path,
-                                                                   std::shared_ptr<EmbreeDevice> device) {
+StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(
+    const std::filesystem::path& path, std::shared_ptr<EmbreeDevice> device) {
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> st, store::Store::Open(path));
-    return std::unique_ptr<StoreBrickSource>(new StoreBrickSource(std::move(st), std::move(device)));
+    return std::unique_ptr<StoreBrickSource>(
+        new StoreBrickSource(std::move(st), std::move(device)));
 }
 
 uint64_t StoreBrickSource::EstimatedResidentBytes(uint32_t id) const {
     const store::BrickInfo& b = store_->bricks()[id];
-    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals, b.has_uvs,
-                                              bvh_settings());
+    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals,
+                                              b.has_uvs, bvh_settings());
 }
 
 uint64_t StoreBrickSource::LoadScratchBytes(uint32_t id) const {

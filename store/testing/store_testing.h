@@ -24,8 +24,8 @@ struct SurfaceOptions {
     uint32_t material_count = 3;
     bool normals = true;
     bool uvs = true;
-    /// Irregular tessellation: interior vertices move by up to +-jitter/2 of a quad in x and y, and each quad
-    /// takes a random diagonal (seeded by `seed`). 0 gives the regular grid.
+    /// Irregular tessellation: interior vertices move by up to +-jitter/2 of a quad in x and y, and
+    /// each quad takes a random diagonal (seeded by `seed`). 0 gives the regular grid.
     float jitter = 0.f;
     uint32_t seed = 1;
 };

@@ -1,5 +1,6 @@
 #pragma once
-// Runs the `nave` executable (NAVE_BINARY) as a user would, for end-to-end tests of every subcommand.
+// Runs the `nave` executable (NAVE_BINARY) as a user would, for end-to-end tests of every
+// subcommand.
 
 #include <sys/wait.h>
 
@@ -9,7 +10,8 @@
 namespace nave::test {
 
 struct CommandResult {
-    int exit_code = -1;  ///< the process's exit code; -1 if it could not start or was killed by a signal
+    int exit_code =
+        -1;  ///< the process's exit code; -1 if it could not start or was killed by a signal
     std::string output;  ///< what it printed: stdout, and stderr too where asked
 };
 

@@ -11,14 +11,12 @@
 #include "core/spectrum.h"
 #include "core/spectrum_data.h"
 #include "imaging/image_io.h"
-
-#include "test_util.h"
-
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/abbey/glass_textures.h"
 #include "preprocess/abbey/materials.h"
 #include "preprocess/abbey/primitives.h"
+#include "test_util.h"
 
 namespace nave::preprocess {
 namespace {
@@ -62,8 +60,8 @@ TEST(Abbey, DeterministicWithTheAgreedMaterialsAndSize) {
 }
 
 TEST(Abbey, ParallelProducersGiveTheSameTrianglesInTheSameOrder) {
-    // Parts generated on several threads are handed on in the plan's order: the stream (count, and a
-    // hash of every triangle in order) is the one thread's.
+    // Parts generated on several threads are handed on in the plan's order: the stream (count, and
+    // a hash of every triangle in order) is the one thread's.
     const AbbeyDigest one = DigestOf(*MakeAbbeySource(0.5, 1));
     for (int threads : {2, 3, 8}) {
         const AbbeyDigest many = DigestOf(*MakeAbbeySource(0.5, threads));
@@ -111,8 +109,8 @@ TEST(Abbey, GeneratorSpecErrors) {
 namespace nave::preprocess {
 namespace {
 
-// Every glass pane carries texture coordinates across its window (origin top-left), and the glass materials
-// name their spectral transmittance maps.
+// Every glass pane carries texture coordinates across its window (origin top-left), and the glass
+// materials name their spectral transmittance maps.
 TEST(AbbeyGlass, PanesHaveWindowTextureCoordinatesAndMaterialsNameTheirMaps) {
     auto source = MakeAbbeySource(0.25);
     const auto& materials = source->materials();
@@ -126,22 +124,26 @@ TEST(AbbeyGlass, PanesHaveWindowTextureCoordinatesAndMaterialsNameTheirMaps) {
             if (materials[t.material].name.rfind("glass_", 0) != 0) continue;
             ++panes;
             without_uv += !t.has_uvs;
-            for (const auto& uv : t.uv) outside += !(uv[0] >= -1e-5f && uv[0] <= 1.00001f && uv[1] >= -1e-5f && uv[1] <= 1.00001f);
+            for (const auto& uv : t.uv)
+                outside +=
+                    !(uv[0] >= -1e-5f && uv[0] <= 1.00001f && uv[1] >= -1e-5f && uv[1] <= 1.00001f);
         }
     }
     EXPECT_GT(panes, 100u);
     EXPECT_EQ(without_uv, 0u);
     EXPECT_EQ(outside, 0u);
-    for (const char* name : {"glass_clear", "glass_blue", "glass_red", "glass_yellow", "glass_green"}) {
-        auto it = std::find_if(materials.begin(), materials.end(), [&](const auto& m) { return m.name == name; });
+    for (const char* name :
+         {"glass_clear", "glass_blue", "glass_red", "glass_yellow", "glass_green"}) {
+        auto it = std::find_if(materials.begin(), materials.end(),
+                               [&](const auto& m) { return m.name == name; });
         ASSERT_NE(it, materials.end());
         EXPECT_EQ(it->textures.at(abbey::kTransmittanceSlot), abbey::GlassTextureName(name));
     }
 }
 
-// The maps: 21 bands 380-780 nm named in the header; the internal transmittance at 550 nm averages the value
-// inverted from the CSV's total transmittance, T = (1-R)² τ / (1 - R² τ²) with R = 0.04, and varies with the
-// glass's thickness (τ0^(1 ± 0.3)).
+// The maps: 21 bands 380-780 nm named in the header; the internal transmittance at 550 nm averages
+// the value inverted from the CSV's total transmittance, T = (1-R)² τ / (1 - R² τ²) with R = 0.04,
+// and varies with the glass's thickness (τ0^(1 ± 0.3)).
 TEST(AbbeyGlass, TransmittanceMapsFollowTheGlassSpectra) {
     auto dir = testing::MakeTempDir("abbey_glass");
     ASSERT_TRUE(abbey::WriteGlassTextures(dir).ok());
@@ -154,17 +156,19 @@ TEST(AbbeyGlass, TransmittanceMapsFollowTheGlassSpectra) {
         double sum540 = 0, sum560 = 0, lo = 1, hi = 0;
         const size_t n = size_t(image->width) * size_t(image->height);
         for (size_t p = 0; p < n; ++p) {
-            const float v540 = image->pixels[p * 21 + band550], v560 = image->pixels[p * 21 + band550 + 1];
+            const float v540 = image->pixels[p * 21 + band550],
+                        v560 = image->pixels[p * 21 + band550 + 1];
             sum540 += v540;
             sum560 += v560;
             lo = std::min(lo, double(v560));
             hi = std::max(hi, double(v560));
         }
         const double mean550 = 0.5 * (sum540 + sum560) / double(n);
-        const double total = 0.5 * (table.ToSpectrum(name)->Evaluate(540) + table.ToSpectrum(name)->Evaluate(560));
+        const double total =
+            0.5 * (table.ToSpectrum(name)->Evaluate(540) + table.ToSpectrum(name)->Evaluate(560));
         const double r = 0.04;
-        // Check the inversion the other way: the pane with the mean τ has the CSV's total T (Jensen's gap of
-        // τ0^(1 ± 0.3) and half-float storage allow a few per cent).
+        // Check the inversion the other way: the pane with the mean τ has the CSV's total T
+        // (Jensen's gap of τ0^(1 ± 0.3) and half-float storage allow a few per cent).
         const double total_back = (1 - r) * (1 - r) * mean550 / (1 - r * r * mean550 * mean550);
         EXPECT_NEAR(total_back, total, 0.04 * total + 2e-3) << name;
         if (total > 0.05 && total < 0.95) {
@@ -174,7 +178,8 @@ TEST(AbbeyGlass, TransmittanceMapsFollowTheGlassSpectra) {
     // The band centres travel in the header.
     auto in = OIIO::ImageInput::open((dir / abbey::GlassTextureName("glass_blue")).string());
     ASSERT_TRUE(in);
-    EXPECT_EQ(in->spec().get_string_attribute(imaging::kBandCentresAttribute).substr(0, 12), "380,400,420,");
+    EXPECT_EQ(in->spec().get_string_attribute(imaging::kBandCentresAttribute).substr(0, 12),
+              "380,400,420,");
 }
 
 }  // namespace

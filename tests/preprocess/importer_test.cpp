@@ -211,13 +211,14 @@ TEST(GltfImporter, NodeTransformsAndMaterials) {
     EXPECT_EQ(source->units(), "m");
 }
 
-// glTF 2.0 §3.9.4: alphaMode MASK cuts the surface out where base-colour alpha is below alphaCutoff; the
-// importer keeps the cutoff and names the base-colour image as the alpha source.
+// glTF 2.0 §3.9.4: alphaMode MASK cuts the surface out where base-colour alpha is below
+// alphaCutoff; the importer keeps the cutoff and names the base-colour image as the alpha source.
 TEST(GltfImporter, AlphaMaskKeepsCutoffAndAlphaSource) {
     std::string text = ReadFileToString(Fixture("node_transform.gltf")).value();
     const std::string name = "\"name\": \"brass\",";
     ASSERT_NE(text.find(name), std::string::npos);
-    text.replace(text.find(name), name.size(), name + " \"alphaMode\": \"MASK\", \"alphaCutoff\": 0.3,");
+    text.replace(text.find(name), name.size(),
+                 name + " \"alphaMode\": \"MASK\", \"alphaCutoff\": 0.3,");
     auto dir = testing::MakeTempDir("gltf_mask");
     std::ofstream(dir / "mask.gltf") << text;
     std::unique_ptr<TriangleSource> source;
@@ -235,7 +236,8 @@ TEST(GltfImporter, AlphaMaskKeepsCutoffAndAlphaSource) {
 
 // RFC 4648 base64, for building data URIs in tests.
 std::string Base64(const std::string& bytes) {
-    static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    static const char kAlphabet[] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
     for (size_t i = 0; i < bytes.size(); i += 3) {
         const size_t rem = std::min<size_t>(3, bytes.size() - i);
@@ -250,8 +252,8 @@ std::string Base64(const std::string& bytes) {
     return out;
 }
 
-// An image embedded in the file (a data URI here; GLB buffer views take the same path) gets a name, and the
-// source writes its bytes under that name for the texture conversion.
+// An image embedded in the file (a data URI here; GLB buffer views take the same path) gets a name,
+// and the source writes its bytes under that name for the texture conversion.
 TEST(GltfImporter, EmbeddedImageIsWrittenForTheTextureConversion) {
     auto dir = testing::MakeTempDir("gltf_embedded");
     // A real 2 x 1 PNG written by OpenImageIO.
@@ -259,7 +261,8 @@ TEST(GltfImporter, EmbeddedImageIsWrittenForTheTextureConversion) {
         auto out = OIIO::ImageOutput::create((dir / "src.png").string());
         ASSERT_TRUE(out);
         const uint8_t px[6] = {255, 0, 0, 0, 0, 255};
-        ASSERT_TRUE(out->open((dir / "src.png").string(), OIIO::ImageSpec(2, 1, 3, OIIO::TypeUInt8)));
+        ASSERT_TRUE(
+            out->open((dir / "src.png").string(), OIIO::ImageSpec(2, 1, 3, OIIO::TypeUInt8)));
         ASSERT_TRUE(out->write_image(OIIO::TypeUInt8, px));
         ASSERT_TRUE(out->close());
     }
@@ -267,7 +270,8 @@ TEST(GltfImporter, EmbeddedImageIsWrittenForTheTextureConversion) {
     std::string text = ReadFileToString(Fixture("node_transform.gltf")).value();
     const std::string uri = "\"uri\": \"brass.png\"";
     ASSERT_NE(text.find(uri), std::string::npos);
-    text.replace(text.find(uri), uri.size(), "\"uri\": \"data:image/png;base64," + Base64(png) + "\"");
+    text.replace(text.find(uri), uri.size(),
+                 "\"uri\": \"data:image/png;base64," + Base64(png) + "\"");
     std::ofstream(dir / "inline.gltf") << text;
     std::unique_ptr<TriangleSource> source;
     auto tris = ReadModel(dir / "inline.gltf", &source);

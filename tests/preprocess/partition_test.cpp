@@ -174,8 +174,9 @@ class PartitionedSphere : public ::testing::Test {
     static inline std::filesystem::path dir_;
 };
 
-// Without --brick-triangles, a budget too small for million-triangle bricks gets smaller bricks instead of a
-// refusal: here about 5 000 triangles (48 MiB fixed + 5 000 x 5/4 x 600 bytes of encoding work).
+// Without --brick-triangles, a budget too small for million-triangle bricks gets smaller bricks
+// instead of a refusal: here about 5 000 triangles (48 MiB fixed + 5 000 x 5/4 x 600 bytes of
+// encoding work).
 TEST_F(PartitionedSphere, SmallBudgetWithoutBrickSizeChoosesSmallerBricks) {
     const auto out = dir_ / "auto.nave";
     PreprocessOptions o;
@@ -211,8 +212,8 @@ std::set<QTri, QTriLess> StoreTriangles(const store::Store& s, uint64_t* referen
     return all;
 }
 
-// Brick ids follow the brick tree's leaves, not the order threads finish them in: one thread and two give
-// the same directory (cells, counts, payload checksums) and the same tree.
+// Brick ids follow the brick tree's leaves, not the order threads finish them in: one thread and
+// two give the same directory (cells, counts, payload checksums) and the same tree.
 TEST_F(PartitionedSphere, BrickIdsDoNotDependOnTheThreadCount) {
     Run(dir_ / "one.nave", 0, 1);
     Run(dir_ / "two.nave", 0, 2);
@@ -231,8 +232,9 @@ TEST_F(PartitionedSphere, BrickIdsDoNotDependOnTheThreadCount) {
         EXPECT_EQ(a[i].mesh.offset, b[i].mesh.offset) << "brick " << i;
     }
     for (int k = 0; k < 100; ++k) {
-        const Vec3f p = (*one)->header().bounds.min + ((*one)->header().bounds.max - (*one)->header().bounds.min) *
-                                                         (float(k) / 100.f);
+        const Vec3f p =
+            (*one)->header().bounds.min +
+            ((*one)->header().bounds.max - (*one)->header().bounds.min) * (float(k) / 100.f);
         EXPECT_EQ((*one)->tree().Locate(p), (*two)->tree().Locate(p));
     }
 }

@@ -73,13 +73,14 @@ std::vector<std::string> Leftovers(const std::filesystem::path& dir) {
 }
 
 // The abbey at detail 3 is several million triangles: several times the 64 MiB budget as triangles
-// in memory (104 bytes each). Its glass maps would need OpenImageIO (kTextureConversionBytes), which 64 MiB
-// cannot hold: --no-textures (the next test checks the refusal without it).
+// in memory (104 bytes each). Its glass maps would need OpenImageIO (kTextureConversionBytes),
+// which 64 MiB cannot hold: --no-textures (the next test checks the refusal without it).
 TEST(PreprocessProcess, PeakMemoryStaysUnderTheBudget) {
     auto dir = testing::MakeTempDir("memory");
     const uint64_t budget = 64ull << 20;
-    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=3", "-o", "abbey.nave",
-                                  "--memory", "64M", "--brick-triangles", "20000", "--no-textures"});
+    ChildResult r =
+        RunNave(dir, {"preprocess", "--generate", "abbey:detail=3", "-o", "abbey.nave", "--memory",
+                      "64M", "--brick-triangles", "20000", "--no-textures"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_LT(r.max_rss_bytes, budget)
         << "peak RSS " << r.max_rss_bytes << " over the budget " << budget;
@@ -92,22 +93,25 @@ TEST(PreprocessProcess, PeakMemoryStaysUnderTheBudget) {
     std::filesystem::remove_all(dir);
 }
 
-// With textures to convert, a budget that cannot hold OpenImageIO beside the work is refused, naming both ways
-// out, and nothing is left behind; a budget that can hold it is kept (peak RSS under it).
+// With textures to convert, a budget that cannot hold OpenImageIO beside the work is refused,
+// naming both ways out, and nothing is left behind; a budget that can hold it is kept (peak RSS
+// under it).
 TEST(PreprocessProcess, TextureConversionIsCountedInTheBudget) {
     auto dir = testing::MakeTempDir("texture_budget");
-    ChildResult refused = RunNave(dir, {"preprocess", "--generate", "abbey:detail=0.25", "-o", "abbey.nave",
-                                        "--memory", "100M", "--brick-triangles", "20000"});
+    ChildResult refused =
+        RunNave(dir, {"preprocess", "--generate", "abbey:detail=0.25", "-o", "abbey.nave",
+                      "--memory", "100M", "--brick-triangles", "20000"});
     EXPECT_NE(refused.exit_code, 0);
     EXPECT_THAT(refused.err, ::testing::HasSubstr("--no-textures"));
     EXPECT_THAT(refused.err, ::testing::HasSubstr("--memory"));
     EXPECT_FALSE(std::filesystem::exists(dir / "abbey.nave"));
     EXPECT_FALSE(std::filesystem::exists(dir / "abbey.nave.textures"));
     const uint64_t budget = 256ull << 20;
-    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=0.25", "-o", "abbey.nave",
-                                  "--memory", "256M", "--brick-triangles", "20000"});
+    ChildResult r = RunNave(dir, {"preprocess", "--generate", "abbey:detail=0.25", "-o",
+                                  "abbey.nave", "--memory", "256M", "--brick-triangles", "20000"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_LT(r.max_rss_bytes, budget) << "peak RSS " << r.max_rss_bytes << " over the budget " << budget;
+    EXPECT_LT(r.max_rss_bytes, budget)
+        << "peak RSS " << r.max_rss_bytes << " over the budget " << budget;
     EXPECT_TRUE(std::filesystem::exists(dir / "abbey.nave.textures"));
     std::filesystem::remove_all(dir);
 }
@@ -115,8 +119,8 @@ TEST(PreprocessProcess, TextureConversionIsCountedInTheBudget) {
 TEST(PreprocessProcess, InterruptLeavesNoStoreAndNoTemporaries) {
     auto dir = testing::MakeTempDir("interrupt");
     for (int sig : {SIGINT, SIGTERM}) {
-        // Detail 4 (~3.8 M triangles) is still being read or encoded when the signal comes, even on an
-        // idle machine; detail 1 can finish first.
+        // Detail 4 (~3.8 M triangles) is still being read or encoded when the signal comes, even on
+        // an idle machine; detail 1 can finish first.
         ChildResult r = RunNave(dir,
                                 {"preprocess", "--generate", "abbey:detail=4", "-o", "abbey.nave",
                                  "--brick-triangles", "50000"},

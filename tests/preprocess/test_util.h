@@ -22,9 +22,9 @@ std::vector<Triangle> ReadModel(const std::filesystem::path& path,
 /// The error message of opening and reading `path` completely ("" if it succeeded).
 std::string ReadError(const std::filesystem::path& path);
 
-/// What a triangle stream holds, in a few numbers: counts, bounds, a hash of every position (FNV-1a over
-/// the float bits, so two streams with equal digests are identical), and shading normals that point to the
-/// back of their triangle or are not unit length (winding errors).
+/// What a triangle stream holds, in a few numbers: counts, bounds, a hash of every position (FNV-1a
+/// over the float bits, so two streams with equal digests are identical), and shading normals that
+/// point to the back of their triangle or are not unit length (winding errors).
 struct AbbeyDigest {
     uint64_t triangles = 0, with_normals = 0, bad_normals = 0;
     uint64_t hash = 1469598103934665603ull;

@@ -1,9 +1,11 @@
-// Tracing across bricks: the t-range acceptance finds the same nearest hit whatever the brick count.
+// Tracing across bricks: the t-range acceptance finds the same nearest hit whatever the brick
+// count.
+
+#include "render/brick_walk.h"
 
 #include <gtest/gtest.h>
 
 #include "render/brick_source.h"
-#include "render/brick_walk.h"
 #include "render/procedural_meshes.h"
 #include "render/rng.h"
 
@@ -36,7 +38,8 @@ TEST(SplitIntoGridBricks, EveryTriangleLandsInEveryOverlappedCell) {
     for (size_t b = 0; b < grid.meshes.size(); ++b) {
         for (size_t t = 0; t < grid.meshes[b].TriangleCount(); ++t) {
             Bounds3f tb;
-            for (int c = 0; c < 3; ++c) tb.Extend(grid.meshes[b].positions[grid.meshes[b].indices[3 * t + c]]);
+            for (int c = 0; c < 3; ++c)
+                tb.Extend(grid.meshes[b].positions[grid.meshes[b].indices[3 * t + c]]);
             EXPECT_TRUE(tb.Overlaps(cells[b])) << "brick " << b << " triangle " << t;
         }
     }
@@ -71,7 +74,8 @@ TEST(TraceNearest, SameHitsWithOneAnd64Bricks) {
         uint32_t m64 = many.meshes[b64].material_ids[h64.triangle];
         if (m1 != m64 || std::abs(h1.t - h64.t) > 1e-5f * (1 + h1.t)) {
             ++mismatches;
-            ADD_FAILURE() << "ray " << i << " t " << h1.t << " vs " << h64.t << " material " << m1 << " vs " << m64;
+            ADD_FAILURE() << "ray " << i << " t " << h1.t << " vs " << h64.t << " material " << m1
+                          << " vs " << m64;
         }
     }
     EXPECT_GT(hits, kRays / 4);

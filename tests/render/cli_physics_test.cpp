@@ -1,8 +1,6 @@
 // End-to-end: the `nave sun` and `nave spectrum` commands, run as the user would (NAVE_BINARY).
 
 #include <gtest/gtest.h>
-
-#include "common/run_nave.h"
 #include <sys/wait.h>
 
 #include <array>
@@ -11,12 +9,13 @@
 #include <fstream>
 #include <string>
 
+#include "common/run_nave.h"
+
 namespace nave {
 namespace {
 
 using ::nave::test::CommandResult;
 using ::nave::test::RunNave;
-
 
 // The SPA paper's example (Reda & Andreas 2004, Table A5.1): zenith 50.11162°, azimuth 194.34024°.
 TEST(CliSunTest, ReferenceExampleEndToEnd) {

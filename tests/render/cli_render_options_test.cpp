@@ -13,10 +13,12 @@ namespace {
 using ::nave::test::CommandResult;
 using ::nave::test::RunNave;
 
-const std::string kFurnaceConfig = std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_furnace.toml";
+const std::string kFurnaceConfig =
+    std::string(NAVE_TEST_FIXTURES) + "/../../configs/test_furnace.toml";
 
 TEST(CliRenderOptionsTest, ResolutionOverridesTheConfig) {
-    const auto out = std::filesystem::temp_directory_path() / ("nave_resolution_" + std::to_string(getpid()) + ".exr");
+    const auto out = std::filesystem::temp_directory_path() /
+                     ("nave_resolution_" + std::to_string(getpid()) + ".exr");
     const CommandResult r = RunNave("render --procedural furnace --config " + kFurnaceConfig +
                                     " --resolution 8x6 --spp 1 --threads 1 -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -28,8 +30,9 @@ TEST(CliRenderOptionsTest, ResolutionOverridesTheConfig) {
 
 TEST(CliRenderOptionsTest, MalformedResolutionIsAUsageErrorNamingIt) {
     for (const char* bad : {"12x", "0x10", "axb", "10x10x", "99999x2"}) {
-        const CommandResult r = RunNave(std::string("render --procedural furnace --config ") + kFurnaceConfig +
-                                        " --resolution " + bad + " -o /tmp/never_written.exr");
+        const CommandResult r =
+            RunNave(std::string("render --procedural furnace --config ") + kFurnaceConfig +
+                    " --resolution " + bad + " -o /tmp/never_written.exr");
         EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
         EXPECT_NE(r.output.find(std::string("--resolution ") + bad), std::string::npos) << r.output;
         EXPECT_NE(r.output.find("WIDTHxHEIGHT"), std::string::npos) << r.output;

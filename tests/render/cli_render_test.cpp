@@ -1,8 +1,7 @@
-// End-to-end: `nave render` as the user runs it (NAVE_BINARY): outputs, metadata, error messages, exit codes.
+// End-to-end: `nave render` as the user runs it (NAVE_BINARY): outputs, metadata, error messages,
+// exit codes.
 
 #include <gtest/gtest.h>
-
-#include "common/run_nave.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,6 +12,7 @@
 #include <fstream>
 #include <string>
 
+#include "common/run_nave.h"
 #include "core/file.h"
 #include "imaging/image_io.h"
 
@@ -22,11 +22,11 @@ namespace {
 using ::nave::test::CommandResult;
 using ::nave::test::RunNave;
 
-
 class CliRenderTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = std::filesystem::temp_directory_path() / ("nave_cli_render_" + std::to_string(getpid()));
+        dir_ = std::filesystem::temp_directory_path() /
+               ("nave_cli_render_" + std::to_string(getpid()));
         std::filesystem::create_directories(dir_);
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -37,32 +37,39 @@ class CliRenderTest : public ::testing::Test {
     std::filesystem::path dir_;
 };
 
-// The whole texture path as a user runs it: an OBJ whose MTL names an sRGB checkerboard (map_Kd) and a mask
-// (map_d) is preprocessed (textures converted beside the store) and rendered over a uniform sky. The masked-out
-// left half shows the sky; the right half shows the checker's colours where its texels are.
+// The whole texture path as a user runs it: an OBJ whose MTL names an sRGB checkerboard (map_Kd)
+// and a mask (map_d) is preprocessed (textures converted beside the store) and rendered over a
+// uniform sky. The masked-out left half shows the sky; the right half shows the checker's colours
+// where its texels are.
 TEST_F(CliRenderTest, PreprocessedTexturesAppearInTheRender) {
-    // 2 x 2 checker, 8-bit sRGB: top-left and bottom-right red, the others blue. Mask 2 x 1: left 0, right 255.
+    // 2 x 2 checker, 8-bit sRGB: top-left and bottom-right red, the others blue. Mask 2 x 1: left
+    // 0, right 255.
     const std::vector<uint8_t> checker = {200, 10, 10, 10, 10, 200, 10, 10, 200, 200, 10, 10};
     ASSERT_TRUE(imaging::WriteRgb8(dir_ / "checker.png", 2, 2, checker, {}).ok());
     ASSERT_TRUE(imaging::WriteRgb8(dir_ / "mask.png", 2, 1, {0, 0, 0, 255, 255, 255}, {}).ok());
     Write("quad.mtl", "newmtl painted\nKd 0.5 0.5 0.5\nmap_Kd checker.png\nmap_d mask.png\n");
-    Write("quad.obj", "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
-                      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl painted\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
-    CommandResult pre = RunNave("preprocess " + (dir_ / "quad.obj").string() + " -o " + (dir_ / "q.nave").string());
+    Write("quad.obj",
+          "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl painted\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    CommandResult pre =
+        RunNave("preprocess " + (dir_ / "quad.obj").string() + " -o " + (dir_ / "q.nave").string());
     ASSERT_EQ(pre.exit_code, 0) << pre.output;
     int converted = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir_ / "q.nave.textures")) converted += e.is_regular_file();
+    for (const auto& e : std::filesystem::directory_iterator(dir_ / "q.nave.textures"))
+        converted += e.is_regular_file();
     EXPECT_EQ(converted, 2) << "one colour texture and one data texture";
 
     const auto config = std::filesystem::path(NAVE_TEST_FIXTURES) / "scenes/quad_under_sky.toml";
     auto out = dir_ / "quad.exr";
-    CommandResult r = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " + out.string());
+    CommandResult r = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() +
+                              " -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("textures: read"), std::string::npos) << r.output;
     auto image = imaging::ReadImage(out);
     ASSERT_TRUE(image.ok()) << image.status().ToString();
     ASSERT_GE(image->channels.size(), 3u);
-    // The mean of the 3 x 3 pixels around (x, y): single pixels carry the colour noise of 16 spectral samples.
+    // The mean of the 3 x 3 pixels around (x, y): single pixels carry the colour noise of 16
+    // spectral samples.
     auto rgb = [&](int x, int y) {
         std::array<float, 3> sum{};
         for (int dy = -1; dy <= 1; ++dy)
@@ -75,23 +82,27 @@ TEST_F(CliRenderTest, PreprocessedTexturesAppearInTheRender) {
     auto blue = rgb(26, 5), red = rgb(26, 26), sky = rgb(5, 16);
     EXPECT_GT(blue[2], 4 * blue[0]) << blue[0] << " " << blue[2];
     EXPECT_GT(red[0], 4 * red[2]) << red[0] << " " << red[2];
-    // The sky (radiance 1) seen through the cut-out half: brighter than any lit texel (albedo <= 0.6) and grey.
+    // The sky (radiance 1) seen through the cut-out half: brighter than any lit texel (albedo <=
+    // 0.6) and grey.
     EXPECT_GT(sky[1], 0.8f);
     EXPECT_GT(sky[2], 0.6f * sky[0]);
 
-    // Under --memory the texture cache gets [textures] memory_share of the budget (1 % of 400 MiB here, below
-    // what the two tiny textures would use), counted as reserved.
-    const std::string shared_config = ReadFileToString(config).value() + "[textures]\nmemory_share = 0.01\n";
+    // Under --memory the texture cache gets [textures] memory_share of the budget (1 % of 400 MiB
+    // here, below what the two tiny textures would use), counted as reserved.
+    const std::string shared_config =
+        ReadFileToString(config).value() + "[textures]\nmemory_share = 0.01\n";
     const auto share = Write("share.toml", shared_config);
-    CommandResult budget = RunNave("render " + (dir_ / "q.nave").string() + " -c " + share.string() + " -o " +
-                                   out.string() + " --memory 400M");
+    CommandResult budget = RunNave("render " + (dir_ / "q.nave").string() + " -c " +
+                                   share.string() + " -o " + out.string() + " --memory 400M");
     ASSERT_EQ(budget.exit_code, 0) << budget.output;
-    EXPECT_NE(budget.output.find("of which 4.0 MiB for the texture cache"), std::string::npos) << budget.output;
-    EXPECT_NE(budget.output.find("through a 4.0 MiB tile cache"), std::string::npos) << budget.output;
+    EXPECT_NE(budget.output.find("of which 4.0 MiB for the texture cache"), std::string::npos)
+        << budget.output;
+    EXPECT_NE(budget.output.find("through a 4.0 MiB tile cache"), std::string::npos)
+        << budget.output;
 
     // --no-textures: the flat grey material everywhere, the quad whole.
-    CommandResult flat = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() + " -o " +
-                                 out.string() + " --no-textures");
+    CommandResult flat = RunNave("render " + (dir_ / "q.nave").string() + " -c " + config.string() +
+                                 " -o " + out.string() + " --no-textures");
     ASSERT_EQ(flat.exit_code, 0) << flat.output;
     image = imaging::ReadImage(out);
     ASSERT_TRUE(image.ok());
@@ -117,8 +128,8 @@ max_depth = 32
 aovs = ["albedo", "normal", "depth"]
 )");
     auto out = dir_ / "furnace.exr";
-    CommandResult r = RunNave("-q render --procedural furnace:bricks=2 --config " + config.string() + " -o " +
-                              out.string());
+    CommandResult r = RunNave("-q render --procedural furnace:bricks=2 --config " +
+                              config.string() + " -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     ASSERT_TRUE(std::filesystem::exists(out));
     ASSERT_TRUE(std::filesystem::exists(dir_ / "furnace.png"));
@@ -141,7 +152,8 @@ aovs = ["albedo", "normal", "depth"]
 }
 
 TEST_F(CliRenderTest, ConfigErrorsNameFileLineAndKeyWithExitCode2) {
-    auto config = Write("bad.toml", "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\nsp = 4\n");
+    auto config =
+        Write("bad.toml", "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\nsp = 4\n");
     CommandResult r = RunNave("render --procedural furnace --config " + config.string() + " -o " +
                               (dir_ / "x.exr").string());
     EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -151,13 +163,14 @@ TEST_F(CliRenderTest, ConfigErrorsNameFileLineAndKeyWithExitCode2) {
 }
 
 TEST_F(CliRenderTest, MissingMaterialMappingAndMissingModel) {
-    auto config = Write("c.toml", "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.stone]\n");
+    auto config =
+        Write("c.toml", "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.stone]\n");
     CommandResult r = RunNave("render --procedural furnace --config " + config.string() + " -o " +
                               (dir_ / "x.exr").string());
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find("'shell' has no mapping"), std::string::npos) << r.output;
-    CommandResult m = RunNave("render " + (dir_ / "nowhere.nave").string() + " --config " + config.string() +
-                              " -o " + (dir_ / "x.exr").string());
+    CommandResult m = RunNave("render " + (dir_ / "nowhere.nave").string() + " --config " +
+                              config.string() + " -o " + (dir_ / "x.exr").string());
     EXPECT_NE(m.exit_code, 0);
     EXPECT_NE(m.output.find("nowhere.nave"), std::string::npos) << m.output;
 }

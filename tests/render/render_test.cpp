@@ -24,9 +24,10 @@ class RenderTest : public ::testing::Test {
     void SetUp() override { ProgressBar::SetEnabled(false); }
 };
 
-// White furnace: inside a closed sphere of albedo a whose surface emits Le, the radiance everywhere is
-// Le / (1 - a) (the Neumann series of the rendering equation, Kajiya 1986, with constant L). With a = 0.5,
-// Le = 0.5: L = 1, and a constant spectrum of 1 has Y = 1 (CIE normalisation of SampledToXYZ).
+// White furnace: inside a closed sphere of albedo a whose surface emits Le, the radiance everywhere
+// is Le / (1 - a) (the Neumann series of the rendering equation, Kajiya 1986, with constant L).
+// With a = 0.5, Le = 0.5: L = 1, and a constant spectrum of 1 has Y = 1 (CIE normalisation of
+// SampledToXYZ).
 store::BrickMesh FurnaceMesh() {
     store::BrickMesh m;
     AppendSphere(&m, {0, 0, 0}, 1.0f, 24, 48, 0, /*inward=*/true);
@@ -63,8 +64,9 @@ TEST_F(RenderTest, WhiteFurnacePhotonMapping) {
     EXPECT_GT(t->stats.photons, 0u);
 }
 
-// A diffuse plane of albedo R lit by the sun alone: L = R / pi * E, E = L_sun * Omega_sun * cos(zenith)
-// (Lambert's cosine law; the disc's radiance is uniform, and cos varies by < 1e-4 across the disc).
+// A diffuse plane of albedo R lit by the sun alone: L = R / pi * E, E = L_sun * Omega_sun *
+// cos(zenith) (Lambert's cosine law; the disc's radiance is uniform, and cos varies by < 1e-4
+// across the disc).
 TEST_F(RenderTest, SunOnDiffusePlaneMatchesCosineLaw) {
     store::BrickMesh m;
     AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
@@ -91,8 +93,8 @@ spp = 4
         // %.
         double omega = ConeSolidAngle(0.2666 * M_PI / 180);
         double expected = 0.6 / 3.14159265 * 1000.0 * omega * std::sin(e);
-        // Y of a constant spectrum equals its value; the estimate is exact up to the 4 wavelengths' pdf
-        // weighting of a flat spectrum, which is exact.
+        // Y of a constant spectrum equals its value; the estimate is exact up to the 4 wavelengths'
+        // pdf weighting of a flat spectrum, which is exact.
         EXPECT_NEAR(MeanY(*t->film), expected, 0.01 * expected) << "elevation " << elevation_deg;
     }
 }
@@ -131,7 +133,8 @@ photons_per_iteration = {}
                                          c.mode, c.sky_direct, c.photons);
         auto t = Render(m, {"plane"}, config, 1);
         ASSERT_TRUE(t);
-        // The 50 m plane seen from 5 m hides a little sky near the horizon from nothing: exact up to noise.
+        // The 50 m plane seen from 5 m hides a little sky near the horizon from nothing: exact up
+        // to noise.
         EXPECT_NEAR(MeanY(*t->film), 0.6 * 2.0, 0.02 * 1.2)
             << c.mode << ", sky_direct " << c.sky_direct;
     }
@@ -176,7 +179,8 @@ type = "preetham"
 reflectance = 0.6
 [render]
 spp = 256
-)", to_sun.x, to_sun.y, to_sun.z);
+)",
+                                     to_sun.x, to_sun.y, to_sun.z);
     auto t = Render(m, {"plane"}, config, 1);
     ASSERT_TRUE(t);
     EXPECT_NEAR(MeanY(*t->film), expected, 0.03 * expected);
@@ -413,7 +417,8 @@ TEST(SceneConfigGround, GroundAlbedoIsCheckedAndOnlyForThePhysicalSky) {
             .ok());
 }
 
-// The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread counts.
+// The decomposition must not change the image: same seed, 1 brick vs 64 bricks vs other thread
+// counts.
 const std::string kClutter = testing::ClutterScene(32, 24) + R"(
 [render]
 mode = "{}"
@@ -449,7 +454,8 @@ TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
             uint32_t best = store::kNoBrick;
             for (uint32_t b = 0; b < waiting.size(); ++b) {
                 if (waiting[b] == 0) continue;
-                if (best == store::kNoBrick || (policy == 0 ? waiting[b] < waiting[best] : true)) best = b;
+                if (best == store::kNoBrick || (policy == 0 ? waiting[b] < waiting[best] : true))
+                    best = b;
             }
             return best;
         };
@@ -465,7 +471,8 @@ TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePhoton) {
     auto many = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 3);
     ASSERT_TRUE(one && many);
     EXPECT_GT(MeanY(*one->film), 0.0);
-    // Photon deposits add floats atomically per pixel: summation order changes the float flux by ~1e-6.
+    // Photon deposits add floats atomically per pixel: summation order changes the float flux by
+    // ~1e-6.
     EXPECT_LT(MaxRelativeDifference(*one->film, *many->film), 1e-4);
 }
 
@@ -476,12 +483,15 @@ TEST_F(RenderTest, MissingMaterialMappingNamesIt) {
     store::MaterialRecord rec;
     rec.name = "glass_blue";
     MemoryBrickSource source(*device, grid.tree, grid.meshes, {rec});
-    auto config = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.limestone]\n", "abbey.toml");
+    auto config = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.limestone]\n", "abbey.toml");
     ASSERT_TRUE(config.ok()) << config.status().ToString();
     auto scene = BuildRenderScene(*config, source);
     ASSERT_FALSE(scene.ok());
-    EXPECT_NE(scene.status().message().find("glass_blue"), std::string::npos) << scene.status().message();
-    EXPECT_NE(scene.status().message().find("abbey.toml"), std::string::npos) << scene.status().message();
+    EXPECT_NE(scene.status().message().find("glass_blue"), std::string::npos)
+        << scene.status().message();
+    EXPECT_NE(scene.status().message().find("abbey.toml"), std::string::npos)
+        << scene.status().message();
 }
 
 }  // namespace
@@ -492,7 +502,8 @@ TEST_F(RenderTest, MissingMaterialMappingNamesIt) {
 namespace nave::render {
 namespace {
 
-/// Writes `mesh` as a store cut into n^3 bricks (triangles in every cell they overlap, as preprocess does).
+/// Writes `mesh` as a store cut into n^3 bricks (triangles in every cell they overlap, as
+/// preprocess does).
 Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh& mesh,
                       const std::vector<std::string>& names, int n,
                       const store::EncodeOptions& options = {}) {
@@ -500,7 +511,8 @@ Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh&
     store::GlobalGrid g;
     g.origin = Vec3d(-10, -10, -10);
     g.step = 1e-4;
-    NAVE_ASSIGN_OR_RETURN(auto writer, store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
+    NAVE_ASSIGN_OR_RETURN(auto writer,
+                          store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
     std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
     for (size_t b = 0; b < grid.meshes.size(); ++b) {
         NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e,
@@ -518,7 +530,8 @@ Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh&
 }
 
 TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
-    auto dir = std::filesystem::temp_directory_path() / fmt::format("nave_render_test_{}", getpid());
+    auto dir =
+        std::filesystem::temp_directory_path() / fmt::format("nave_render_test_{}", getpid());
     std::filesystem::create_directories(dir);
     std::vector<std::string> names = {"floor", "ball", "chrome"};
     // Stored normals: derived ones depend on which faces a brick holds whole (see below).
@@ -546,9 +559,10 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
         EXPECT_GT(stats.bytes_read, 0u);
     }
     EXPECT_GT(MeanY(*films[0]), 0.0);
-    // Each brick is Draco-encoded on its own; decoding starts every triangle at its lowest grid point, so
-    // Embree sees the same corners in the same order in every brick. Random decisions are keyed by the
-    // path, not by position, so paths do not diverge and the image stays within float precision.
+    // Each brick is Draco-encoded on its own; decoding starts every triangle at its lowest grid
+    // point, so Embree sees the same corners in the same order in every brick. Random decisions are
+    // keyed by the path, not by position, so paths do not diverge and the image stays within float
+    // precision.
     EXPECT_LT(MaxRelativeDifference(*films[0], *films[1]), 1e-5);
     // Derived normals: a face whose fan a brick does not hold whole keeps its stored normals, so a
     // face may be derived in one cut and stored in another, its normals up to 1 degree apart. The
@@ -565,11 +579,12 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
 namespace nave::render {
 namespace {
 
-// A closed room (black walls and roof) with a thin glass window in the roof and the sun at the zenith: the
-// floor under the window receives E = L_sun Omega T_tot, T_tot = (1-r)^2 tau / (1 - r^2 tau^2) for a pane of
-// internal transmittance tau (Stokes; Hecht, Optics §9.7), r = ((n-1)/(n+1))^2 at normal incidence.
-// Shadow rays pass through thin glass, so path tracing gets this by next-event estimation; photon mode must
-// give the same (no double counting by photons that merely crossed the pane).
+// A closed room (black walls and roof) with a thin glass window in the roof and the sun at the
+// zenith: the floor under the window receives E = L_sun Omega T_tot, T_tot = (1-r)^2 tau / (1 - r^2
+// tau^2) for a pane of internal transmittance tau (Stokes; Hecht, Optics §9.7), r = ((n-1)/(n+1))^2
+// at normal incidence. Shadow rays pass through thin glass, so path tracing gets this by next-event
+// estimation; photon mode must give the same (no double counting by photons that merely crossed the
+// pane).
 TEST_F(RenderTest, SunThroughThinGlassWindow) {
     constexpr const char* kRoom = R"(
 [camera]
@@ -603,11 +618,13 @@ max_depth = 1
     double t_tot = (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
     double expected = 0.5 / 3.14159265 * 1000.0 * omega * t_tot;
     std::vector<std::string> names = {"floor", "wall", "window"};
-    auto path = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "path", "bounds"), 2);
+    auto path = Render(testing::RoomWithRoofWindow(), names,
+                       fmt::format(fmt::runtime(kRoom), "path", "bounds"), 2);
     ASSERT_TRUE(path);
     EXPECT_NEAR(MeanY(*path->film), expected, 0.01 * expected);
     for (const char* target : {"bounds", "portals"}) {
-        auto photon = Render(testing::RoomWithRoofWindow(), names, fmt::format(fmt::runtime(kRoom), "photon", target), 2);
+        auto photon = Render(testing::RoomWithRoofWindow(), names,
+                             fmt::format(fmt::runtime(kRoom), "photon", target), 2);
         ASSERT_TRUE(photon);
         // One wavelength set per iteration: 32 sets give the flat spectrum's Y to about 0.5 %.
         EXPECT_NEAR(MeanY(*photon->film), expected, 0.015 * expected) << target;

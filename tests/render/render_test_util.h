@@ -1,5 +1,6 @@
 #pragma once
-// Building small scenes in memory for render tests: a mesh, split into a grid of bricks, plus a config.
+// Building small scenes in memory for render tests: a mesh, split into a grid of bricks, plus a
+// config.
 
 #include <gtest/gtest.h>
 
@@ -26,11 +27,13 @@ struct TestRender {
     RenderStats stats;
 };
 
-/// Splits `mesh` into n^3 bricks, parses `config_text`, renders. Material names: material_names[id]. With
-/// `render_status`, the render's own Status goes there (for tests of its errors) instead of being expected ok.
-inline std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh, const std::vector<std::string>& material_names,
-                                          const std::string& config_text, int n_split, int threads = 0,
-                                          Status* render_status = nullptr) {
+/// Splits `mesh` into n^3 bricks, parses `config_text`, renders. Material names:
+/// material_names[id]. With `render_status`, the render's own Status goes there (for tests of its
+/// errors) instead of being expected ok.
+inline std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh,
+                                          const std::vector<std::string>& material_names,
+                                          const std::string& config_text, int n_split,
+                                          int threads = 0, Status* render_status = nullptr) {
     auto t = std::make_unique<TestRender>();
     auto device = EmbreeDevice::Create();
     EXPECT_TRUE(device.ok());
@@ -62,7 +65,8 @@ inline std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh, const st
     return t;
 }
 
-/// The largest per-channel difference of two films' pixels, relative to their sum (floored at 1e-3).
+/// The largest per-channel difference of two films' pixels, relative to their sum (floored at
+/// 1e-3).
 inline double MaxRelativeDifference(const Film& a, const Film& b) {
     double worst = 0;
     for (size_t p = 0; p < a.pixel_count(); ++p) {
@@ -151,20 +155,20 @@ inline double MeanY(const Film& film) {
     return sum / double(film.pixel_count());
 }
 
-/// A 4 x 4 x 3 m closed room (materials: 0 floor, 1 walls and roof) with a 2 x 2 m window (material 2) in
-/// the roof.
+/// A 4 x 4 x 3 m closed room (materials: 0 floor, 1 walls and roof) with a 2 x 2 m window (material
+/// 2) in the roof.
 inline store::BrickMesh RoomWithRoofWindow() {
     store::BrickMesh m;
-    AppendQuad(&m, {0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 4, 0);                  // floor, facing up
-    AppendQuad(&m, {2, 0, 1.5f}, {0, 2, 0}, {0, 0, 1.5f}, 1, 1);            // walls
+    AppendQuad(&m, {0, 0, 0}, {2, 0, 0}, {0, 2, 0}, 4, 0);        // floor, facing up
+    AppendQuad(&m, {2, 0, 1.5f}, {0, 2, 0}, {0, 0, 1.5f}, 1, 1);  // walls
     AppendQuad(&m, {-2, 0, 1.5f}, {0, 0, 1.5f}, {0, 2, 0}, 1, 1);
     AppendQuad(&m, {0, 2, 1.5f}, {0, 0, 1.5f}, {2, 0, 0}, 1, 1);
     AppendQuad(&m, {0, -2, 1.5f}, {2, 0, 0}, {0, 0, 1.5f}, 1, 1);
-    AppendQuad(&m, {1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);             // roof around a 2 x 2 m hole
+    AppendQuad(&m, {1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);  // roof around a 2 x 2 m hole
     AppendQuad(&m, {-1.5f, 0, 3}, {0.5f, 0, 0}, {0, 2, 0}, 1, 1);
     AppendQuad(&m, {0, 1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
     AppendQuad(&m, {0, -1.5f, 3}, {1, 0, 0}, {0, 0.5f, 0}, 1, 1);
-    AppendQuad(&m, {0, 0, 3}, {1, 0, 0}, {0, 1, 0}, 2, 2);                   // the window
+    AppendQuad(&m, {0, 0, 3}, {1, 0, 0}, {0, 1, 0}, 2, 2);  // the window
     return m;
 }
 

@@ -1,8 +1,8 @@
 // Scene configs: every key parsed, and bad keys, types and dates rejected with file, line and key.
 
-#include <gtest/gtest.h>
-
 #include "render/scene_config.h"
+
+#include <gtest/gtest.h>
 
 namespace nave::render {
 namespace {
@@ -70,15 +70,18 @@ TEST(SceneConfig, ParsesEveryPart) {
 }
 
 TEST(SceneConfig, UnknownKeyNamesKeyFileAndLine) {
-    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfovv = 40\n", "scene.toml");
+    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfovv = 40\n",
+                              "scene.toml");
     ASSERT_FALSE(c.ok());
-    EXPECT_NE(c.status().message().find("scene.toml:4:1"), std::string::npos) << c.status().message();
+    EXPECT_NE(c.status().message().find("scene.toml:4:1"), std::string::npos)
+        << c.status().message();
     EXPECT_NE(c.status().message().find("camera.fovv"), std::string::npos) << c.status().message();
 }
 
 TEST(SceneConfig, UnknownKeyInsideNestedTable) {
     auto c = ParseSceneConfig(
-        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.wood]\nreflectance = {value = 0.3, scael = 2}\n",
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.wood]\nreflectance = {value = "
+        "0.3, scael = 2}\n",
         "s.toml");
     ASSERT_FALSE(c.ok());
     EXPECT_NE(c.status().message().find("materials.wood.reflectance.scael"), std::string::npos)
@@ -86,7 +89,8 @@ TEST(SceneConfig, UnknownKeyInsideNestedTable) {
 }
 
 TEST(SceneConfig, UnknownTopLevelTable) {
-    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[rendr]\nspp = 4\n", "s.toml");
+    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[rendr]\nspp = 4\n",
+                              "s.toml");
     ASSERT_FALSE(c.ok());
     EXPECT_NE(c.status().message().find("'rendr'"), std::string::npos) << c.status().message();
 }
@@ -105,7 +109,8 @@ TEST(SceneConfig, PhotonsPerIterationFitIn32Bits) {
 }
 
 TEST(SceneConfig, WrongTypeSaysExpectedAndFound) {
-    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfov_deg = \"wide\"\n", "s.toml");
+    auto c = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfov_deg = \"wide\"\n", "s.toml");
     ASSERT_FALSE(c.ok());
     EXPECT_NE(c.status().message().find("s.toml:4"), std::string::npos) << c.status().message();
     EXPECT_NE(c.status().message().find("expected a number, found string"), std::string::npos)
@@ -113,21 +118,26 @@ TEST(SceneConfig, WrongTypeSaysExpectedAndFound) {
 }
 
 TEST(SceneConfig, BadDates) {
-    const char* base = "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[sun]\ndatetime = \"{}\"\n";
-    for (const char* bad : {"2025-02-30T08:00+01:00", "2025-13-01T08:00Z", "2025-06-21T25:00Z", "2025-06-21T08:00",
-                            "21/06/2025 08:00"}) {
+    const char* base =
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[sun]\ndatetime = \"{}\"\n";
+    for (const char* bad : {"2025-02-30T08:00+01:00", "2025-13-01T08:00Z", "2025-06-21T25:00Z",
+                            "2025-06-21T08:00", "21/06/2025 08:00"}) {
         auto c = ParseSceneConfig(fmt::format(fmt::runtime(base), bad), "sun.toml");
         ASSERT_FALSE(c.ok()) << bad;
-        EXPECT_NE(c.status().message().find("sun.toml:5"), std::string::npos) << c.status().message();
-        EXPECT_NE(c.status().message().find("sun.datetime"), std::string::npos) << c.status().message();
+        EXPECT_NE(c.status().message().find("sun.toml:5"), std::string::npos)
+            << c.status().message();
+        EXPECT_NE(c.status().message().find("sun.datetime"), std::string::npos)
+            << c.status().message();
     }
     auto leap = ParseDateTime("2024-02-29T12:00:30.5-05:30");
     ASSERT_TRUE(leap.ok()) << leap.status().ToString();
     EXPECT_EQ(leap->utc_offset_minutes, -330);
     EXPECT_DOUBLE_EQ(leap->second, 30.5);
     // Native TOML date-times are accepted too.
-    auto native = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[sun]\n"
-                                   "datetime = 2025-06-21T08:00:00+02:00\nlatitude_deg = 49\n", "n.toml");
+    auto native = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[sun]\n"
+        "datetime = 2025-06-21T08:00:00+02:00\nlatitude_deg = 49\n",
+        "n.toml");
     ASSERT_TRUE(native.ok()) << native.status().ToString();
     EXPECT_EQ(native->sun.when.utc_offset_minutes, 120);
 }
@@ -135,29 +145,35 @@ TEST(SceneConfig, BadDates) {
 TEST(SceneConfig, SyntaxErrorHasLocation) {
     auto c = ParseSceneConfig("[camera\nposition = [0,0,0]\n", "broken.toml");
     ASSERT_FALSE(c.ok());
-    EXPECT_NE(c.status().message().find("broken.toml:1"), std::string::npos) << c.status().message();
+    EXPECT_NE(c.status().message().find("broken.toml:1"), std::string::npos)
+        << c.status().message();
 }
 
 TEST(SceneConfig, MissingCameraAndBadMode) {
     EXPECT_FALSE(ParseSceneConfig("", "e.toml").ok());
-    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\nmode = \"bidir\"\n",
-                              "m.toml");
+    auto c = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\nmode = \"bidir\"\n", "m.toml");
     ASSERT_FALSE(c.ok());
     EXPECT_NE(c.status().message().find("bidir"), std::string::npos);
 }
 
 TEST(SceneConfig, SpectrumFromCsvColumnOfNavesData) {
-    auto c = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.glass_blue]\n"
-                              "type = \"thin_dielectric\"\ntransmittance = { csv = \"stained_glass_approx.csv\", "
-                              "column = \"glass_blue\" }\n", "g.toml");
+    auto c = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.glass_blue]\n"
+        "type = \"thin_dielectric\"\ntransmittance = { csv = \"stained_glass_approx.csv\", "
+        "column = \"glass_blue\" }\n",
+        "g.toml");
     ASSERT_TRUE(c.ok()) << c.status().ToString();
     const SpectrumSpec& t = c->materials.at("glass_blue").transmittance;
     EXPECT_EQ(t.kind, SpectrumSpec::Kind::kTable);
     EXPECT_GT(t.Evaluate(450), 2 * t.Evaluate(620));  // blue glass passes blue, not red
-    auto bad = ParseSceneConfig("[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.x]\n"
-                                "reflectance = { csv = \"stone_approx.csv\", column = \"marble\" }\n", "g.toml");
+    auto bad = ParseSceneConfig(
+        "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.x]\n"
+        "reflectance = { csv = \"stone_approx.csv\", column = \"marble\" }\n",
+        "g.toml");
     ASSERT_FALSE(bad.ok());
-    EXPECT_NE(bad.status().message().find("limestone"), std::string::npos) << bad.status().message();
+    EXPECT_NE(bad.status().message().find("limestone"), std::string::npos)
+        << bad.status().message();
 }
 
 TEST(SpectrumSpec, BlackbodyPeaksAtWien) {

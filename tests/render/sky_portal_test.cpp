@@ -1,8 +1,9 @@
-// Sky next-event estimation through portals (render.sky_sampling = "portals"): a closed room lit only by a
-// uniform sky through a window in its roof (render_test_util.h). Aiming sky samples at the window must give
-// the same image in expectation as uniform directions (the estimator stays unbiased: MIS against BSDF sampling
-// with the mixture pdf, Veach 1997) and less noise (most uniform directions hit the walls and roof). With
-// max_depth 1 the test also catches paths that stop at the window instead of passing through it.
+// Sky next-event estimation through portals (render.sky_sampling = "portals"): a closed room lit
+// only by a uniform sky through a window in its roof (render_test_util.h). Aiming sky samples at
+// the window must give the same image in expectation as uniform directions (the estimator stays
+// unbiased: MIS against BSDF sampling with the mixture pdf, Veach 1997) and less noise (most
+// uniform directions hit the walls and roof). With max_depth 1 the test also catches paths that
+// stop at the window instead of passing through it.
 
 #include <gtest/gtest.h>
 
@@ -47,10 +48,12 @@ testing::SeedPair RenderRoom(const std::string& sky_sampling) {
 TEST(SkyPortals, SameImageInExpectationWithLessNoise) {
     const testing::SeedPair uniform = RenderRoom("uniform"), portals = RenderRoom("portals");
     ASSERT_GT(uniform.mean, 0);
-    // Each mean averages 2 x pixels x 32 paths; their difference stays within a few standard errors.
-    const double tolerance = 4 * std::hypot(uniform.noise, portals.noise) / std::sqrt(2.0 * double(uniform.pixels));
-    EXPECT_NEAR(portals.mean, uniform.mean, tolerance) << "uniform noise " << uniform.noise << ", portals noise "
-                                                      << portals.noise;
+    // Each mean averages 2 x pixels x 32 paths; their difference stays within a few standard
+    // errors.
+    const double tolerance =
+        4 * std::hypot(uniform.noise, portals.noise) / std::sqrt(2.0 * double(uniform.pixels));
+    EXPECT_NEAR(portals.mean, uniform.mean, tolerance)
+        << "uniform noise " << uniform.noise << ", portals noise " << portals.noise;
     EXPECT_LT(portals.noise, 0.5 * uniform.noise);
 }
 
@@ -58,8 +61,8 @@ TEST(SkyPortals, PortalSamplingWithoutPortalsIsAnError) {
     std::string config = kConfig;
     config.replace(config.find("portal = true"), std::string("portal = true").size(), "");
     Status s;
-    auto t = testing::Render(testing::RoomWithRoofWindow(), kMaterials, config + "sky_sampling = \"portals\"\n", 1,
-                             0, &s);
+    auto t = testing::Render(testing::RoomWithRoofWindow(), kMaterials,
+                             config + "sky_sampling = \"portals\"\n", 1, 0, &s);
     ASSERT_TRUE(t != nullptr);
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.message().find("portal = true"), std::string::npos) << s.ToString();

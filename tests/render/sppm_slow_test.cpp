@@ -1,5 +1,5 @@
-// Photon mapping against path tracing (slow: label "slow"). A glass ball on a floor under the sun shows a
-// caustic; SPPM's error against a path-traced reference shrinks as iterations grow.
+// Photon mapping against path tracing (slow: label "slow"). A glass ball on a floor under the sun
+// shows a caustic; SPPM's error against a path-traced reference shrinks as iterations grow.
 
 #include <gtest/gtest.h>
 
@@ -50,12 +50,14 @@ seed = 5
 )";
     auto t = Render(m, {"floor", "glass"}, config, 2);
     ASSERT_TRUE(t);
-    // The floor under the ball (image centre) is in the ball's shadow for direct sunlight, yet the ball
-    // focuses the sunlight that crosses it there: its brightest pixel outshines the directly lit floor.
+    // The floor under the ball (image centre) is in the ball's shadow for direct sunlight, yet the
+    // ball focuses the sunlight that crosses it there: its brightest pixel outshines the directly
+    // lit floor.
     auto region_max = [](const Film& f) {
         double best = 0;
         for (int y = 15; y < 18; ++y)
-            for (int x = 20; x < 28; ++x) best = std::max(best, f.PixelXYZ(uint32_t(y * f.width() + x)).y);
+            for (int x = 20; x < 28; ++x)
+                best = std::max(best, f.PixelXYZ(uint32_t(y * f.width() + x)).y);
         return best;
     };
     double caustic = region_max(*t->film);
@@ -99,7 +101,8 @@ photons_per_iteration = 100000
 max_depth = 16
 seed = 9
 )";
-    auto reference = Render(m, {"floor", "ball"}, fmt::format(fmt::runtime(base), "path", 1024, 1), 1);
+    auto reference =
+        Render(m, {"floor", "ball"}, fmt::format(fmt::runtime(base), "path", 1024, 1), 1);
     auto few = Render(m, {"floor", "ball"}, fmt::format(fmt::runtime(base), "photon", 1, 2), 2);
     auto many = Render(m, {"floor", "ball"}, fmt::format(fmt::runtime(base), "photon", 1, 32), 2);
     ASSERT_TRUE(reference && few && many);
@@ -110,13 +113,14 @@ seed = 9
     EXPECT_NEAR(MeanY(*many->film), mean, 0.03 * mean);
 }
 
-// Indirect light through a window: photons aimed at the portals only must give the same image as photons
-// aimed at the model's bounds (the portal estimator is unbiased, also where two portals overlap as seen
-// from the sun: here a second pane hangs below the roof window).
+// Indirect light through a window: photons aimed at the portals only must give the same image as
+// photons aimed at the model's bounds (the portal estimator is unbiased, also where two portals
+// overlap as seen from the sun: here a second pane hangs below the roof window).
 TEST(SppmSlow, PortalPhotonsMatchBoundsPhotons) {
     ProgressBar::SetEnabled(false);
     store::BrickMesh m = testing::RoomWithRoofWindow();
-    AppendQuad(&m, {0.4f, 0.3f, 1.8f}, {0.5f, 0, 0}, {0, 0.5f, 0}, 1, 2);  // a pane under the window
+    AppendQuad(&m, {0.4f, 0.3f, 1.8f}, {0.5f, 0, 0}, {0, 0.5f, 0}, 1,
+               2);  // a pane under the window
     constexpr const char* kRoom = R"(
 [camera]
 position = [1.8, 1.8, 2.5]

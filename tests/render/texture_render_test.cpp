@@ -1,6 +1,7 @@
-// Textures in rendered images, attached as `nave render` does (AttachTextures): an albedo checkerboard lands at
-// the right place on a rendered quad in both modes; an alpha-masked quad lets light through where alpha is 0,
-// for camera rays and shadow rays; an emission texture emits its colours.
+// Textures in rendered images, attached as `nave render` does (AttachTextures): an albedo
+// checkerboard lands at the right place on a rendered quad in both modes; an alpha-masked quad lets
+// light through where alpha is 0, for camera rays and shadow rays; an emission texture emits its
+// colours.
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -12,13 +13,13 @@
 
 #include "core/color.h"
 #include "core/file.h"
+#include "imaging/texture_cache.h"
 #include "render/brick_source.h"
 #include "render/film.h"
 #include "render/integrator.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
 #include "render/texture/surface_textures.h"
-#include "imaging/texture_cache.h"
 
 namespace nave::render {
 namespace {
@@ -27,13 +28,15 @@ using namespace nave::imaging;
 
 /// The scene of every test here (tests/fixtures/scenes/quad_under_sky.toml), as text to adapt.
 std::string BaseConfig() {
-    auto text = ReadFileToString(std::filesystem::path(NAVE_TEST_FIXTURES) / "scenes/quad_under_sky.toml");
+    auto text =
+        ReadFileToString(std::filesystem::path(NAVE_TEST_FIXTURES) / "scenes/quad_under_sky.toml");
     EXPECT_TRUE(text.ok()) << text.status().ToString();
     return text.ok() ? *text : std::string();
 }
 
 /// Writes a small float image with OpenImageIO (rows from the top).
-void WriteImage(const std::filesystem::path& path, int w, int h, int channels, const std::vector<float>& px) {
+void WriteImage(const std::filesystem::path& path, int w, int h, int channels,
+                const std::vector<float>& px) {
     auto out = OIIO::ImageOutput::create(path.string());
     ASSERT_TRUE(out);
     ASSERT_TRUE(out->open(path.string(), OIIO::ImageSpec(w, h, channels, OIIO::TypeFloat)));
@@ -62,15 +65,16 @@ class TextureRenderTest : public ::testing::Test {
         const float red[3] = {0.8f, 0.05f, 0.05f}, blue[3] = {0.05f, 0.05f, 0.8f};
         std::vector<float> px(12);
         for (int i = 0; i < 4; ++i)
-            for (int c = 0; c < 3; ++c) px[size_t(i * 3 + c)] = (i == 0 || i == 3) ? red[c] : blue[c];
+            for (int c = 0; c < 3; ++c)
+                px[size_t(i * 3 + c)] = (i == 0 || i == 3) ? red[c] : blue[c];
         WriteImage(dir_ / "checker.exr", 2, 2, 3, px);
         // 2 x 1 grey mask: left half cut out (0), right half kept (1).
         WriteImage(dir_ / "mask.exr", 2, 1, 1, {0.f, 1.f});
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }
 
-    /// Renders `mesh` (one material, `rec`) with `config_text`, its textures attached unless `textures` is
-    /// false.
+    /// Renders `mesh` (one material, `rec`) with `config_text`, its textures attached unless
+    /// `textures` is false.
     std::unique_ptr<Film> Render(const store::BrickMesh& mesh, const store::MaterialRecord& rec,
                                  const std::string& config_text, bool textures = true) {
         auto device = EmbreeDevice::Create();
@@ -116,9 +120,9 @@ class TextureRenderTest : public ::testing::Test {
         return RgbColorSpace::Srgb().ToRgb(xyz * (1.0 / 9));
     }
 
-    /// Red where the checker is red, blue elsewhere: pixels 5 and 26 of 32 look at x, y = -0.5 and +0.5 m,
-    /// the centres of the four texels. Image top-left is world (-x, +y) = uv (0.25, 0.75) = texel (0, 0)
-    /// (top-left of the image): red.
+    /// Red where the checker is red, blue elsewhere: pixels 5 and 26 of 32 look at x, y = -0.5 and
+    /// +0.5 m, the centres of the four texels. Image top-left is world (-x, +y) = uv (0.25, 0.75) =
+    /// texel (0, 0) (top-left of the image): red.
     static void ExpectChecker(const Film& film) {
         const struct {
             int x, y;
@@ -127,9 +131,11 @@ class TextureRenderTest : public ::testing::Test {
         for (const auto& spot : kSpots) {
             Vec3d rgb = Block(film, spot.x, spot.y);
             if (spot.red) {
-                EXPECT_GT(rgb.x, 4 * rgb.z) << spot.x << "," << spot.y << ": " << rgb.x << " " << rgb.z;
+                EXPECT_GT(rgb.x, 4 * rgb.z)
+                    << spot.x << "," << spot.y << ": " << rgb.x << " " << rgb.z;
             } else {
-                EXPECT_GT(rgb.z, 4 * rgb.x) << spot.x << "," << spot.y << ": " << rgb.x << " " << rgb.z;
+                EXPECT_GT(rgb.z, 4 * rgb.x)
+                    << spot.x << "," << spot.y << ": " << rgb.x << " " << rgb.z;
             }
         }
     }
@@ -151,15 +157,16 @@ TEST_F(TextureRenderTest, CheckerboardLandsAtItsTextureCoordinates) {
     EXPECT_NEAR(a.x / a.z, e.x / e.z, 0.1);
 }
 
-// Textures are filtered over the pixel's footprint: a checkerboard of 512 x 512 texels alternating 0.05 and
-// 0.95 (about 12 texels under each pixel here) renders like flat 0.5 with the same random numbers; bilinear
-// point samples of the finest level would differ by tens of per cent per sample.
+// Textures are filtered over the pixel's footprint: a checkerboard of 512 x 512 texels alternating
+// 0.05 and 0.95 (about 12 texels under each pixel here) renders like flat 0.5 with the same random
+// numbers; bilinear point samples of the finest level would differ by tens of per cent per sample.
 TEST_F(TextureRenderTest, FineTextureIsFilteredOverThePixelFootprint) {
     const int n = 512;
     std::vector<float> checker(size_t(n) * n * 3), grey(size_t(n) * n * 3, 0.5f);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-            for (int c = 0; c < 3; ++c) checker[(size_t(y) * n + size_t(x)) * 3 + size_t(c)] = (x + y) % 2 ? 0.95f : 0.05f;
+            for (int c = 0; c < 3; ++c)
+                checker[(size_t(y) * n + size_t(x)) * 3 + size_t(c)] = (x + y) % 2 ? 0.95f : 0.05f;
     WriteImage(dir_ / "fine.exr", n, n, 3, checker);
     WriteImage(dir_ / "grey.exr", n, n, 3, grey);
     store::MaterialRecord fine, flat;
@@ -181,16 +188,17 @@ TEST_F(TextureRenderTest, FineTextureIsFilteredOverThePixelFootprint) {
     EXPECT_LT(diff / sum, 0.05) << "mean relative difference per pixel";
 }
 
-// Photon mode: the camera's visible points see the texture (direct sky at the visible point, and photon
-// deposits evaluated with the visible point's texture coordinates).
+// Photon mode: the camera's visible points see the texture (direct sky at the visible point, and
+// photon deposits evaluated with the visible point's texture coordinates).
 TEST_F(TextureRenderTest, CheckerboardInPhotonMode) {
-    std::unique_ptr<Film> film = RenderQuad(true, "mode = \"photon\"\niterations = 2\nphotons_per_iteration = 20000\n");
+    std::unique_ptr<Film> film =
+        RenderQuad(true, "mode = \"photon\"\niterations = 2\nphotons_per_iteration = 20000\n");
     ASSERT_TRUE(film);
     ExpectChecker(*film);
 }
 
-// A black quad whose left half is cut out by map_d over a uniform sky: camera rays pass the cut half and see
-// the sky (radiance 1), and stop on the kept half (black).
+// A black quad whose left half is cut out by map_d over a uniform sky: camera rays pass the cut
+// half and see the sky (radiance 1), and stop on the kept half (black).
 TEST_F(TextureRenderTest, AlphaMaskLetsTheSkyThroughWhereAlphaIsZero) {
     store::MaterialRecord rec;
     rec.name = "leaf";
@@ -209,11 +217,12 @@ TEST_F(TextureRenderTest, AlphaMaskLetsTheSkyThroughWhereAlphaIsZero) {
     EXPECT_LT(opaque->PixelXYZ(16 * 32 + 6).y, 1e-6);
 }
 
-// Shadow rays obey the mask too: a ground quad under a masked occluder, lit by a light straight down, is lit
-// under the cut half and in shadow under the kept half.
+// Shadow rays obey the mask too: a ground quad under a masked occluder, lit by a light straight
+// down, is lit under the cut half and in shadow under the kept half.
 TEST_F(TextureRenderTest, AlphaMaskCastsShadowsOnlyWhereAlphaIsOne) {
     store::BrickMesh m = Quad();
-    // The occluder: the same quad lifted to z = 0.5, material 1 (masked); the ground keeps material 0.
+    // The occluder: the same quad lifted to z = 0.5, material 1 (masked); the ground keeps material
+    // 0.
     const uint32_t base = uint32_t(m.positions.size());
     for (int i = 0; i < 4; ++i) {
         m.positions.push_back(m.positions[size_t(i)] + Vec3f(0, 0, 0.5f));
@@ -238,7 +247,8 @@ TEST_F(TextureRenderTest, AlphaMaskCastsShadowsOnlyWhereAlphaIsOne) {
     auto brick = source.Acquire(0);
     ASSERT_TRUE(brick.ok()) << brick.status().ToString();
     const Vec3f down(0, 0, -1);
-    // Under the cut half (x < 0) the first surface met from above is the ground; under the kept half the leaf.
+    // Under the cut half (x < 0) the first surface met from above is the ground; under the kept
+    // half the leaf.
     BrickHit hit;
     ASSERT_TRUE((*brick)->Intersect(Vec3f(-0.5f, 0, 2), down, 0, 10, &hit));
     EXPECT_NEAR(hit.t, 2.f, 1e-4f);
@@ -249,14 +259,15 @@ TEST_F(TextureRenderTest, AlphaMaskCastsShadowsOnlyWhereAlphaIsOne) {
     EXPECT_TRUE((*brick)->Occluded(Vec3f(0.5f, 0, 0.01f), -down, 0, 1.9f));
 }
 
-// An emission texture (map_Ke) emits its own colours, lifted as illuminant spectra, scaled by the config's
-// emission_scale; no sky.
+// An emission texture (map_Ke) emits its own colours, lifted as illuminant spectra, scaled by the
+// config's emission_scale; no sky.
 TEST_F(TextureRenderTest, EmissionTextureEmitsItsColours) {
     store::MaterialRecord rec;
     rec.name = "panel";
     rec.textures["map_Ke"] = "checker.exr";
     std::string config = BaseConfig();
-    config.replace(config.find("[sky]\nradiance = 1.0\n"), std::string("[sky]\nradiance = 1.0\n").size(), "");
+    config.replace(config.find("[sky]\nradiance = 1.0\n"),
+                   std::string("[sky]\nradiance = 1.0\n").size(), "");
     config.replace(config.find("reflectance = 0.5"), std::string("reflectance = 0.5").size(),
                    "reflectance = 0.0\nemission_scale = 2.0");
     std::unique_ptr<Film> film = Render(Quad(), rec, config);
@@ -266,13 +277,14 @@ TEST_F(TextureRenderTest, EmissionTextureEmitsItsColours) {
     const double y_red = RgbColorSpace::Srgb().ToXyz(Vec3d(0.8, 0.05, 0.05)).y * 2;
     Vec3d xyz;
     for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) xyz = xyz + film->PixelXYZ(uint32_t((5 + dy) * 32 + 5 + dx));
+        for (int dx = -1; dx <= 1; ++dx)
+            xyz = xyz + film->PixelXYZ(uint32_t((5 + dy) * 32 + 5 + dx));
     EXPECT_NEAR(xyz.y / 9, y_red, 0.05 * y_red);
 }
 
-// A thin glass pane whose internal transmittance is a spectral texture ("nave:transmittance", one channel per
-// band): over a uniform sky, the left half (every band 1) passes the sky's grey; the right half (bands below
-// 600 nm 0) passes only red.
+// A thin glass pane whose internal transmittance is a spectral texture ("nave:transmittance", one
+// channel per band): over a uniform sky, the left half (every band 1) passes the sky's grey; the
+// right half (bands below 600 nm 0) passes only red.
 TEST_F(TextureRenderTest, SpectralTransmittanceTextureColoursTheLightThroughAPane) {
     const std::vector<float> bands = {400, 450, 500, 550, 590, 610, 650, 700};
     std::vector<float> px;

@@ -2,13 +2,12 @@
 // damaged copy.
 
 #include <gtest/gtest.h>
-
-#include "common/run_nave.h"
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <fstream>
 
+#include "common/run_nave.h"
 #include "core/file.h"
 #include "store/store_reader.h"
 #include "store/testing/store_testing.h"
@@ -17,15 +16,15 @@
 namespace nave::store {
 namespace {
 
-using test::ScratchDir;
 using ::nave::test::CommandResult;
 using ::nave::test::Streams;
+using test::ScratchDir;
 
 /// Stdout only unless `with_stderr` (JSON output is parsed from stdout alone).
 CommandResult RunNave(const std::string& args, bool with_stderr = false) {
-    return ::nave::test::RunNave(args, with_stderr ? Streams::kStdoutAndStderr : Streams::kStdoutOnly);
+    return ::nave::test::RunNave(args,
+                                 with_stderr ? Streams::kStdoutAndStderr : Streams::kStdoutOnly);
 }
-
 
 class NaveCli : public ::testing::Test {
   protected:
@@ -53,9 +52,9 @@ TEST_F(NaveCli, InspectJsonDescribesTheStore) {
     for (const std::string& part :
          {fmt::format("\"triangles\": {},", triangles_),
           fmt::format("\"source_triangles\": {},", triangles_), std::string("\"bricks\": 4,"),
-          fmt::format("\"format_version\": \"{}.{}\"", kFormatMajor, kFormatMinor), std::string("\"step\": 0.001"),
-          std::string("\"max_axis_error\": 0.0005"), std::string("\"name\": \"m2\""),
-          std::string("\"map_Kd\": \"textures/m1.png\""),
+          fmt::format("\"format_version\": \"{}.{}\"", kFormatMajor, kFormatMinor),
+          std::string("\"step\": 0.001"), std::string("\"max_axis_error\": 0.0005"),
+          std::string("\"name\": \"m2\""), std::string("\"map_Kd\": \"textures/m1.png\""),
           std::string("\"source_files\": [\"synthetic-surface\"]"),
           fmt::format("\"bytes_on_disk\": {},", std::filesystem::file_size(store_))}) {
         EXPECT_NE(run.output.find(part), std::string::npos) << "missing " << part << " in\n"

@@ -268,7 +268,8 @@ TEST_F(StoreCorruption, FutureMajorVersionIsRefusedNamingBothVersions) {
     auto store = OpenBytes(bytes);
     ExpectError(store.status(), StatusCode::kUnsupported,
                 {bad_.string(), fmt::format("version {}.3", kFormatMajor + 1),
-                 fmt::format("reads versions {}.x to {}.x", kOldestReadableMajor, kFormatMajor), "newer nave"});
+                 fmt::format("reads versions {}.x to {}.x", kOldestReadableMajor, kFormatMajor),
+                 "newer nave"});
 }
 
 TEST_F(StoreCorruption, NewerMinorVersionStillOpens) {

@@ -153,7 +153,8 @@ TEST(StoreRoundTrip, SurfaceSplitOnGridIsExact) {
             const Vec3f ng = Normalize(Cross(p[1] - p[0], p[2] - p[0]));
             for (int c = 0; c < 3; ++c) {
                 EXPECT_TRUE(flat_corner[corner[c]]) << "triangle " << t << " mixes flat and smooth";
-                const Vec3f n = in.normals[input_vertex[test::GridKey(grid, out.positions[corner[c]])]];
+                const Vec3f n =
+                    in.normals[input_vertex[test::GridKey(grid, out.positions[corner[c]])]];
                 EXPECT_GE(std::fabs(Dot(Normalize(n), ng)), 0.9999f - 1e-4f) << "triangle " << t;
             }
         }
@@ -409,8 +410,8 @@ TEST(StoreWriter, FinishRefusesInconsistentTablesAndCanRetry) {
 namespace nave::store {
 namespace {
 
-// Format 1.1 appended alpha_cutoff to each material record; a 1.0 record ends before it and must read as
-// the default, while a 1.1 record keeps its value.
+// Format 1.1 appended alpha_cutoff to each material record; a 1.0 record ends before it and must
+// read as the default, while a 1.1 record keeps its value.
 TEST(StoreMaterialTable, ReadsRecordsOfFormat10WithoutAlphaCutoff) {
     using format::DecodeMaterials;
     using format::EncodeMaterials;

@@ -28,7 +28,9 @@ class OiioTextureCache final : public TextureCache {
     StatusOr<std::string> StringAttribute(TextureRef texture,
                                           const std::string& name) const override;
     size_t max_memory_bytes() const override { return max_memory_bytes_; }
-    Status SetMaxMemoryBytes(size_t max_memory_bytes) override { return Configure(max_memory_bytes); }
+    Status SetMaxMemoryBytes(size_t max_memory_bytes) override {
+        return Configure(max_memory_bytes);
+    }
     uint64_t opened_pixel_bytes() const override {
         std::lock_guard<std::mutex> lock(mutex_);
         uint64_t sum = 0;
@@ -66,10 +68,11 @@ Status OiioTextureCache::Configure(size_t max_memory_bytes) {
     return Status::Ok();
 }
 
-// Texture systems are never destroyed: a destroyed one leaves tile references in the per-thread data of the
-// worker threads that used it, and OpenImageIO 2.4 then drives another cache's memory count below zero (an
-// assertion in imagecache_pvt.h when a process makes caches one after another). A finished cache's system
-// is emptied and kept here for the next cache; the pool lives as long as the process (reachable, not leaked).
+// Texture systems are never destroyed: a destroyed one leaves tile references in the per-thread
+// data of the worker threads that used it, and OpenImageIO 2.4 then drives another cache's memory
+// count below zero (an assertion in imagecache_pvt.h when a process makes caches one after
+// another). A finished cache's system is emptied and kept here for the next cache; the pool lives
+// as long as the process (reachable, not leaked).
 std::mutex& PoolMutex() {
     static std::mutex mutex;
     return mutex;
@@ -104,9 +107,9 @@ StatusOr<TextureRef> OiioTextureCache::Open(const std::filesystem::path& path) {
     if (ts->get_texture_info(handle, nullptr, 0, OIIO::ustring("miplevels"), OIIO::TypeInt,
                              &levels))
         entry->info.mip_levels = levels;
-    // What the cache holds for it: whole tiles (64 when the file is untiled: autotile) of 4-byte floats, as
-    // OpenImageIO's cache may widen half and 8-bit texels; the finest level and a third more for the coarser
-    // ones (each a quarter of the one before).
+    // What the cache holds for it: whole tiles (64 when the file is untiled: autotile) of 4-byte
+    // floats, as OpenImageIO's cache may widen half and 8-bit texels; the finest level and a third
+    // more for the coarser ones (each a quarter of the one before).
     const uint64_t tile_w = spec.tile_width > 0 ? uint64_t(spec.tile_width) : 64;
     const uint64_t tile_h = spec.tile_height > 0 ? uint64_t(spec.tile_height) : 64;
     const uint64_t padded = (uint64_t(spec.width) + tile_w - 1) / tile_w * tile_w *
@@ -122,9 +125,9 @@ const TextureInfo& OiioTextureCache::info(TextureRef texture) const {
     return static_cast<const Entry*>(texture.entry)->info;
 }
 
-Status OiioTextureCache::Lookup(TextureRef texture, float s, float t, const TextureFootprint& footprint,
-                            int first_channel, int num_channels, float* result,
-                            TextureWrap wrap) const {
+Status OiioTextureCache::Lookup(TextureRef texture, float s, float t,
+                                const TextureFootprint& footprint, int first_channel,
+                                int num_channels, float* result, TextureWrap wrap) const {
     NAVE_CHECK(texture.entry != nullptr);
     const Entry& e = *static_cast<const Entry*>(texture.entry);
     OIIO::TextureOpt opt;
@@ -145,7 +148,7 @@ Status OiioTextureCache::Lookup(TextureRef texture, float s, float t, const Text
 }
 
 StatusOr<std::string> OiioTextureCache::StringAttribute(TextureRef texture,
-                                                    const std::string& name) const {
+                                                        const std::string& name) const {
     NAVE_CHECK(texture.entry != nullptr);
     const Entry& e = *static_cast<const Entry*>(texture.entry);
     OIIO::TextureSystem* ts = system_;

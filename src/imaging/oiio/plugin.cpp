@@ -1,5 +1,6 @@
-// nave's OpenImageIO plugin (libnave_oiio.so): the implementation of imaging/oiio_plugin.h. Loaded on first
-// use by LoadOiioPlugin; see that header for why OpenImageIO is not linked into `nave` itself.
+// nave's OpenImageIO plugin (libnave_oiio.so): the implementation of imaging/oiio_plugin.h. Loaded
+// on first use by LoadOiioPlugin; see that header for why OpenImageIO is not linked into `nave`
+// itself.
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -18,9 +19,12 @@ namespace {
 
 OIIO::TypeDesc TypeOf(StoredPixel p) {
     switch (p) {
-        case StoredPixel::kFloat: return OIIO::TypeDesc::FLOAT;
-        case StoredPixel::kHalf: return OIIO::TypeDesc::HALF;
-        case StoredPixel::kUint8: return OIIO::TypeDesc::UINT8;
+        case StoredPixel::kFloat:
+            return OIIO::TypeDesc::FLOAT;
+        case StoredPixel::kHalf:
+            return OIIO::TypeDesc::HALF;
+        case StoredPixel::kUint8:
+            return OIIO::TypeDesc::UINT8;
     }
     return OIIO::TypeDesc::FLOAT;
 }
@@ -30,11 +34,13 @@ std::string GlobalError() { return OIIO::geterror(); }
 
 class Plugin final : public OiioPlugin {
   public:
-    Status WriteImage(const std::filesystem::path& format_path, const std::filesystem::path& temp_path,
+    Status WriteImage(const std::filesystem::path& format_path,
+                      const std::filesystem::path& temp_path,
                       const ImageWriteRequest& r) const override {
         NAVE_CHECK_EQ(r.channels.size(), r.stored.size());
         auto out = OIIO::ImageOutput::create(format_path.string());
-        if (!out) return OiioError(format_path, "no image writer for this extension", GlobalError());
+        if (!out)
+            return OiioError(format_path, "no image writer for this extension", GlobalError());
         const bool uint8 = !r.stored.empty() && r.stored[0] == StoredPixel::kUint8;
         const OIIO::TypeDesc in_type = uint8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
         OIIO::ImageSpec spec(r.width, r.height, int(r.channels.size()), in_type);
@@ -51,13 +57,15 @@ class Plugin final : public OiioPlugin {
         }
         for (const auto& [key, value] : r.metadata) spec.attribute(key, value);
         if (!out->open(temp_path.string(), spec))
-            return IoError("{}: cannot open for writing: {}", format_path.string(), out->geterror());
+            return IoError("{}: cannot open for writing: {}", format_path.string(),
+                           out->geterror());
         if (!out->write_image(in_type, r.pixels)) {
             std::string err = out->geterror();
             out->close();
             return IoError("{}: write failed: {}", format_path.string(), err);
         }
-        if (!out->close()) return IoError("{}: close failed: {}", format_path.string(), out->geterror());
+        if (!out->close())
+            return IoError("{}: close failed: {}", format_path.string(), out->geterror());
         return Status::Ok();
     }
 
@@ -76,14 +84,16 @@ class Plugin final : public OiioPlugin {
         return image;
     }
 
-    StatusOr<std::unique_ptr<TextureCache>> CreateTextureCache(size_t max_memory_bytes) const override {
+    StatusOr<std::unique_ptr<TextureCache>> CreateTextureCache(
+        size_t max_memory_bytes) const override {
         return CreateOiioTextureCache(max_memory_bytes);
     }
 
     Status MakeTexture(const std::filesystem::path& source, const std::filesystem::path& output,
                        TextureContent content) const override {
         std::error_code ec;
-        if (!std::filesystem::exists(source, ec)) return NotFoundError("{}: no such file", source.string());
+        if (!std::filesystem::exists(source, ec))
+            return NotFoundError("{}: no such file", source.string());
         OIIO::ImageBuf in(source.string());
         if (!in.read(0, 0, /*force=*/true, OIIO::TypeFloat)) {
             Status st = OiioError(source, "unreadable", in.geterror());
@@ -91,36 +101,40 @@ class Plugin final : public OiioPlugin {
         }
         const bool colour = content == TextureContent::kColour;
         if (colour) {
-            // Colour textures are sRGB-encoded (IEC 61966-2-1); the renderer filters and lifts linear values.
-            // Alpha and further channels are linear already, and colorconvert leaves alpha alone.
+            // Colour textures are sRGB-encoded (IEC 61966-2-1); the renderer filters and lifts
+            // linear values. Alpha and further channels are linear already, and colorconvert leaves
+            // alpha alone.
             OIIO::ImageBuf linear;
             if (!OIIO::ImageBufAlgo::colorconvert(linear, in, "sRGB", "linear")) {
-                Status st = OiioError(source, "cannot convert from sRGB to linear", linear.geterror());
+                Status st =
+                    OiioError(source, "cannot convert from sRGB to linear", linear.geterror());
                 return InvalidArgumentError("{}", st.message());
             }
             in = std::move(linear);
         }
-        // make_texture stamps the output with the current time unless the image has a DateTime: stamp the
-        // source's own modification time, so that converting the same file twice gives the same bytes (the
-        // converted file's name carries its checksum).
+        // make_texture stamps the output with the current time unless the image has a DateTime:
+        // stamp the source's own modification time, so that converting the same file twice gives
+        // the same bytes (the converted file's name carries its checksum).
         std::string stamp = "unknown";
         const auto mtime = std::filesystem::last_write_time(source, ec);
         if (!ec) {
             const auto sys = std::chrono::file_clock::to_sys(mtime);
-            stamp = fmt::format("source modified {} s after 1970",
-                                std::chrono::duration_cast<std::chrono::seconds>(sys.time_since_epoch()).count());
+            stamp = fmt::format(
+                "source modified {} s after 1970",
+                std::chrono::duration_cast<std::chrono::seconds>(sys.time_since_epoch()).count());
         }
         OIIO::ImageSpec config;
-        // Colour: half floats (OpenEXR; OIIO's TIFF writer would store half as float); data: the source's
-        // pixel type. Both tiled and MIP-mapped by make_texture.
+        // Colour: half floats (OpenEXR; OIIO's TIFF writer would store half as float); data: the
+        // source's pixel type. Both tiled and MIP-mapped by make_texture.
         config.format = colour ? OIIO::TypeHalf : in.nativespec().format;
         config.tile_width = config.tile_height = 64;
         config.attribute("wrapmodes", "periodic,periodic");
         config.attribute("compression", "zip");
         config.attribute("DateTime", stamp);
-        if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in, output.string(), config))
-            return IoError("{}: cannot write the texture converted from {}: {}", output.string(), source.string(),
-                           GlobalError());
+        if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in,
+                                              output.string(), config))
+            return IoError("{}: cannot write the texture converted from {}: {}", output.string(),
+                           source.string(), GlobalError());
         return Status::Ok();
     }
 };
@@ -128,7 +142,8 @@ class Plugin final : public OiioPlugin {
 }  // namespace
 }  // namespace nave::imaging::oiio
 
-extern "C" __attribute__((visibility("default"))) nave::imaging::OiioPlugin* NaveCreateOiioPlugin(int version) {
+extern "C" __attribute__((visibility("default"))) nave::imaging::OiioPlugin* NaveCreateOiioPlugin(
+    int version) {
     if (version != nave::imaging::kOiioPluginVersion) return nullptr;
     return new nave::imaging::oiio::Plugin();
 }
