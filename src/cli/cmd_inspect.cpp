@@ -9,7 +9,7 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "cli/json_text.h"
+#include "core/json_string.h"
 #include "core/memory.h"
 #include "core/progress.h"
 #include "store/store_reader.h"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "cli/json_text.h"
+#include "core/json_string.h"
 #include "core/log.h"
 #include "core/memory.h"
 #include "core/progress.h"

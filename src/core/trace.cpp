@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "core/file.h"
+#include "core/json_string.h"
 
 namespace nave {
 namespace {
@@ -16,44 +17,6 @@ namespace {
 // The JSON is built in pieces of about this size and appended to the file, so that a trace of
 // millions of events never needs its whole text in memory.
 constexpr size_t kFlushBytes = 1 << 20;
-
-/// Appends `text` as a JSON string literal (RFC 8259 section 7: quote, backslash and control
-/// characters escaped; other bytes, UTF-8 included, kept as they are).
-void AppendJsonString(std::string& out, std::string_view text) {
-    out += '"';
-    for (char c : text) {
-        switch (c) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\r':
-                out += "\\r";
-                break;
-            case '\t':
-                out += "\\t";
-                break;
-            case '\b':
-                out += "\\b";
-                break;
-            case '\f':
-                out += "\\f";
-                break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) {
-                    fmt::format_to(std::back_inserter(out), "\\u{:04x}", static_cast<unsigned>(c));
-                } else {
-                    out += c;
-                }
-        }
-    }
-    out += '"';
-}
 
 /// JSON has no NaN or infinity: they become null (the viewers show the key with no value).
 void AppendJsonNumber(std::string& out, double value) {
