@@ -73,8 +73,8 @@ void BrickTree::BricksOverlapping(const Bounds3f& box, std::vector<uint32_t>* ou
         }
         // Below the plane: [.., split); above: [split, ..]. Closed tests: a box touching the plane
         // is on both sides.
-        if (box.min[n.axis] <= n.split && top <= kMaxDepth) stack[top++] = n.child[0];
-        if (box.max[n.axis] >= n.split && top <= kMaxDepth) stack[top++] = n.child[1];
+        if (box.min[n.axis] <= n.split && top <= int(kMaxDepth)) stack[top++] = n.child[0];
+        if (box.max[n.axis] >= n.split && top <= int(kMaxDepth)) stack[top++] = n.child[1];
     }
 }
 
