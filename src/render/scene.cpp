@@ -87,12 +87,9 @@ StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name)
         case MaterialConfig::Kind::kThinDielectric:
             if (mc.glass_k) {
                 // Internal transmittance of one pass at normal incidence: exp(-α d), α = 4πk/λ.
-                const Spectrum alpha = AbsorptionPerMetre(GlassK(mc));
-                const double d = double(mc.thickness_mm) * 1e-3;
-                return Material(
-                    ThinGlassMaterial{ToSpectrum(mc.eta), Spectrum::FromFunction([&](double l) {
-                                          return std::exp(-double(alpha.Evaluate(float(l))) * d);
-                                      })});
+                return Material(ThinGlassMaterial::FromAbsorption(ToSpectrum(mc.eta),
+                                                                  AbsorptionPerMetre(GlassK(mc)),
+                                                                  double(mc.thickness_mm) * 1e-3));
             }
             if (mc.total_transmittance) {
                 return Material(ThinGlassMaterial::FromTotalTransmittance(

@@ -16,6 +16,17 @@ float ThinGlassMaterial::InternalFromTotalTransmittance(float total_t, float eta
     return PaneInternalTransmittance(total_t, FrDielectric(1.f, eta));
 }
 
+ThinGlassMaterial ThinGlassMaterial::FromAbsorption(const Spectrum& eta,
+                                                    const Spectrum& absorption_per_metre,
+                                                    double thickness_m) {
+    ThinGlassMaterial m;
+    m.eta = eta;
+    m.internal_transmittance = Spectrum::FromFunction([&](double l) {
+        return std::exp(-double(absorption_per_metre.Evaluate(float(l))) * thickness_m);
+    });
+    return m;
+}
+
 ThinGlassMaterial ThinGlassMaterial::FromTotalTransmittance(const Spectrum& eta,
                                                             const Spectrum& total_transmittance) {
     ThinGlassMaterial m;
@@ -44,16 +55,6 @@ ConductorMaterial Metal(std::string_view symbol, float alpha) {
     m.eta = ci->eta;
     m.k = ci->k;
     m.alpha_x = m.alpha_y = alpha;
-    return m;
-}
-
-// A soda-lime pane of `thickness_m`: one pass transmits exp(-α d) (Beer-Lambert); the Fresnel
-// series of its two faces is the BxDF's.
-ThinGlassMaterial ThinPane(const Spectrum& absorption_per_metre, double thickness_m) {
-    ThinGlassMaterial m;
-    m.eta = SodaLimeIndex();
-    m.internal_transmittance = Spectrum::FromFunction(
-        [&](double l) { return std::exp(-absorption_per_metre.Evaluate(float(l)) * thickness_m); });
     return m;
 }
 
@@ -86,11 +87,13 @@ StatusOr<Material> BuiltinMaterial(std::string_view name) {
         // A 3 mm pane (the thickness the approximated panes assume, data/SOURCES.md) of measured
         // green soda-lime glass: Fe²⁺/Fe³⁺, the colourant of medieval forest glass, measured
         // (Rubin 1985) rather than approximated like the other glass_ builtins.
-        return Material(ThinPane(GreenSodaLimeAbsorptionPerMetre(), 0.003));
+        return Material(ThinGlassMaterial::FromAbsorption(
+            SodaLimeIndex(), GreenSodaLimeAbsorptionPerMetre(), 0.003));
     }
     if (name == "window_glass") {
         // A 4 mm pane of clear soda-lime glass.
-        return Material(ThinPane(SodaLimeAbsorptionPerMetre(), 0.004));
+        return Material(ThinGlassMaterial::FromAbsorption(SodaLimeIndex(),
+                                                          SodaLimeAbsorptionPerMetre(), 0.004));
     }
     std::string all;
     for (const char* n : kNames) all += (all.empty() ? "" : ", ") + std::string(n);

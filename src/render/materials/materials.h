@@ -66,6 +66,11 @@ struct ThinGlassMaterial {
     Spectrum eta = Spectrum::Constant(1.5f);
     Spectrum internal_transmittance = Spectrum::Constant(1.f);
 
+    /// A pane `thickness_m` thick of a glass absorbing `absorption_per_metre`: one pass transmits
+    /// exp(-α d) (Beer-Lambert); the Fresnel series of its two faces is the BxDF's.
+    static ThinGlassMaterial FromAbsorption(const Spectrum& eta,
+                                            const Spectrum& absorption_per_metre,
+                                            double thickness_m);
     /// The pane whose total normal-incidence transmittance is the measured `total_transmittance`
     /// (what a spectrophotometer reports for a pane): inverts T = (1-R)² τ / (1 - R² τ²) for τ per
     /// wavelength, with R the single-face Fresnel reflectance of eta at normal incidence.
