@@ -29,6 +29,15 @@ int ReadInChild(const std::filesystem::path& path, int fd) {
                : kErrorExitBase + int(StatusCode::kIoError);
 }
 
+// How long Assimp may take on a file: generous for what its slowest readers do with a valid file
+// (a few MiB per minute of text formats and post-processing), so that only a reader stuck in a
+// loop on damaged data reaches it.
+double AssimpTimeLimitSeconds(uintmax_t file_bytes) {
+    constexpr double kBaseSeconds = 300;
+    constexpr double kSecondsPerMiB = 60;
+    return kBaseSeconds + kSecondsPerMiB * double(file_bytes) / double(1 << 20);
+}
+
 // The last non-empty line a crashed child printed (Assimp's assertion message), shortened.
 std::string LastLine(const std::string& text) {
     size_t end = text.find_last_not_of(" \r\n");
@@ -52,8 +61,18 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
     // Assimp runs in a child process: on some malformed files it aborts (ai_assert) or crashes, and
     // that must end in an error naming the file, not take nave (and a half-written store) with it.
-    NAVE_ASSIGN_OR_RETURN(ChildOutcome child,
-                          RunInChildProcess([&](int fd) { return ReadInChild(path, fd); }));
+    const uintmax_t file_bytes = std::filesystem::file_size(path, ec);
+    const double time_limit = AssimpTimeLimitSeconds(ec ? 0 : file_bytes);
+    NAVE_ASSIGN_OR_RETURN(
+        ChildOutcome child,
+        RunInChildProcess([&](int fd) { return ReadInChild(path, fd); }, time_limit));
+    if (child.timed_out) {
+        return DataLossError(
+            "{}: the Assimp importer was stopped after {:.0f} s reading this file of {} bytes "
+            "(its limit: 300 s + 60 s per MiB), the sign of a reader stuck on damaged data; repair "
+            "or re-export it (glTF, OBJ and PLY are read by nave itself)",
+            path.string(), time_limit, ec ? 0 : file_bytes);
+    }
     if (!child.exited || child.exit_code != 0) {
         const int code = child.exit_code - kErrorExitBase;
         if (child.exited && code > int(StatusCode::kOk) && code <= int(StatusCode::kInternal)) {

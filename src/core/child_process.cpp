@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -84,7 +86,8 @@ std::string DescribeSignal(int signal) {
     return "signal " + std::to_string(signal) + ": " + (name != nullptr ? name : "unknown");
 }
 
-StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work) {
+StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work,
+                                         double time_limit_seconds) {
     Pipe out, err;
     NAVE_RETURN_IF_ERROR(out.Open());
     NAVE_RETURN_IF_ERROR(err.Open());
@@ -98,7 +101,7 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         ::dup2(err.fd[1], STDERR_FILENO);
         // The parent's handlers (a crash reporter, a sanitizer, libFuzzer's) must not turn the
         // child's crash into an orderly exit: the parent learns of it from the signal.
-        for (int s : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGPIPE})
+        for (int s : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGPIPE, SIGXCPU})
             std::signal(s, SIG_DFL);
         // The parent reports the crash; a core file of it would only litter the user's directory.
         const rlimit no_core = {0, 0};
@@ -110,6 +113,13 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         if (address_space > 0 && ::getrlimit(RLIMIT_AS, &as) == 0) {
             as.rlim_cur = std::min<rlim_t>(as.rlim_max, rlim_t(address_space));
             ::setrlimit(RLIMIT_AS, &as);
+        }
+        if (time_limit_seconds > 0) {
+            // SIGXCPU at the soft limit ends the child (default action); the hard limit a little
+            // later is the kernel's SIGKILL should something catch SIGXCPU after all.
+            const auto cpu_seconds = rlim_t(std::ceil(time_limit_seconds));
+            const rlimit cpu = {cpu_seconds, cpu_seconds + 2};
+            ::setrlimit(RLIMIT_CPU, &cpu);
         }
         int code = 125;
         try {
@@ -126,8 +136,28 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
     pollfd fds[2] = {{out.fd[0], POLLIN, 0}, {err.fd[0], POLLIN, 0}};
     int open_fds = 2;
     char buffer[1 << 16];
+    // The wall-clock deadline catches a child that is blocked rather than spinning; twice the CPU
+    // limit leaves room for a child that shares the cores with other work.
+    using Clock = std::chrono::steady_clock;
+    const bool limited = time_limit_seconds > 0;
+    const Clock::time_point deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(2 * time_limit_seconds + 1));
     while (open_fds > 0) {
-        if (::poll(fds, 2, -1) < 0) {
+        int timeout_ms = -1;
+        if (limited) {
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+            if (left.count() <= 0) {
+                ::kill(pid, SIGKILL);
+                outcome.timed_out = true;
+                break;  // its pipes close with the Pipe objects; waitpid below reaps it
+            }
+            timeout_ms = int(std::min<int64_t>(left.count() + 1, 60'000));
+        }
+        const int ready = ::poll(fds, 2, timeout_ms);
+        if (ready == 0) continue;  // the deadline is checked above
+        if (ready < 0) {
             if (errno == EINTR) continue;
             break;  // cannot happen with valid descriptors; waitpid below still reaps the child
         }
@@ -159,6 +189,7 @@ StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>
         outcome.exit_code = WEXITSTATUS(status);
     } else if (WIFSIGNALED(status)) {
         outcome.signal = WTERMSIG(status);
+        if (limited && outcome.signal == SIGXCPU) outcome.timed_out = true;
     }
     return outcome;
 }

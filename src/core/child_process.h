@@ -19,6 +19,7 @@ struct ChildOutcome {
     bool exited = false;      ///< it returned from its work (or called _exit)
     int exit_code = 0;        ///< when exited
     int signal = 0;           ///< when killed by a signal: its number
+    bool timed_out = false;   ///< stopped for overrunning its time limit (signal says how)
 };
 
 /// Forks; the child runs `work(output_fd)` and `_exit`s with its return value without running
@@ -28,11 +29,17 @@ struct ChildOutcome {
 /// and is seen by the parent as that signal; its address space is capped
 /// (ChildAddressSpaceLimitBytes).
 ///
+/// `time_limit_seconds` > 0 bounds a child that never finishes (a library looping on a damaged
+/// count): it may use that much CPU time (RLIMIT_CPU; SIGXCPU ends it), and the parent kills it
+/// (SIGKILL) if it is still running twice that long plus a second after it started, which catches
+/// a child blocked without using the CPU. Either way `timed_out` is set. 0 sets no limit.
+///
 /// Safe to call from a process with other threads (TBB's workers) as long as `work` only uses what
 /// a freshly forked single thread may use: malloc (glibc and jemalloc reset their locks at fork),
 /// files, and a library that starts no threads of its own. Errors: IoError when the pipe or the
 /// fork fails; a crashing child is not an error here but an outcome.
-StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work);
+StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work,
+                                         double time_limit_seconds = 0);
 
 /// The child's address-space limit (RLIMIT_AS): the parent's virtual size now plus the memory the
 /// machine has available (MemAvailable), so that the work can use what is free but a runaway

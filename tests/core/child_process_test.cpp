@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -139,6 +140,61 @@ TEST(ChildProcess, WorksFromAProcessWithOtherThreadsRunning) {
     }
     stop = true;
     for (auto& t : busy) t.join();
+}
+
+// A child stuck in a loop is ended by its CPU-time limit; the parent learns it timed out.
+TEST(ChildProcess, ASpinningChildIsStoppedAtItsTimeLimit) {
+    const auto start = std::chrono::steady_clock::now();
+    auto outcome = RunInChildProcess(
+        [](int) {
+            volatile uint64_t n = 0;
+            for (;;) n = n + 1;
+            return 0;
+        },
+        1.0);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(outcome.ok()) << outcome.status().ToString();
+    EXPECT_TRUE(outcome->timed_out);
+    EXPECT_FALSE(outcome->exited);
+    // SIGXCPU after 1 s of CPU, or SIGKILL at the wall deadline (3 s) on a machine too busy to give
+    // the child its second of CPU in time.
+    EXPECT_TRUE(outcome->signal == SIGXCPU || outcome->signal == SIGKILL) << outcome->signal;
+    EXPECT_GE(seconds, 0.9);
+    EXPECT_LT(seconds, 20.0);
+}
+
+// A child blocked without using the CPU never reaches RLIMIT_CPU: the wall-clock deadline
+// (twice the limit plus a second) ends it.
+TEST(ChildProcess, ABlockedChildIsKilledAtTheWallDeadline) {
+    const auto start = std::chrono::steady_clock::now();
+    auto outcome = RunInChildProcess(
+        [](int fd) {
+            WriteAllToFd(fd, "before", 6);
+            for (;;) ::pause();
+            return 0;
+        },
+        0.5);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(outcome.ok()) << outcome.status().ToString();
+    EXPECT_TRUE(outcome->timed_out);
+    EXPECT_EQ(outcome->signal, SIGKILL);
+    EXPECT_EQ(outcome->output, "before");
+    EXPECT_GE(seconds, 1.9);
+    EXPECT_LT(seconds, 20.0);
+}
+
+// Without a limit nothing is stopped.
+TEST(ChildProcess, NoLimitMeansNoTimeout) {
+    auto outcome = RunInChildProcess([](int) {
+        ::usleep(300'000);
+        return 4;
+    });
+    ASSERT_TRUE(outcome.ok());
+    EXPECT_FALSE(outcome->timed_out);
+    EXPECT_TRUE(outcome->exited);
+    EXPECT_EQ(outcome->exit_code, 4);
 }
 
 }  // namespace
