@@ -2,6 +2,12 @@
 find_package(PkgConfig REQUIRED)
 find_package(Threads REQUIRED)
 find_package(TBB REQUIRED)
+if(NAVE_SANITIZE_THREAD AND NOT TBB_DIR MATCHES "tbb-tsan")
+  # TBB hands a task to another thread inside libtbb: ThreadSanitizer sees that hand-off only in an
+  # instrumented libtbb, and without it reports every parallel_for as a race.
+  message(FATAL_ERROR "ThreadSanitizer needs a TBB built with -fsanitize=thread; found ${TBB_DIR}. "
+                      "Run scripts/test.sh tsan (it builds Debian's oneTBB with TSan into build/deps/tbb-tsan).")
+endif()
 find_package(embree 3 REQUIRED)                  # target: embree
 find_package(draco REQUIRED)                     # target: draco::draco
 find_package(OpenImageIO REQUIRED)               # target: OpenImageIO::OpenImageIO
