@@ -1,8 +1,11 @@
 #pragma once
 // `nave preprocess` as a library call: inputs (model files or a generator) -> a brick store, in
-// bounded memory. Phases: read/bin, split (partition/partitioner.h), encode (several threads,
-// store::EncodeBrick) and write (store::StoreWriter, atomic). See docs/preprocess.md.
+// bounded memory. A plan first (preprocess_plan.h: the budget, brick size and threads, or a
+// refusal), then the phases: read/bin, split (partition/partitioner.h), encode (several threads,
+// store::EncodeBrick) and write (store::StoreWriter, atomic). The library changes nothing in the
+// process (no signal handler, no limit): the caller does that. See docs/preprocess.md.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -40,6 +43,9 @@ struct PreprocessOptions {
     /// Convert the textures the materials name (texture_convert.h); false drops every texture slot.
     bool convert_textures = true;
     std::string tool_version = "nave";
+    /// Set by the caller (its SIGINT / SIGTERM handler) to a signal number to stop the run; null:
+    /// never stopped. Read only.
+    const std::atomic<int>* interrupt = nullptr;
 };
 
 struct PreprocessStats {
@@ -67,9 +73,10 @@ struct PreprocessStats {
 /// not cover (docs/preprocess.md).
 inline constexpr uint64_t kTextureConversionBytes = uint64_t(160) << 20;
 
-/// Runs the whole preprocess. Errors: bad input (with file and line), a budget too small (with the
-/// numbers and the option to change), I/O, Cancelled on SIGINT/SIGTERM. On any error nothing is
-/// left behind.
+/// Runs the whole preprocess: plans it (PlanPreprocess on this machine's resources), then reads,
+/// splits, encodes and writes. Errors: bad options or a budget too small (the plan's refusals),
+/// bad input (with file and line), I/O, Cancelled once `options.interrupt` holds a signal. On any
+/// error nothing is left behind.
 StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options);
 
 /// The end-of-run summary, several lines.

@@ -1,6 +1,5 @@
 #include "preprocess/partition/partitioner.h"
 
-#include <sys/resource.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -76,12 +75,12 @@ struct RouteTree {
 };
 
 // The pass of a split: every triangle of `reader` to each leaf cell of `tree` it overlaps (its
-// leaf's writer and sample), on `threads` threads. A pipeline of chunks: read (LZ4) in order,
-// routed on any thread, appended in order, so that each leaf receives its triangles in the bin's
-// order and the bins (and the store) do not depend on the thread count.
+// leaf's writer and sample), on `threads` threads, until `interrupt` holds a signal. A pipeline of
+// chunks: read (LZ4) in order, routed on any thread, appended in order, so that each leaf receives
+// its triangles in the bin's order and the bins (and the store) do not depend on the thread count.
 Status RoutePass(BinReader& reader, const RouteTree& tree, int threads,
                  std::vector<std::unique_ptr<BinWriter>>& writers, std::vector<Reservoir>& samples,
-                 ProgressBar& progress, const TempDir& temp) {
+                 ProgressBar& progress, const TempDir& temp, const std::atomic<int>* interrupt) {
     // A chunk of the bin and where its triangles go: (triangle, leaf) pairs in the chunk's order;
     // kUnsampled marks a triangle kept in a cell it touches only through rounding.
     struct Chunk {
@@ -107,7 +106,7 @@ Status RoutePass(BinReader& reader, const RouteTree& tree, int threads,
         }
         if (!chunk) chunk = std::make_unique<Chunk>();
         chunk->triangles.clear();
-        Status cancelled = CheckCancelled();
+        Status cancelled = CheckCancelled(interrupt);
         StatusOr<bool> more =
             cancelled.ok() ? reader.Read(chunk->triangles, kChunkTriangles) : cancelled;
         if (!more.ok() || !*more || !failure.ok()) {
@@ -177,16 +176,7 @@ Status RoutePass(BinReader& reader, const RouteTree& tree, int threads,
 
 }  // namespace
 
-int MaxSplitFanout(size_t split_buffer_bytes) {
-    rlimit files{};
-    if (getrlimit(RLIMIT_NOFILE, &files) != 0) return 64;
-    if (files.rlim_cur < files.rlim_max) {
-        rlimit raised = files;
-        raised.rlim_cur = files.rlim_max;
-        if (setrlimit(RLIMIT_NOFILE, &raised) == 0) files = raised;
-    }
-    const uint64_t open_files =
-        files.rlim_cur == RLIM_INFINITY ? uint64_t(1) << 20 : uint64_t(files.rlim_cur);
+int MaxSplitFanout(size_t split_buffer_bytes, uint64_t open_files) {
     const uint64_t by_files = open_files > 130 ? open_files - 128 : 2;
     const uint64_t by_memory = split_buffer_bytes / (2 * (size_t(16) << 10));
     return int(std::clamp<uint64_t>(std::min(by_files, by_memory), 2, 4096));
@@ -213,7 +203,7 @@ Status Partitioner::Bin(TriangleSource& source, ProgressBar& progress) {
     Reservoir sample(config_.root_sample, 1);
     std::vector<Triangle> batch;
     while (true) {
-        NAVE_RETURN_IF_ERROR(CheckCancelled());
+        NAVE_RETURN_IF_ERROR(CheckCancelled(config_.interrupt));
         NAVE_ASSIGN_OR_RETURN(bool more, source.Next(batch, 1 << 14));
         if (!more) break;
         for (const Triangle& t : batch) {
@@ -269,7 +259,7 @@ Status Partitioner::Split(const Bounds3f& root, double margin, ProgressBar& prog
 }
 
 Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
-    NAVE_RETURN_IF_ERROR(CheckCancelled());
+    NAVE_RETURN_IF_ERROR(CheckCancelled(config_.interrupt));
     const uint64_t leaf_max = config_.brick_triangles + config_.brick_triangles / 4;
     if (task.triangles <= leaf_max || task.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -365,8 +355,8 @@ Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
         tree.grown[i] = Grow(lleaves[i].cell, margin_);
     }
     NAVE_ASSIGN_OR_RETURN(auto reader, BinReader::Open(task.file));
-    NAVE_RETURN_IF_ERROR(
-        RoutePass(*reader, tree, config_.threads, writers, samples, *progress_, temp_));
+    NAVE_RETURN_IF_ERROR(RoutePass(*reader, tree, config_.threads, writers, samples, *progress_,
+                                   temp_, config_.interrupt));
     reader.reset();
     std::error_code ec;
     int64_t parent_bytes = int64_t(std::filesystem::file_size(task.file, ec));

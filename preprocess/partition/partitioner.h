@@ -43,12 +43,14 @@ struct PartitionConfig {
     /// Memory for the block buffers of one pass's child bins (two copies of a block each; a block
     /// is 16 KiB to block_bytes).
     size_t split_buffer_bytes = size_t(64) << 20;
+    /// Set by the caller (its signal handler) to a signal number to stop the work: Cancelled.
+    const std::atomic<int>* interrupt = nullptr;
 };
 
 /// The most leaves one split pass may cut a bin into (PartitionConfig::max_fanout): each is an open
-/// file with two block buffers of 16 KiB or more, within `split_buffer_bytes` and the process's
-/// open-file limit (raised to its hard limit here, less 128 files for the rest), from 2 to 4096.
-int MaxSplitFanout(size_t split_buffer_bytes);
+/// file with two block buffers of 16 KiB or more, within `split_buffer_bytes` and `open_files`
+/// (the process's open-file limit, less 128 files for the rest), from 2 to 4096.
+int MaxSplitFanout(size_t split_buffer_bytes, uint64_t open_files);
 
 /// A bin of triangles and the tree leaf it belongs to.
 struct LeafBin {

@@ -1,12 +1,7 @@
 #include "preprocess/partition/temp_dir.h"
 
-#include <signal.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <cerrno>
-#include <csignal>
-#include <cstdlib>
 #include <vector>
 
 #include "core/log.h"
@@ -14,15 +9,6 @@
 
 namespace nave::preprocess {
 namespace {
-
-std::atomic<int> g_signal{0};
-
-void OnSignal(int sig) {
-    if (g_signal.exchange(sig) != 0) {
-        // Second signal: stop now, with the conventional exit code.
-        _exit(128 + sig);
-    }
-}
 
 /// Says which leftovers of killed runs were removed: a user who finds space freed, or a file gone,
 /// learns why.
@@ -70,21 +56,8 @@ void RemoveStaleOutputTemporaries(const std::filesystem::path& output) {
     LogRemoved(RemoveStaleTemporaries(dir, output.filename().string() + ".tmp-"));
 }
 
-void InstallInterruptHandlers() {
-    static bool installed = false;
-    if (installed) return;
-    installed = true;
-    struct sigaction sa {};
-    sa.sa_handler = OnSignal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
-}
-
-bool Cancelled() { return g_signal.load(std::memory_order_relaxed) != 0; }
-
-Status CheckCancelled() {
-    int sig = g_signal.load(std::memory_order_relaxed);
+Status CheckCancelled(const std::atomic<int>* interrupt) {
+    const int sig = interrupt ? interrupt->load(std::memory_order_relaxed) : 0;
     if (sig == 0) return Status::Ok();
     return Status(StatusCode::kCancelled, "interrupted by signal " + std::to_string(sig) +
                                               ": output and temporary files removed");

@@ -1,10 +1,11 @@
 #pragma once
 // The temporary directory of one preprocess run, and interruption. The directory is removed when
-// the run ends, succeeds or fails. SIGINT and SIGTERM set a flag that the work loops poll
-// (Cancelled()), so the run unwinds normally and removes its files; a second signal ends the
-// process at once. Leftovers of a run that was killed outright (SIGKILL, power loss) are removed by
-// the next run in the same place: their names carry the dead process's id.
+// the run ends, succeeds or fails. The caller's signal handler stores the signal in a flag that the
+// work loops poll (CheckCancelled), so the run unwinds normally and removes its files. Leftovers
+// of a run that was killed outright (SIGKILL, power loss) are removed by the next run in the same
+// place: their names carry the dead process's id.
 
+#include <atomic>
 #include <filesystem>
 #include <string>
 
@@ -38,11 +39,8 @@ class TempDir {
 /// `output`.
 void RemoveStaleOutputTemporaries(const std::filesystem::path& output);
 
-/// Installs the SIGINT / SIGTERM handlers (idempotent).
-void InstallInterruptHandlers();
-/// True once SIGINT or SIGTERM arrived.
-bool Cancelled();
-/// A Cancelled status ("interrupted by signal N"), or Ok.
-Status CheckCancelled();
+/// A Cancelled status ("interrupted by signal N") once `interrupt` holds a signal number, or Ok
+/// (also when `interrupt` is null).
+Status CheckCancelled(const std::atomic<int>* interrupt);
 
 }  // namespace nave::preprocess

@@ -1,4 +1,11 @@
 // `nave preprocess`: model files (or the procedural abbey) -> a brick store, in bounded memory.
+// The library plans and runs; what touches the whole process is done here: the handlers of SIGINT
+// and SIGTERM and the open-file limit.
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdio>
 
 #include "cli/commands.h"
@@ -7,6 +14,36 @@
 #include "preprocess/preprocess.h"
 
 namespace nave::cli {
+namespace {
+
+// The signal that asked the run to stop, 0 until one does (PreprocessOptions::interrupt).
+std::atomic<int> g_preprocess_interrupt{0};
+static_assert(std::atomic<int>::is_always_lock_free, "set from a signal handler");
+
+void OnPreprocessSignal(int sig) {
+    // The first signal asks the run to unwind (removing its files); a second stops it now, with
+    // the conventional exit code.
+    if (g_preprocess_interrupt.exchange(sig) != 0) _exit(128 + sig);
+}
+
+void InstallPreprocessInterruptHandlers() {
+    struct sigaction sa {};
+    sa.sa_handler = OnPreprocessSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+// Each leaf of a split pass is an open file: the soft limit (often 1024) would cap the pass's
+// fan-out (preprocess::MaxSplitFanout) where the hard limit does not.
+void RaiseOpenFileLimit() {
+    rlimit files{};
+    if (getrlimit(RLIMIT_NOFILE, &files) != 0 || files.rlim_cur >= files.rlim_max) return;
+    files.rlim_cur = files.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &files);
+}
+
+}  // namespace
 
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand(
@@ -61,18 +98,11 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             preprocess::PreprocessOptions o;
             for (const auto& in : opt->inputs) o.inputs.emplace_back(in);
             o.generate = opt->generate;
-            if (o.inputs.empty() == o.generate.empty()) {
-                return InvalidArgumentError(
-                    "give either input files or --generate abbey[:detail=D], not {}",
-                    o.inputs.empty() ? "neither" : "both");
-            }
             o.output = opt->output;
             if (!opt->memory.empty()) {
                 NAVE_ASSIGN_OR_RETURN(o.memory_bytes, ParseByteSize(opt->memory));
             }
             o.brick_triangles = opt->brick_triangles;
-            if (opt->precision < 0)
-                return InvalidArgumentError("--precision {}: must be positive", opt->precision);
             o.precision = opt->precision;
             o.threads = opt->threads;
             o.temp_dir = opt->temp_dir;
@@ -81,6 +111,9 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             o.verify_every = opt->verify_every;
             o.convert_textures = !opt->no_textures;
             o.tool_version = std::string("nave ") + NAVE_VERSION;
+            o.interrupt = &g_preprocess_interrupt;
+            InstallPreprocessInterruptHandlers();
+            RaiseOpenFileLimit();
             NAVE_ASSIGN_OR_RETURN(auto stats, preprocess::RunPreprocess(o));
             log::Info("wrote {}\n{}", o.output.string(), preprocess::FormatSummary(stats));
             return Status::Ok();

@@ -447,9 +447,12 @@ TEST(SplitPass, LeavesDoNotDependOnTheThreadCount) {
 }
 
 TEST(SplitPass, FanOutFollowsTheBuffersAndTheOpenFileLimit) {
-    EXPECT_EQ(MaxSplitFanout(size_t(1) << 40), 4096) << "at most 4096 leaves a pass";
-    EXPECT_EQ(MaxSplitFanout(size_t(64) * 2 * (16 << 10)), 64) << "two 16 KiB blocks a leaf";
-    EXPECT_EQ(MaxSplitFanout(0), 2);
+    const uint64_t files = 1 << 20;
+    EXPECT_EQ(MaxSplitFanout(size_t(1) << 40, files), 4096) << "at most 4096 leaves a pass";
+    EXPECT_EQ(MaxSplitFanout(size_t(64) * 2 * (16 << 10), files), 64) << "two 16 KiB blocks a leaf";
+    EXPECT_EQ(MaxSplitFanout(0, files), 2);
+    EXPECT_EQ(MaxSplitFanout(size_t(1) << 40, 1024), 896) << "128 files kept for the rest";
+    EXPECT_EQ(MaxSplitFanout(size_t(1) << 40, 100), 2);
 }
 
 }  // namespace
