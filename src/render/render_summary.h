@@ -31,6 +31,7 @@ struct RenderFact {
         kRatio,      ///< `real`, dimensionless; NaN: not known
     };
     /// Where the metadata holds it (kStatisticsAttribute, kTexturesAttribute), or kTerminalOnly.
+    /// Both views are of string literals.
     std::string_view attribute;
     /// Its key in that attribute; unique within it.
     std::string_view key;
