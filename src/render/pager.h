@@ -35,8 +35,8 @@ inline constexpr uint64_t kUnlimitedBrickBudget = ~uint64_t(0);
 /// Tunables of the pager; docs/pager.md has the measurements behind the defaults.
 struct PagerOptions {
     /// Bytes the resident bricks may take (sum of ResidentBrick::memory_bytes, plus the estimate of
-    /// a brick being loaded). The caller computes it from the user's --memory, minus what it
-    /// reserves for the rest. kUnlimitedBrickBudget: in-core.
+    /// a brick being loaded). `nave render --memory` gets it from RenderMemoryPlan (memory_plan.h):
+    /// the budget minus what it reserves for the rest. kUnlimitedBrickBudget: in-core.
     uint64_t brick_budget_bytes = kUnlimitedBrickBudget;
     bool in_core() const { return brick_budget_bytes == kUnlimitedBrickBudget; }
     /// How loaded bricks build their BVH (applied to the brick source before anything loads).
