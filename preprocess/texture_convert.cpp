@@ -122,9 +122,9 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
                             made.message(), result.first_user));
             continue;
         }
-        // Named after what it was made from, not after its own bytes (OpenImageIO writes the time
-        // of conversion into them): preprocessing the same model into the same place again
-        // replaces each converted texture instead of adding another.
+        // Named after what it was made from (its bytes are a function of those): preprocessing the
+        // same model into the same place again replaces each converted texture, with the same
+        // bytes, instead of adding another; the name is known before the conversion's bytes.
         NAVE_ASSIGN_OR_RETURN(uint64_t source_checksum, SourceChecksum(source, colour));
         std::error_code size_ec;
         const uint64_t bytes_written = std::filesystem::file_size(temp, size_ec);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <system_error>
 
@@ -67,6 +68,13 @@ Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
 Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image, int tile_size,
                      const ImageMetadata& metadata) {
     ImageWriteRequest request = FloatRequest(image, metadata);
+    // OIIO's OpenEXR writer stamps the current time as DateTime when given none. A texture is a
+    // function of its pixels and metadata (writing the same one twice gives the same bytes, and the
+    // texture converted from it is named after those bytes), so it gets an empty DateTime, which
+    // OIIO reads back as none, unless the caller names one.
+    const bool dated = std::any_of(metadata.begin(), metadata.end(),
+                                   [](const auto& entry) { return entry.first == "DateTime"; });
+    if (!dated) request.metadata.emplace_back("DateTime", "");
     request.stored.assign(image.channels.size(), StoredPixel::kHalf);
     request.tile_size = tile_size;
     return WriteAtomically(path, request);

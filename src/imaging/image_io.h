@@ -35,7 +35,9 @@ std::string BandChannelName(int b);
 /// metadata.
 Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
                 const ImageMetadata& metadata);
-/// Writes a tiled (tile_size x tile_size), half-float OpenEXR file, as textures are read best.
+/// Writes a tiled (tile_size x tile_size), half-float OpenEXR file, as textures are read best. The
+/// bytes depend only on the image and the metadata: no time of writing (the DateTime is empty
+/// unless `metadata` has one).
 Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image, int tile_size,
                      const ImageMetadata& metadata);
 /// Writes an 8-bit RGB image (PNG or anything OIIO knows by extension); `rgb` is width * height * 3

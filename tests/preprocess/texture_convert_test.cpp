@@ -77,8 +77,10 @@ TEST_F(TextureConvertTest, ConvertsToTiledMipmappedChecksummedFiles) {
     std::filesystem::path file = store.parent_path() / colour;
     EXPECT_NE(materials[0].textures["map_d"].find("stone.data."), std::string::npos);
     // Named after the source and the conversion: preprocessing again into the same place gives the
-    // same names and replaces the two files instead of adding two more, also when the source was
-    // written again since (OpenImageIO puts its modification time in the converted file).
+    // same names and replaces the two files, with the same bytes, instead of adding two more, also
+    // when the source was written again since (a later modification time).
+    StatusOr<std::string> first_bytes = ReadFileToString(file);
+    ASSERT_TRUE(first_bytes.ok()) << first_bytes.status().ToString();
     const auto tga = dir_ / "model" / "stone.tga";
     std::filesystem::last_write_time(
         tga, std::filesystem::last_write_time(tga) + std::chrono::seconds(10));
@@ -89,6 +91,9 @@ TEST_F(TextureConvertTest, ConvertsToTiledMipmappedChecksummedFiles) {
     ASSERT_TRUE(ConvertTextures(&again, {dir_ / "model"}, store).ok());
     EXPECT_EQ(again[0].textures["map_Kd"], colour);
     EXPECT_EQ(again[0].textures["map_d"], materials[0].textures["map_d"]);
+    StatusOr<std::string> again_bytes = ReadFileToString(file);
+    ASSERT_TRUE(again_bytes.ok()) << again_bytes.status().ToString();
+    EXPECT_TRUE(*again_bytes == *first_bytes) << file << " changed";
     size_t files = 0;
     for (const auto& e : std::filesystem::directory_iterator(file.parent_path())) {
         ++files;

@@ -6,7 +6,6 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
-#include <chrono>
 #include <system_error>
 
 #include "imaging/image_io.h"
@@ -99,6 +98,12 @@ class Plugin final : public OiioPlugin {
             Status st = OiioError(source, "unreadable", in.geterror());
             return InvalidArgumentError("{}", st.message());
         }
+        // make_texture stamps the output with the current time unless given a DateTime. The
+        // converted file is a function of the source's bytes (its name carries their checksum), so
+        // it carries the DateTime written in the source, or an empty one (read back as none): not
+        // the time of conversion, nor the source's modification time, which changes when the same
+        // bytes are written again (as the abbey's generated textures are on every run).
+        const std::string source_date = in.spec().get_string_attribute("DateTime");
         const bool colour = content == TextureContent::kColour;
         if (colour) {
             // Colour textures are sRGB-encoded (IEC 61966-2-1); the renderer filters and lifts
@@ -112,17 +117,6 @@ class Plugin final : public OiioPlugin {
             }
             in = std::move(linear);
         }
-        // make_texture stamps the output with the current time unless the image has a DateTime:
-        // stamp the source's own modification time, so that converting the same file twice gives
-        // the same bytes (the converted file's name carries its checksum).
-        std::string stamp = "unknown";
-        const auto mtime = std::filesystem::last_write_time(source, ec);
-        if (!ec) {
-            const auto sys = std::chrono::file_clock::to_sys(mtime);
-            stamp = fmt::format(
-                "source modified {} s after 1970",
-                std::chrono::duration_cast<std::chrono::seconds>(sys.time_since_epoch()).count());
-        }
         OIIO::ImageSpec config;
         // Colour: half floats (OpenEXR; OIIO's TIFF writer would store half as float); data: the
         // source's pixel type. Both tiled and MIP-mapped by make_texture.
@@ -130,7 +124,10 @@ class Plugin final : public OiioPlugin {
         config.tile_width = config.tile_height = 64;
         config.attribute("wrapmodes", "periodic,periodic");
         config.attribute("compression", "zip");
-        config.attribute("DateTime", stamp);
+        config.attribute("DateTime", source_date);
+        // Its average colour is a sum that OIIO reduces over threads in the order they finish,
+        // which can change its last digits from run to run; nave does not read it.
+        config.attribute("maketx:compute_average", 0);
         if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in,
                                               output.string(), config))
             return IoError("{}: cannot write the texture converted from {}: {}", output.string(),
