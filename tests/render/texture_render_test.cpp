@@ -16,6 +16,7 @@
 #include "imaging/texture_cache.h"
 #include "render/brick_source.h"
 #include "render/film.h"
+#include "render/grid_bricks.h"
 #include "render/integrator.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
