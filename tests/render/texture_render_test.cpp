@@ -62,7 +62,7 @@ class TextureRenderTest : public ::testing::Test {
         std::vector<float> px(12);
         for (int i = 0; i < 4; ++i)
             for (int c = 0; c < 3; ++c)
-                px[size_t(i * 3 + c)] = (i == 0 || i == 3) ? red[c] : blue[c];
+                px[size_t(i) * 3 + size_t(c)] = (i == 0 || i == 3) ? red[c] : blue[c];
         WriteImage(dir_ / "checker.exr", 2, 2, 3, px);
         // 2 x 1 grey mask: left half cut out (0), right half kept (1).
         WriteImage(dir_ / "mask.exr", 2, 1, 1, {0.f, 1.f});
