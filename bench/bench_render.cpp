@@ -8,6 +8,7 @@
 #include "core/progress.h"
 #include "render/brick_source.h"
 #include "render/film.h"
+#include "render/grid_bricks.h"
 #include "render/integrator.h"
 #include "render/procedural_meshes.h"
 #include "render/scene.h"

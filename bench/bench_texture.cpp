@@ -130,6 +130,7 @@ void BM_UpliftLookup(benchmark::State& state) {
     std::mt19937 rng(4);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     std::vector<Vec3f> colours;
+    colours.reserve(4096);
     for (int i = 0; i < 4096; ++i) colours.emplace_back(u(rng), u(rng), u(rng));
     SampledWavelengths lambda = SampledWavelengths::SampleVisible(0.3f);
     size_t i = 0;

@@ -285,15 +285,6 @@ class MemoryBrickSource final : public BrickSource {
     std::vector<store::BrickMesh> meshes_;
 };
 
-/// Cuts `mesh` into an nx * ny * nz grid of bricks over its bounds (slightly enlarged), as
-/// preprocess does: every triangle goes to every cell its box overlaps. For tests and benchmarks
-/// that compare brick counts.
-struct GridBricks {
-    store::BrickTree tree;
-    std::vector<store::BrickMesh> meshes;
-};
-GridBricks SplitIntoGridBricks(const store::BrickMesh& mesh, int nx, int ny, int nz);
-
 /// The process's Embree device. Embree errors reported through its callback are kept and turned
 /// into a Status by the call that caused them.
 class EmbreeDevice {

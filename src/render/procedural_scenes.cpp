@@ -1,5 +1,6 @@
 #include "render/procedural_scenes.h"
 
+#include "render/grid_bricks.h"
 #include "render/procedural_meshes.h"
 
 namespace nave::render {

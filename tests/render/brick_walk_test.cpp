@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "render/brick_source.h"
+#include "render/grid_bricks.h"
 #include "render/procedural_meshes.h"
 #include "render/rng.h"
 

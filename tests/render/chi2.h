@@ -91,7 +91,7 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
         if (phi < 0) phi += 2 * M_PI;
         int ti = std::clamp(int(theta / M_PI * theta_res), 0, theta_res - 1);
         int pi = std::clamp(int(phi / (2 * M_PI) * phi_res), 0, phi_res - 1);
-        observed[size_t(ti * phi_res + pi)] += 1;
+        observed[size_t(ti) * size_t(phi_res) + size_t(pi)] += 1;
     }
     // Integrate the pdf over each cell (midpoint rule on a fine sub-grid), in solid angle sinθ dθ
     // dφ.
@@ -107,7 +107,8 @@ inline Chi2Result Chi2Test(const std::function<std::optional<Vec3f>(float, float
                             float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
                     sum += pdf(w) * std::sin(theta);
                 }
-            expected[size_t(ti * phi_res + pi)] = sum * (dt / sub) * (dp / sub) * num_samples;
+            expected[size_t(ti) * size_t(phi_res) + size_t(pi)] =
+                sum * (dt / sub) * (dp / sub) * num_samples;
         }
     // Pool cells with small expected counts (Pearson's test needs >= 5 per cell).
     std::vector<size_t> order(observed.size());

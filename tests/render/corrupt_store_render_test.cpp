@@ -16,11 +16,7 @@
 #include "core/file.h"
 #include "core/log.h"
 #include "core/progress.h"
-#include "render/brick_source.h"
-#include "render/film.h"
-#include "render/integrator.h"
-#include "render/scene.h"
-#include "render/scene_config.h"
+#include "render_test_util.h"
 #include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/testing/store_testing.h"
@@ -90,12 +86,11 @@ class CorruptStoreRender : public ::testing::Test {
     // Renders the store at `path` as `nave render` does; the image's pixels, or the first error.
     static StatusOr<std::vector<Vec3d>> RenderStore(const std::filesystem::path& path) {
         NAVE_ASSIGN_OR_RETURN(auto source, StoreBrickSource::Open(path, *device_));
-        NAVE_ASSIGN_OR_RETURN(RenderScene scene, BuildRenderScene(*config_, *source));
-        Film film(config_->camera.width, config_->camera.height, scene.output);
-        RenderStats stats;
-        NAVE_RETURN_IF_ERROR(RenderStreams(scene, &film, &stats));
-        std::vector<Vec3d> pixels(film.pixel_count());
-        for (size_t p = 0; p < pixels.size(); ++p) pixels[p] = film.PixelXYZ(uint32_t(p));
+        NAVE_ASSIGN_OR_RETURN(auto scene, testing::BuildTestScene(std::move(source), *config_));
+        const testing::RenderResult r = scene->Run();
+        NAVE_RETURN_IF_ERROR(r.status);
+        std::vector<Vec3d> pixels(r.film->pixel_count());
+        for (size_t p = 0; p < pixels.size(); ++p) pixels[p] = r.film->PixelXYZ(uint32_t(p));
         return pixels;
     }
 

@@ -19,13 +19,17 @@
 #include "render/ray.h"
 #include "render_test_util.h"
 #include "store/store_reader.h"
-#include "store/store_writer.h"
 
 namespace nave::render {
 namespace {
 
+using testing::BuildAndRender;
+using testing::BuildTestScene;
 using testing::MaxRelativeDifference;
 using testing::MeanY;
+using testing::RenderResult;
+using testing::RunOptions;
+using testing::TestRender;
 
 class PagerTest : public ::testing::Test {
   protected:
@@ -67,40 +71,28 @@ seed = 5
 )";
 
 /// A fresh source over the ball grid (fresh so that its own peak counter covers this render only).
-std::unique_ptr<MemoryBrickSource> BallGridSource() {
-    auto device = EmbreeDevice::Create();
-    EXPECT_TRUE(device.ok());
-    GridBricks grid = SplitIntoGridBricks(BallGrid(), 4, 4, 2);
-    std::vector<store::MaterialRecord> materials;
-    for (const auto& name : kNames) {
-        store::MaterialRecord r;
-        r.name = name;
-        materials.push_back(r);
-    }
-    return std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
+std::unique_ptr<BrickSource> BallGridSource() {
+    return testing::GridSource(BallGrid(), testing::NamedMaterials(kNames), {4, 4, 2});
 }
 
-struct Rendered {
-    std::unique_ptr<MemoryBrickSource> source;
-    std::unique_ptr<Film> film;
-    RenderStats stats;
-    Status status;
-};
-
-Rendered RenderBallGrid(const std::string& mode, const PagerOptions* paging, int threads = 2,
-                        uint32_t wave_paths = 0, int spp = 0) {
-    Rendered r;
-    r.source = BallGridSource();
+/// The ball grid's config in `mode` (path or photon).
+SceneConfig BallGridConfig(const std::string& mode) {
     auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), mode), "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
-    config->render.threads = threads;
-    if (wave_paths > 0) config->render.wave_paths = wave_paths;
-    if (spp > 0) config->render.spp = spp;
-    auto scene = BuildRenderScene(*config, *r.source);
-    EXPECT_TRUE(scene.ok()) << scene.status().ToString();
-    r.film = std::make_unique<Film>(config->camera.width, config->camera.height, config->output);
-    r.status = RenderStreams(*scene, r.film.get(), &r.stats, {}, paging);
-    return r;
+    return config.ok() ? *config : SceneConfig();
+}
+
+/// The ball grid rendered on a fresh source; the render's Status is kept, not expected. Null if
+/// the scene could not be built (the test has failed then).
+std::unique_ptr<TestRender> RenderBallGrid(const std::string& mode, const PagerOptions* paging,
+                                           int threads = 2, uint32_t wave_paths = 0, int spp = 0) {
+    SceneConfig config = BallGridConfig(mode);
+    config.render.threads = threads;
+    if (wave_paths > 0) config.render.wave_paths = wave_paths;
+    if (spp > 0) config.render.spp = spp;
+    RunOptions run;
+    run.paging = paging;
+    return BuildAndRender(BallGridSource(), std::move(config), run);
 }
 
 /// A budget of about 15 % of the in-core size, or the minimum if that is more.
@@ -114,46 +106,48 @@ PagerOptions SmallBudget(const BrickSource& source, bool prefetch = true) {
 }
 
 void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
-    Rendered in_core = RenderBallGrid(mode, nullptr);
-    ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
-    const BrickBudgetMinimum m = MinimumBrickBudget(*in_core.source, true);
-    EXPECT_GE(in_core.source->brick_count(), 30u);
+    const auto in_core = RenderBallGrid(mode, nullptr);
+    ASSERT_TRUE(in_core != nullptr);
+    ASSERT_TRUE(in_core->status.ok()) << in_core->status.ToString();
+    const BrickBudgetMinimum m = MinimumBrickBudget(*in_core->source, true);
+    EXPECT_GE(in_core->source->brick_count(), 30u);
     // Prefetching on and off; then small waves (the in-core render has one), which under paging
     // overlap; then without the brick cache (every reload decodes the brick again); then with
     // queues spilled to disk beyond 64 KiB.
     for (int variant = 0; variant < 5; ++variant) {
         const bool prefetch = variant != 1;
         const uint32_t wave_paths = variant == 2 ? 500 : 0;
-        PagerOptions options = SmallBudget(*in_core.source, prefetch);
+        PagerOptions options = SmallBudget(*in_core->source, prefetch);
         options.brick_cache = variant != 3;
         if (variant == 4) options.queue_memory_bytes = 64 << 10;
         EXPECT_LE(options.brick_budget_bytes, m.total_bytes / 4)
             << "the test scene should allow a small budget";
-        Rendered paged = RenderBallGrid(mode, &options, 2, wave_paths);
-        ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
-        EXPECT_GT(MeanY(*paged.film), 0.0);
+        const auto paged = RenderBallGrid(mode, &options, 2, wave_paths);
+        ASSERT_TRUE(paged != nullptr);
+        ASSERT_TRUE(paged->status.ok()) << paged->status.ToString();
+        EXPECT_GT(MeanY(*paged->film), 0.0);
         // Same bounds as the brick-count and brick-order tests (render_test.cpp): path mode differs
         // only by double summation order; photon deposits add floats atomically.
-        EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), bound)
+        EXPECT_LT(MaxRelativeDifference(*in_core->film, *paged->film), bound)
             << mode << " variant " << variant;
         // The budget holds, by the pager's count and by the source's own.
-        EXPECT_LE(paged.stats.residency.peak_resident_bytes, options.brick_budget_bytes);
-        EXPECT_LE(paged.source->stats().peak_resident_bytes, options.brick_budget_bytes);
-        EXPECT_GT(paged.stats.residency.evictions, 0u);
-        EXPECT_GT(paged.stats.residency.reloads, 0u);
-        EXPECT_GT(paged.stats.residency.loads, in_core.stats.residency.loads);
-        EXPECT_EQ(paged.stats.residency.prefetch_loads > 0, prefetch);
-        EXPECT_EQ(paged.stats.residency.brick_budget_bytes, options.brick_budget_bytes);
-        EXPECT_EQ(paged.stats.spilled_rays > 0, variant == 4) << variant;
+        EXPECT_LE(paged->stats.residency.peak_resident_bytes, options.brick_budget_bytes);
+        EXPECT_LE(paged->source->stats().peak_resident_bytes, options.brick_budget_bytes);
+        EXPECT_GT(paged->stats.residency.evictions, 0u);
+        EXPECT_GT(paged->stats.residency.reloads, 0u);
+        EXPECT_GT(paged->stats.residency.loads, in_core->stats.residency.loads);
+        EXPECT_EQ(paged->stats.residency.prefetch_loads > 0, prefetch);
+        EXPECT_EQ(paged->stats.residency.brick_budget_bytes, options.brick_budget_bytes);
+        EXPECT_EQ(paged->stats.spilled_rays > 0, variant == 4) << variant;
         // With the cache, every brick is decoded once and every reload read back from it.
         if (options.brick_cache) {
-            EXPECT_EQ(paged.stats.cache_reads, paged.stats.residency.reloads) << variant;
-            EXPECT_EQ(paged.stats.cache_bricks_written + paged.stats.residency.reloads,
-                      paged.stats.residency.loads)
+            EXPECT_EQ(paged->stats.cache_reads, paged->stats.residency.reloads) << variant;
+            EXPECT_EQ(paged->stats.cache_bricks_written + paged->stats.residency.reloads,
+                      paged->stats.residency.loads)
                 << variant;
         } else {
-            EXPECT_EQ(paged.stats.cache_reads, 0u);
-            EXPECT_EQ(paged.stats.cache_bricks_written, 0u);
+            EXPECT_EQ(paged->stats.cache_reads, 0u);
+            EXPECT_EQ(paged->stats.cache_bricks_written, 0u);
         }
     }
 }
@@ -161,19 +155,21 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
 TEST_F(PagerTest, AWaveLargerThanTheQueueMemorySpillsAsItIsGenerated) {
     // 32x24 pixels at 64 spp in one wave: 49 152 camera paths, 5.3 MiB of records, where the queues
     // may hold 64 KiB and what the reserve allows beyond (RenderReserveBytes).
-    Rendered in_core = RenderBallGrid("path", nullptr, 2, 1 << 20, 64);
-    ASSERT_TRUE(in_core.status.ok()) << in_core.status.ToString();
-    PagerOptions options = SmallBudget(*in_core.source);
+    const auto in_core = RenderBallGrid("path", nullptr, 2, 1 << 20, 64);
+    ASSERT_TRUE(in_core != nullptr);
+    ASSERT_TRUE(in_core->status.ok()) << in_core->status.ToString();
+    PagerOptions options = SmallBudget(*in_core->source);
     options.queue_memory_bytes = 64 << 10;
-    Rendered paged = RenderBallGrid("path", &options, 2, 1 << 20, 64);
-    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
+    const auto paged = RenderBallGrid("path", &options, 2, 1 << 20, 64);
+    ASSERT_TRUE(paged != nullptr);
+    ASSERT_TRUE(paged->status.ok()) << paged->status.ToString();
     const uint64_t bound = options.queue_memory_bytes +
                            3 * MaxBatchRays(options.queue_memory_bytes) * sizeof(RayRecord);
-    ASSERT_GT(paged.stats.camera_paths * sizeof(RayRecord), 2 * bound)
+    ASSERT_GT(paged->stats.camera_paths * sizeof(RayRecord), 2 * bound)
         << "the wave should exceed the bound";
-    EXPECT_LE(paged.stats.peak_queue_bytes, bound);
-    EXPECT_GT(paged.stats.spilled_rays, paged.stats.camera_paths / 2);
-    EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
+    EXPECT_LE(paged->stats.peak_queue_bytes, bound);
+    EXPECT_GT(paged->stats.spilled_rays, paged->stats.camera_paths / 2);
+    EXPECT_LT(MaxRelativeDifference(*in_core->film, *paged->film), 1e-9);
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
@@ -181,16 +177,18 @@ TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path",
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-4); }
 
 TEST_F(PagerTest, InCoreBudgetLoadsEveryBrickOnceAndEvictsNothing) {
-    Rendered in_core = RenderBallGrid("path", nullptr);
-    ASSERT_TRUE(in_core.status.ok());
+    const auto in_core = RenderBallGrid("path", nullptr);
+    ASSERT_TRUE(in_core != nullptr);
+    ASSERT_TRUE(in_core->status.ok());
     PagerOptions options;
-    options.brick_budget_bytes = MinimumBrickBudget(*in_core.source, true).total_bytes;
-    Rendered paged = RenderBallGrid("path", &options);
-    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
-    EXPECT_EQ(paged.stats.residency.evictions, 0u);
-    EXPECT_EQ(paged.stats.residency.reloads, 0u);
-    EXPECT_EQ(paged.stats.residency.loads, in_core.stats.residency.loads);
-    EXPECT_LT(MaxRelativeDifference(*in_core.film, *paged.film), 1e-9);
+    options.brick_budget_bytes = MinimumBrickBudget(*in_core->source, true).total_bytes;
+    const auto paged = RenderBallGrid("path", &options);
+    ASSERT_TRUE(paged != nullptr);
+    ASSERT_TRUE(paged->status.ok()) << paged->status.ToString();
+    EXPECT_EQ(paged->stats.residency.evictions, 0u);
+    EXPECT_EQ(paged->stats.residency.reloads, 0u);
+    EXPECT_EQ(paged->stats.residency.loads, in_core->stats.residency.loads);
+    EXPECT_LT(MaxRelativeDifference(*in_core->film, *paged->film), 1e-9);
 }
 
 TEST_F(PagerTest, FreePagesGoBackAtBatchEndsNearTheProcessLimitAlsoWithoutLoads) {
@@ -198,34 +196,35 @@ TEST_F(PagerTest, FreePagesGoBackAtBatchEndsNearTheProcessLimitAlsoWithoutLoads)
     // every check return pages: more returns than loads means batch ends check too.
     PagerOptions options;
     options.process_memory_bytes = 1;
-    Rendered paged = RenderBallGrid("path", &options);
-    ASSERT_TRUE(paged.status.ok()) << paged.status.ToString();
-    EXPECT_EQ(paged.stats.residency.evictions, 0u);
-    EXPECT_GT(paged.stats.residency.memory_returns, paged.stats.residency.loads);
+    const auto paged = RenderBallGrid("path", &options);
+    ASSERT_TRUE(paged != nullptr);
+    ASSERT_TRUE(paged->status.ok()) << paged->status.ToString();
+    EXPECT_EQ(paged->stats.residency.evictions, 0u);
+    EXPECT_GT(paged->stats.residency.memory_returns, paged->stats.residency.loads);
 }
 
 TEST_F(PagerTest, CustomPickerWithPagingRendersTheSameImage) {
     // Emptiest brick first: the worst order for paging, still the same image within budget.
-    Rendered in_core = RenderBallGrid("path", nullptr);
-    ASSERT_TRUE(in_core.status.ok());
-    auto source = BallGridSource();
-    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), "path"), "balls.toml");
-    ASSERT_TRUE(config.ok());
-    auto scene = BuildRenderScene(*config, *source);
-    ASSERT_TRUE(scene.ok());
-    Film film(config->camera.width, config->camera.height, config->output);
-    RenderStats stats;
-    PagerOptions options = SmallBudget(*source);
-    BrickPicker emptiest = [](const std::vector<size_t>& waiting, const BrickSource&) {
+    const auto in_core = RenderBallGrid("path", nullptr);
+    ASSERT_TRUE(in_core != nullptr);
+    ASSERT_TRUE(in_core->status.ok());
+    auto scene = BuildTestScene(BallGridSource(), BallGridConfig("path"));
+    ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+    const BrickSource& source = *(*scene)->source;
+    PagerOptions options = SmallBudget(source);
+    RunOptions run;
+    run.paging = &options;
+    run.picker = [](const std::vector<size_t>& waiting, const BrickSource&) {
         uint32_t best = store::kNoBrick;
         for (uint32_t b = 0; b < waiting.size(); ++b) {
             if (waiting[b] > 0 && (best == store::kNoBrick || waiting[b] < waiting[best])) best = b;
         }
         return best;
     };
-    ASSERT_TRUE(RenderStreams(*scene, &film, &stats, emptiest, &options).ok());
-    EXPECT_LT(MaxRelativeDifference(*in_core.film, film), 1e-9);
-    EXPECT_LE(source->stats().peak_resident_bytes, options.brick_budget_bytes);
+    const RenderResult paged = (*scene)->Run(run);
+    ASSERT_TRUE(paged.status.ok());
+    EXPECT_LT(MaxRelativeDifference(*in_core->film, *paged.film), 1e-9);
+    EXPECT_LE(source.stats().peak_resident_bytes, options.brick_budget_bytes);
 }
 
 TEST_F(PagerTest, ImpossibleBudgetNamesTheLargestBrickAndTheMinimum) {
@@ -257,10 +256,11 @@ TEST_F(PagerTest, ImpossibleBudgetNamesTheLargestBrickAndTheMinimum) {
     EXPECT_TRUE(Pager::Create(*source, options, {}).ok());
     // RenderStreams refuses it before tracing anything.
     options.prefetch = true;
-    Rendered r = RenderBallGrid("path", &options);
-    EXPECT_FALSE(r.status.ok());
-    EXPECT_EQ(r.stats.rays, 0u);
-    EXPECT_EQ(r.source->stats().loads, 0u);
+    const auto r = RenderBallGrid("path", &options);
+    ASSERT_TRUE(r != nullptr);
+    EXPECT_FALSE(r->status.ok());
+    EXPECT_EQ(r->stats.rays, 0u);
+    EXPECT_EQ(r->source->stats().loads, 0u);
 }
 
 TEST_F(PagerTest, EstimatesMatchTheRealSizes) {
@@ -372,31 +372,6 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
 // ----------------------------------------------------------------------------------------------
 // store
 
-/// Writes `mesh` as a store cut into nx * ny * nz bricks.
-Status WriteStore(const std::filesystem::path& path, const store::BrickMesh& mesh, int nx, int ny,
-                  int nz) {
-    GridBricks grid = SplitIntoGridBricks(mesh, nx, ny, nz);
-    store::GlobalGrid g;
-    g.origin = Vec3d(-10, -10, -10);
-    g.step = 1e-4;
-    NAVE_ASSIGN_OR_RETURN(auto writer,
-                          store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
-    std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
-    for (size_t b = 0; b < grid.meshes.size(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e,
-                              store::EncodeBrick(grid.meshes[b], cells[b], g, {}));
-        NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(e));
-        NAVE_CHECK_EQ(id, uint32_t(b));
-    }
-    std::vector<store::MaterialRecord> materials;
-    for (const auto& name : kNames) {
-        store::MaterialRecord r;
-        r.name = name;
-        materials.push_back(r);
-    }
-    return writer->Finish(materials, grid.tree, mesh.TriangleCount());
-}
-
 class PagerStoreTest : public PagerTest {
   protected:
     void SetUp() override {
@@ -404,7 +379,7 @@ class PagerStoreTest : public PagerTest {
         dir_ = std::filesystem::temp_directory_path() / fmt::format("nave_pager_test_{}", getpid());
         std::filesystem::create_directories(dir_);
         path_ = dir_ / "balls.nave";
-        Status s = WriteStore(path_, BallGrid(), 4, 4, 2);
+        Status s = testing::WriteGridBricksStore(path_, BallGrid(), kNames, {4, 4, 2});
         ASSERT_TRUE(s.ok()) << s.ToString();
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -450,14 +425,12 @@ TEST_F(PagerStoreTest, CorruptBrickMetWhilePagingNamesIt) {
     ASSERT_TRUE(device.ok());
     auto source = StoreBrickSource::Open(path_, *device);
     ASSERT_TRUE(source.ok()) << source.status().ToString();
-    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), "path"), "balls.toml");
-    ASSERT_TRUE(config.ok());
-    auto scene = BuildRenderScene(*config, **source);
-    ASSERT_TRUE(scene.ok());
-    Film film(config->camera.width, config->camera.height, config->output);
-    RenderStats stats;
     PagerOptions options = SmallBudget(**source);
-    Status s = RenderStreams(*scene, &film, &stats, {}, &options);
+    auto scene = BuildTestScene(std::move(*source), BallGridConfig("path"));
+    ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+    RunOptions run;
+    run.paging = &options;
+    const Status s = (*scene)->Run(run).status;
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.message().find(fmt::format("brick {}", victim)), std::string::npos) << s.message();
     EXPECT_NE(s.message().find("balls.nave"), std::string::npos) << s.message();
@@ -550,7 +523,7 @@ TEST(PagerCliTest, WholeProcessPeakStaysWithinTheBudget) {
         }
     }
     const auto store_path = dir / "dense.nave";
-    ASSERT_TRUE(WriteStore(store_path, mesh, 6, 6, 2).ok());
+    ASSERT_TRUE(testing::WriteGridBricksStore(store_path, mesh, kNames, {6, 6, 2}).ok());
     const auto config = dir / "dense.toml";
     {
         std::ofstream f(config);

@@ -2,6 +2,9 @@
 // thread-count independence.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "core/color.h"
 #include "core/progress.h"
@@ -448,9 +451,8 @@ TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
     auto fullest = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
     ASSERT_TRUE(fullest);
     for (int policy = 0; policy < 2; ++policy) {
-        Film film(fullest->film->width(), fullest->film->height(), fullest->config.output);
-        RenderStats stats;
-        BrickPicker picker = [policy](const std::vector<size_t>& waiting, const BrickSource&) {
+        testing::RunOptions run;
+        run.picker = [policy](const std::vector<size_t>& waiting, const BrickSource&) {
             uint32_t best = store::kNoBrick;
             for (uint32_t b = 0; b < waiting.size(); ++b) {
                 if (waiting[b] == 0) continue;
@@ -459,9 +461,10 @@ TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
             }
             return best;
         };
-        ASSERT_TRUE(RenderStreams(fullest->scene, &film, &stats, picker).ok());
-        EXPECT_GT(stats.batches, fullest->stats.batches / 2);
-        EXPECT_LT(MaxRelativeDifference(*fullest->film, film), 1e-9) << "policy " << policy;
+        const testing::RenderResult r = fullest->Run(run);
+        ASSERT_TRUE(r.status.ok());
+        EXPECT_GT(r.stats.batches, fullest->stats.batches / 2);
+        EXPECT_LT(MaxRelativeDifference(*fullest->film, *r.film), 1e-9) << "policy " << policy;
     }
 }
 
@@ -477,56 +480,17 @@ TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePhoton) {
 }
 
 TEST_F(RenderTest, MissingMaterialMappingNamesIt) {
-    auto device = EmbreeDevice::Create();
-    ASSERT_TRUE(device.ok());
-    GridBricks grid = SplitIntoGridBricks(FurnaceMesh(), 1, 1, 1);
-    store::MaterialRecord rec;
-    rec.name = "glass_blue";
-    MemoryBrickSource source(*device, grid.tree, grid.meshes, {rec});
     auto config = ParseSceneConfig(
         "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.limestone]\n", "abbey.toml");
     ASSERT_TRUE(config.ok()) << config.status().ToString();
-    auto scene = BuildRenderScene(*config, source);
+    auto scene = testing::BuildTestScene(
+        testing::GridSource(FurnaceMesh(), testing::NamedMaterials({"glass_blue"}), {1, 1, 1}),
+        *config);
     ASSERT_FALSE(scene.ok());
     EXPECT_NE(scene.status().message().find("glass_blue"), std::string::npos)
         << scene.status().message();
     EXPECT_NE(scene.status().message().find("abbey.toml"), std::string::npos)
         << scene.status().message();
-}
-
-}  // namespace
-}  // namespace nave::render
-
-#include "store/store_writer.h"
-
-namespace nave::render {
-namespace {
-
-/// Writes `mesh` as a store cut into n^3 bricks (triangles in every cell they overlap, as
-/// preprocess does).
-Status WriteTestStore(const std::filesystem::path& path, const store::BrickMesh& mesh,
-                      const std::vector<std::string>& names, int n,
-                      const store::EncodeOptions& options = {}) {
-    GridBricks grid = SplitIntoGridBricks(mesh, n, n, n);
-    store::GlobalGrid g;
-    g.origin = Vec3d(-10, -10, -10);
-    g.step = 1e-4;
-    NAVE_ASSIGN_OR_RETURN(auto writer,
-                          store::StoreWriter::Create(path, g, {{"test"}, "nave test", ""}));
-    std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
-    for (size_t b = 0; b < grid.meshes.size(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(store::EncodedBrick e,
-                              store::EncodeBrick(grid.meshes[b], cells[b], g, options));
-        NAVE_ASSIGN_OR_RETURN(uint32_t id, writer->Append(e));
-        NAVE_CHECK_EQ(id, uint32_t(b));
-    }
-    std::vector<store::MaterialRecord> materials;
-    for (const auto& name : names) {
-        store::MaterialRecord r;
-        r.name = name;
-        materials.push_back(r);
-    }
-    return writer->Finish(materials, grid.tree, mesh.TriangleCount());
 }
 
 TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
@@ -538,10 +502,18 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
     store::EncodeOptions stored;
     stored.derived_normal_error_deg = 0;
     const store::EncodeOptions derived;
-    ASSERT_TRUE(WriteTestStore(dir / "one.nave", ClutterMesh(), names, 1, stored).ok());
-    ASSERT_TRUE(WriteTestStore(dir / "many.nave", ClutterMesh(), names, 4, stored).ok());
-    ASSERT_TRUE(WriteTestStore(dir / "one_derived.nave", ClutterMesh(), names, 1, derived).ok());
-    ASSERT_TRUE(WriteTestStore(dir / "many_derived.nave", ClutterMesh(), names, 4, derived).ok());
+    ASSERT_TRUE(
+        testing::WriteGridBricksStore(dir / "one.nave", ClutterMesh(), names, {1, 1, 1}, stored)
+            .ok());
+    ASSERT_TRUE(
+        testing::WriteGridBricksStore(dir / "many.nave", ClutterMesh(), names, {4, 4, 4}, stored)
+            .ok());
+    ASSERT_TRUE(testing::WriteGridBricksStore(dir / "one_derived.nave", ClutterMesh(), names,
+                                              {1, 1, 1}, derived)
+                    .ok());
+    ASSERT_TRUE(testing::WriteGridBricksStore(dir / "many_derived.nave", ClutterMesh(), names,
+                                              {4, 4, 4}, derived)
+                    .ok());
     auto device = EmbreeDevice::Create();
     ASSERT_TRUE(device.ok());
     auto config = ParseSceneConfig(fmt::format(fmt::runtime(kClutter), "path"), "clutter.toml");
@@ -550,13 +522,12 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
     for (const char* name : {"one.nave", "many.nave", "one_derived.nave", "many_derived.nave"}) {
         auto source = StoreBrickSource::Open(dir / name, *device);
         ASSERT_TRUE(source.ok()) << source.status().ToString();
-        auto scene = BuildRenderScene(*config, **source);
-        ASSERT_TRUE(scene.ok()) << scene.status().ToString();
-        films.push_back(std::make_unique<Film>(32, 24, config->output));
-        RenderStats stats;
-        ASSERT_TRUE(RenderStreams(*scene, films.back().get(), &stats).ok());
-        EXPECT_EQ(stats.residency.loads, (*source)->brick_count());
-        EXPECT_GT(stats.bytes_read, 0u);
+        auto t = testing::BuildAndRender(std::move(*source), *config);
+        ASSERT_TRUE(t != nullptr);
+        ASSERT_TRUE(t->status.ok()) << t->status.ToString();
+        EXPECT_EQ(t->stats.residency.loads, t->source->brick_count());
+        EXPECT_GT(t->stats.bytes_read, 0u);
+        films.push_back(std::move(t->film));
     }
     EXPECT_GT(MeanY(*films[0]), 0.0);
     // Each brick is Draco-encoded on its own; decoding starts every triangle at its lowest grid
@@ -572,12 +543,6 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
     EXPECT_NEAR(mean_one, MeanY(*films[0]), 0.002 * mean_one);
     std::filesystem::remove_all(dir);
 }
-
-}  // namespace
-}  // namespace nave::render
-
-namespace nave::render {
-namespace {
 
 // A closed room (black walls and roof) with a thin glass window in the roof and the sun at the
 // zenith: the floor under the window receives E = L_sun Omega T_tot, T_tot = (1-r)^2 tau / (1 - r^2

@@ -18,16 +18,14 @@
 #include "render/render_session.h"
 #include "render/scene.h"
 #include "render/scene_config.h"
+#include "render_test_util.h"
 
 namespace nave::render {
 namespace {
 
 const std::string kConfigs = std::string(NAVE_TEST_FIXTURES) + "/../../configs/";
 
-struct RunResult {
-    std::unique_ptr<Film> film;
-    RenderStats stats;
-};
+using testing::RenderResult;
 
 class ResumeTest : public ::testing::Test {
   protected:
@@ -45,35 +43,32 @@ class ResumeTest : public ::testing::Test {
         ASSERT_TRUE(device.ok());
         auto source = OpenProceduralSource(procedural, *device);
         ASSERT_TRUE(source.ok()) << source.status().ToString();
-        source_ = std::move(*source);
         auto config = LoadSceneConfig(kConfigs + config_file);
         ASSERT_TRUE(config.ok()) << config.status().ToString();
-        config_ = *config;
-        config_.render.threads = 1;
-        edit(&config_);
-        auto scene = BuildRenderScene(config_, *source_);
+        config->render.threads = 1;
+        edit(&*config);
+        auto scene = testing::BuildTestScene(std::move(*source), std::move(*config));
         ASSERT_TRUE(scene.ok()) << scene.status().ToString();
         scene_ = std::move(*scene);
     }
 
     /// One run with `options`, into a fresh film.
-    RunResult Render(const SessionOptions& options) {
-        RunResult run;
-        run.film =
-            std::make_unique<Film>(config_.camera.width, config_.camera.height, scene_.output);
+    RenderResult Render(const SessionOptions& options) {
         // The fullest brick first, whether resident or not: the order of the batches, and so of the
         // film's additions, does not depend on when background loads finish.
-        Status s =
-            RenderStreams(scene_, run.film.get(), &run.stats, PickFullestBrick, nullptr, &options);
-        EXPECT_TRUE(s.ok()) << s.ToString();
-        return run;
+        testing::RunOptions run;
+        run.picker = PickFullestBrick;
+        run.session = &options;
+        RenderResult r = scene_->Run(run);
+        EXPECT_TRUE(r.status.ok()) << r.status.ToString();
+        return r;
     }
 
     SessionOptions Options(const std::string& checkpoint_name) const {
         SessionOptions o;
         o.checkpoint_path = dir_ / checkpoint_name;
         o.checkpoint_every_s = 0;
-        o.identity.mode = uint8_t(config_.render.mode);
+        o.identity.mode = uint8_t(scene_->config.render.mode);
         return o;
     }
 
@@ -86,10 +81,10 @@ class ResumeTest : public ::testing::Test {
     /// Renders in one run, then in runs of `stops` passes each resumed from the last one's
     /// checkpoint, and expects the same films and final checkpoint state.
     void ExpectResumedEqualsUninterrupted(std::initializer_list<int> stops, int total) {
-        const RunResult whole = Render(Options("whole.ckpt"));
+        const RenderResult whole = Render(Options("whole.ckpt"));
         ASSERT_EQ(whole.stats.samples_per_pixel, total);
         std::unique_ptr<Checkpoint> resume;
-        RunResult last;
+        RenderResult last;
         int done = 0;
         for (int stop : stops) {
             SessionOptions o = Options("parts.ckpt");
@@ -125,9 +120,7 @@ class ResumeTest : public ::testing::Test {
     }
 
     std::filesystem::path dir_;
-    std::unique_ptr<MemoryBrickSource> source_;
-    SceneConfig config_;
-    RenderScene scene_;
+    std::unique_ptr<testing::TestScene> scene_;
 };
 
 TEST_F(ResumeTest, PathModeWithTheGuideLearningAcrossStops) {
@@ -137,7 +130,7 @@ TEST_F(ResumeTest, PathModeWithTheGuideLearningAcrossStops) {
         c->render.spp = 11;
         c->render.path_guiding = true;
     });
-    ASSERT_TRUE(scene_.settings.path_guiding);
+    ASSERT_TRUE(scene_->scene.settings.path_guiding);
     // Stops before and after guide updates (passes 1, 2, 4, 8).
     ExpectResumedEqualsUninterrupted({1, 2, 4}, 11);
 }
@@ -171,9 +164,9 @@ TEST_F(ResumeTest, ACheckpointOfAnotherSizeIsRefused) {
     SessionOptions resumed = Options("small.ckpt");
     resumed.resume = &*read;
     resumed.resume_name = "small.ckpt";
-    Film film(config_.camera.width, config_.camera.height, scene_.output);
-    RenderStats stats;
-    Status s = RenderStreams(scene_, &film, &stats, {}, nullptr, &resumed);
+    testing::RunOptions run;
+    run.session = &resumed;
+    const Status s = scene_->Run(run).status;
     ASSERT_FALSE(s.ok());
     EXPECT_EQ(s.code(), StatusCode::kDataLoss);
     EXPECT_NE(s.message().find("a film of 16x12, this render's is 20x12"), std::string::npos)

@@ -14,12 +14,8 @@
 #include "core/color.h"
 #include "core/file.h"
 #include "imaging/texture_cache.h"
-#include "render/brick_source.h"
-#include "render/film.h"
-#include "render/integrator.h"
-#include "render/scene.h"
-#include "render/scene_config.h"
 #include "render/texture/surface_textures.h"
+#include "render_test_util.h"
 
 namespace nave::render {
 namespace {
@@ -66,7 +62,7 @@ class TextureRenderTest : public ::testing::Test {
         std::vector<float> px(12);
         for (int i = 0; i < 4; ++i)
             for (int c = 0; c < 3; ++c)
-                px[size_t(i * 3 + c)] = (i == 0 || i == 3) ? red[c] : blue[c];
+                px[size_t(i) * 3 + size_t(c)] = (i == 0 || i == 3) ? red[c] : blue[c];
         WriteImage(dir_ / "checker.exr", 2, 2, 3, px);
         // 2 x 1 grey mask: left half cut out (0), right half kept (1).
         WriteImage(dir_ / "mask.exr", 2, 1, 1, {0.f, 1.f});
@@ -77,31 +73,30 @@ class TextureRenderTest : public ::testing::Test {
     /// `textures` is false.
     std::unique_ptr<Film> Render(const store::BrickMesh& mesh, const store::MaterialRecord& rec,
                                  const std::string& config_text, bool textures = true) {
-        auto device = EmbreeDevice::Create();
-        EXPECT_TRUE(device.ok());
-        GridBricks grid = SplitIntoGridBricks(mesh, 1, 1, 1);
-        EXPECT_TRUE(grid.meshes.size() == 1 && grid.meshes[0].HasUvs());
-        MemoryBrickSource source(*device, grid.tree, grid.meshes, {rec});
+        auto source = testing::GridSource(mesh, {rec}, {1, 1, 1});
+        EXPECT_TRUE(source && source->brick_count() == 1);
+        if (source == nullptr) return nullptr;
         auto config = ParseSceneConfig(config_text, "t");
         EXPECT_TRUE(config.ok()) << config.status().ToString();
         if (!config.ok()) return nullptr;
         config->textures.enabled = textures;
-        auto scene = BuildRenderScene(*config, source);
-        EXPECT_TRUE(scene.ok()) << scene.status().ToString();
-        if (!scene.ok()) return nullptr;
+        auto built = testing::BuildTestScene(std::move(source), std::move(*config));
+        EXPECT_TRUE(built.ok()) << built.status().ToString();
+        if (!built.ok()) return nullptr;
+        testing::TestScene& t = **built;
         auto cache = TextureCache::Create(size_t(16) << 20);
         EXPECT_TRUE(cache.ok());
         std::vector<std::string> warnings;
-        Status attached = AttachTextures(*config, dir_, **cache, &*scene, &warnings);
+        Status attached = AttachTextures(t.config, dir_, **cache, &t.scene, &warnings);
         EXPECT_TRUE(attached.ok()) << attached.ToString();
         EXPECT_TRUE(warnings.empty()) << warnings.front();
-        EXPECT_EQ(scene->materials[0].textures != nullptr, textures);
-        auto film =
-            std::make_unique<Film>(config->camera.width, config->camera.height, config->output);
-        RenderStats stats;
-        Status s = RenderStreams(*scene, film.get(), &stats);
-        EXPECT_TRUE(s.ok()) << s.ToString();
-        return film;
+        EXPECT_EQ(t.scene.materials[0].textures != nullptr, textures);
+        testing::RenderResult r = t.Run();
+        EXPECT_TRUE(r.status.ok()) << r.status.ToString();
+        // The one brick the render traced kept the mesh's texture coordinates.
+        auto brick = t.source->Acquire(0);
+        EXPECT_TRUE(brick.ok() && (*brick)->mesh().HasUvs());
+        return std::move(r.film);
     }
 
     std::unique_ptr<Film> RenderQuad(bool textures, const std::string& extra_config = "") {
@@ -230,14 +225,13 @@ TEST_F(TextureRenderTest, AlphaMaskCastsShadowsOnlyWhereAlphaIsOne) {
     }
     for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
     m.material_ids = {0, 0, 1, 1};
-    auto device = EmbreeDevice::Create();
-    ASSERT_TRUE(device.ok());
-    GridBricks grid = SplitIntoGridBricks(m, 1, 1, 1);
     store::MaterialRecord ground, leaf;
     ground.name = "ground";
     leaf.name = "leaf";
     leaf.textures["map_d"] = "mask.exr";
-    MemoryBrickSource source(*device, grid.tree, grid.meshes, {ground, leaf});
+    auto grid_source = testing::GridSource(m, {ground, leaf}, {1, 1, 1});
+    ASSERT_TRUE(grid_source != nullptr);
+    BrickSource& source = *grid_source;
     auto cache = TextureCache::Create(size_t(16) << 20);
     ASSERT_TRUE(cache.ok());
     std::vector<std::string> warnings;
