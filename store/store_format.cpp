@@ -77,7 +77,6 @@ Status ByteReader::Skip(size_t n) {
 }
 
 // ---- header
-// -------------------------------------------------------------------------------------------
 
 std::string EncodeHeader(const RawHeader& h) {
     ByteWriter w;
@@ -239,7 +238,6 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
 }
 
 // ---- provenance
-// ---------------------------------------------------------------------------------------
 
 std::string EncodeProvenance(const StoreProvenance& p) {
     ByteWriter w;
@@ -271,7 +269,6 @@ StatusOr<StoreProvenance> DecodeProvenance(std::string_view bytes, const std::st
 }
 
 // ---- directory
-// ----------------------------------------------------------------------------------------
 
 std::string EncodeDirectory(const std::vector<RawBrickEntry>& entries) {
     ByteWriter w;
@@ -340,7 +337,6 @@ StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, con
 }
 
 // ---- tree
-// ---------------------------------------------------------------------------------------------
 
 std::string EncodeTree(const BrickTree& tree) {
     ByteWriter w;
@@ -384,7 +380,6 @@ StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h,
 }
 
 // ---- materials
-// ----------------------------------------------------------------------------------------
 
 std::string EncodeMaterials(const std::vector<MaterialRecord>& materials) {
     ByteWriter w;

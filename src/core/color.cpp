@@ -38,7 +38,6 @@ const Spectrum& CieZ() { return GetCmfs().z; }
 double CieYIntegral() { return GetCmfs().y_integral; }
 
 // ---- Mat3d
-// ------------------------------------------------------------------------------------------
 
 Mat3d Mat3d::Identity() { return Diagonal({1, 1, 1}); }
 
@@ -104,7 +103,6 @@ std::ostream& operator<<(std::ostream& os, const Mat3d& m) {
 }
 
 // ---- XYZ
-// --------------------------------------------------------------------------------------------
 
 Chromaticity XYZToChromaticity(const Vec3d& xyz) {
     double sum = xyz.x + xyz.y + xyz.z;
@@ -155,7 +153,6 @@ Vec3d SampledToXYZ(const SampledSpectrum& L, const SampledWavelengths& lambda) {
 }
 
 // ---- RGB colour spaces
-// ------------------------------------------------------------------------------
 
 RgbColorSpace::RgbColorSpace(std::string name, Chromaticity r, Chromaticity g, Chromaticity b,
                              Chromaticity white)
@@ -199,7 +196,6 @@ StatusOr<const RgbColorSpace*> RgbColorSpace::Named(std::string_view name) {
 }
 
 // ---- Chromatic adaptation
-// ---------------------------------------------------------------------------
 
 namespace {
 
@@ -263,7 +259,6 @@ Mat3d WhiteBalancedXyzToRgb(const RgbColorSpace& space, const Chromaticity& scen
 }
 
 // ---- Output
-// -----------------------------------------------------------------------------------------
 
 double SrgbEncode(double linear) {
     // IEC 61966-2-1:1999 §5.2, eq. (5).

@@ -50,7 +50,6 @@ std::ostream& operator<<(std::ostream& os, const SampledSpectrum& s) {
 }
 
 // ---- Wavelength sampling
-// ---------------------------------------------------------------------------
 
 namespace {
 
@@ -131,7 +130,6 @@ bool SampledWavelengths::SecondaryTerminated() const {
 }
 
 // ---- Spectrum
-// ---------------------------------------------------------------------------------------
 
 Spectrum::Spectrum() = default;
 
@@ -241,7 +239,6 @@ Spectrum& Spectrum::operator+=(const Spectrum& s) {
 }
 
 // ---- CSV
-// --------------------------------------------------------------------------------------------
 
 namespace {
 

@@ -18,9 +18,6 @@
 
 namespace nave::render {
 
-// ----------------------------------------------------------------------------------------------
-// options
-
 namespace {
 
 /// A pager tunable's on|off value; the error names the key.
@@ -215,9 +212,6 @@ uint64_t RenderReserveBytes(const RenderSettings& settings, int width, int heigh
                                : 0;
     return kProcess + film + queues + sppm + guide;
 }
-
-// ----------------------------------------------------------------------------------------------
-// pager
 
 Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting)
     : source_(source),

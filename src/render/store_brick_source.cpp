@@ -3,9 +3,6 @@
 
 namespace nave::render {
 
-// ----------------------------------------------------------------------------------------------
-// store source
-
 StoreBrickSource::StoreBrickSource(std::unique_ptr<store::Store> st,
                                    std::shared_ptr<EmbreeDevice> device)
     : BrickSource(std::move(device), st->tree(),

@@ -64,7 +64,6 @@ SampledSpectrum FrComplex(float cos_theta_i, const SampledSpectrum& eta, const S
 }
 
 // ---- Trowbridge-Reitz
-// -------------------------------------------------------------------------------
 
 float TrowbridgeReitz::D(const Vec3f& wm) const {
     float tan2 = Tan2Theta(wm);
@@ -116,7 +115,6 @@ Vec3f TrowbridgeReitz::Sample_wm(const Vec3f& w, Point2f u) const {
 }
 
 // ---- Diffuse
-// ----------------------------------------------------------------------------------------
 
 SampledSpectrum DiffuseBxdf::Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
                                   TransportMode) const {
@@ -141,7 +139,6 @@ float DiffuseBxdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelength
 }
 
 // ---- Conductor
-// --------------------------------------------------------------------------------------
 
 SampledSpectrum ConductorBxdf::Eval(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths&,
                                     TransportMode) const {
@@ -195,7 +192,6 @@ float ConductorBxdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWaveleng
 }
 
 // ---- Dielectric
-// -------------------------------------------------------------------------------------
 
 bool DielectricBxdf::HalfVector(const Vec3f& wo, const Vec3f& wi, Vec3f* wm, float* etap,
                                 bool* reflect) const {
@@ -297,7 +293,6 @@ std::optional<BsdfSample> DielectricBxdf::Sample(const Vec3f& wo, float uc, Poin
 }
 
 // ---- Thin dielectric
-// --------------------------------------------------------------------------------
 
 void ThinDielectricBxdf::ReflectanceTransmittance(float cos_theta, SampledSpectrum* r_tot,
                                                   SampledSpectrum* t_tot) const {

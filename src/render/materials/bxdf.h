@@ -57,7 +57,6 @@ struct BsdfSample {
 };
 
 // ---- Local-frame trigonometry (normal = +z)
-// ---------------------------------------------------------
 
 inline float CosTheta(const Vec3f& w) { return w.z; }
 inline float AbsCosTheta(const Vec3f& w) { return std::abs(w.z); }
@@ -81,7 +80,6 @@ inline Vec3f Reflect(const Vec3f& wo, const Vec3f& n) { return -wo + n * (2.f * 
 bool Refract(const Vec3f& wi, Vec3f n, float eta, float* etap, Vec3f* wt);
 
 // ---- Fresnel
-// ----------------------------------------------------------------------------------------
 
 /// Unpolarised Fresnel reflectance of a dielectric interface for relative index eta = η_t/η_i and
 /// cosθi (negative: the ray arrives from the η_t side, and eta is inverted). 1 under total internal
@@ -99,7 +97,6 @@ float FrComplex(float cos_theta_i, float eta, float k);
 SampledSpectrum FrComplex(float cos_theta_i, const SampledSpectrum& eta, const SampledSpectrum& k);
 
 // ---- Microfacets
-// ------------------------------------------------------------------------------------
 
 /// Perceptual roughness in [0, 1] -> GGX α = roughness² (Burley 2012, "Physically-based shading at
 /// Disney", §5.4).
@@ -142,7 +139,6 @@ class TrowbridgeReitz {
 };
 
 // ---- BxDFs
-// ------------------------------------------------------------------------------------------
 
 /// Lambertian reflection with spectral albedo R: f = R/π, cosine-weighted sampling.
 class DiffuseBxdf {
