@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "core/file.h"
-#include "core/hash.h"
-#include "render/brick_source.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
+#include "src/render/brick_source.h"
 #include "store/brick_codec.h"  // internal to nave_store: the mesh section decoder
 #include "store/store_reader.h"
 

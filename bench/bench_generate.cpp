@@ -10,8 +10,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "core/check.h"
 #include "preprocess/abbey/abbey_source.h"
+#include "src/core/check.h"
 
 namespace nave::preprocess {
 namespace {

@@ -8,8 +8,8 @@
 
 #include <random>
 
-#include "render/brick_source.h"
-#include "render/pager.h"
+#include "src/render/brick_source.h"
+#include "src/render/pager.h"
 #include "store/brick_tree.h"
 
 namespace nave::render {

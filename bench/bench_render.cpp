@@ -5,14 +5,14 @@
 
 #include <benchmark/benchmark.h>
 
-#include "core/progress.h"
-#include "render/brick_source.h"
-#include "render/film.h"
-#include "render/grid_bricks.h"
-#include "render/integrator.h"
-#include "render/procedural_meshes.h"
-#include "render/scene.h"
-#include "render/scene_config.h"
+#include "src/core/progress.h"
+#include "src/render/brick_source.h"
+#include "src/render/film.h"
+#include "src/render/grid_bricks.h"
+#include "src/render/integrator.h"
+#include "src/render/procedural_meshes.h"
+#include "src/render/scene.h"
+#include "src/render/scene_config.h"
 
 namespace nave::render {
 namespace {

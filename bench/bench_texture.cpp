@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "core/rgb_to_spectrum.h"
-#include "imaging/texture_cache.h"
+#include "src/core/rgb_to_spectrum.h"
+#include "src/imaging/texture_cache.h"
 
 namespace nave::render {
 namespace {

@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 
-#include "core/file.h"
-#include "core/progress.h"
+#include "src/core/file.h"
+#include "src/core/progress.h"
 
 namespace nave::preprocess {
 

@@ -5,8 +5,8 @@
 
 #include <filesystem>
 
-#include "core/status.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/status.h"
 
 namespace nave::preprocess {
 

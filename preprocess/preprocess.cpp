@@ -10,9 +10,6 @@
 #include <mutex>
 #include <optional>
 
-#include "core/log.h"
-#include "core/memory.h"
-#include "core/progress.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/import/importer.h"
 #include "preprocess/partition/bin_file.h"
@@ -21,6 +18,9 @@
 #include "preprocess/partition/temp_dir.h"
 #include "preprocess/preprocess_plan.h"
 #include "preprocess/texture_convert.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 #include "store/store_writer.h"
 
 namespace nave::preprocess {

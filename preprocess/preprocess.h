@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/store_writer.h"
 
 namespace nave::preprocess {

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <thread>
 
-#include "core/memory.h"
 #include "preprocess/partition/brick_builder.h"
+#include "src/core/memory.h"
 
 namespace nave::preprocess {
 

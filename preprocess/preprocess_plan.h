@@ -10,10 +10,10 @@
 #include <filesystem>
 #include <vector>
 
-#include "core/status.h"
-#include "core/vecmath.h"
 #include "preprocess/partition/partitioner.h"
 #include "preprocess/preprocess.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 #include "store/grid.h"
 
 namespace nave::preprocess {

@@ -10,12 +10,12 @@
 #include <utility>
 #include <vector>
 
-#include "core/file.h"
-#include "core/hash.h"
-#include "core/log.h"
-#include "core/progress.h"
-#include "core/stale_temporaries.h"
-#include "imaging/make_texture.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
+#include "src/core/log.h"
+#include "src/core/progress.h"
+#include "src/core/stale_temporaries.h"
+#include "src/imaging/make_texture.h"
 
 namespace nave::preprocess {
 

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/material_record.h"
 
 namespace nave::preprocess {

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
-#include "core/vecmath.h"
 #include "preprocess/import_warnings.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 #include "store/material_record.h"
 
 namespace nave::preprocess {

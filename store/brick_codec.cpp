@@ -16,7 +16,7 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "core/key_table.h"
+#include "src/core/key_table.h"
 #include "store/face_shading.h"
 
 namespace nave::store::codec {

@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/brick_mesh.h"
 #include "store/grid.h"
 #include "store/store_writer.h"

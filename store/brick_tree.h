@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
-#include "core/vecmath.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 
 namespace nave::store {
 

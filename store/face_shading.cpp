@@ -4,7 +4,7 @@
 #include <numbers>
 #include <numeric>
 
-#include "core/key_table.h"
+#include "src/core/key_table.h"
 
 namespace nave::store::codec {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 #include "store/brick_mesh.h"
 #include "store/grid.h"
 

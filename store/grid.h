@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave::store {
 

@@ -8,8 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
-#include "core/hash.h"
-#include "core/memory.h"
+#include "src/core/hash.h"
+#include "src/core/memory.h"
 
 namespace nave::store {
 namespace {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::store {
 

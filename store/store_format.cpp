@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/hash.h"
+#include "src/core/hash.h"
 
 namespace nave::store::format {
 namespace {

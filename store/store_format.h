@@ -16,7 +16,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
 #include "store/store_info.h"

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 #include "store/grid.h"
 
 namespace nave::store {

@@ -4,8 +4,8 @@
 
 #include <atomic>
 
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 #include "store/brick_codec.h"
 #include "store/store_format.h"
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <set>
 
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 #include "store/brick_codec.h"
 #include "store/store_format.h"
 

@@ -9,8 +9,8 @@
 #include <functional>
 #include <vector>
 
-#include "core/vecmath.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess::abbey {
 

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include "core/pane.h"
-#include "core/spectrum.h"
-#include "core/spectrum_data.h"
-#include "imaging/image_io.h"
+#include "src/core/pane.h"
+#include "src/core/spectrum.h"
+#include "src/core/spectrum_data.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::preprocess::abbey {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::preprocess::abbey {
 

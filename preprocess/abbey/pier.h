@@ -3,9 +3,9 @@
 // scotia, torus), a shaft built of drums with chamfered joints, an astragal, a bell capital with
 // crockets and an octagonal abacus.
 
-#include "core/vecmath.h"
 #include "preprocess/abbey/detail.h"
 #include "preprocess/abbey/emitter.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess::abbey {
 

@@ -4,9 +4,9 @@
 
 #include <functional>
 
-#include "core/vecmath.h"
 #include "preprocess/abbey/detail.h"
 #include "preprocess/abbey/emitter.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess::abbey {
 

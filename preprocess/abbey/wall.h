@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vecmath.h"
 #include "preprocess/abbey/detail.h"
 #include "preprocess/abbey/emitter.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess::abbey {
 

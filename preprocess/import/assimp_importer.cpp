@@ -3,10 +3,10 @@
 #include <assimp/cimport.h>
 #include <fmt/format.h>
 
-#include "core/child_process.h"
 #include "preprocess/import/assimp_scene.h"
 #include "preprocess/import/indexed_mesh_source.h"
 #include "preprocess/import/model_wire.h"
+#include "src/core/child_process.h"
 
 namespace nave::preprocess {
 namespace {

@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 
-#include "core/file.h"
 #include "preprocess/import/triangle_check.h"
+#include "src/core/file.h"
 
 namespace nave::preprocess {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
 #include "preprocess/import/indexed_mesh_source.h"
+#include "src/core/status.h"
 
 namespace nave::preprocess {
 

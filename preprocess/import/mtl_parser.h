@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "core/status.h"
 #include "preprocess/import_warnings.h"
+#include "src/core/status.h"
 #include "store/material_record.h"
 
 namespace nave::preprocess {

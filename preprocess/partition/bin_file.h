@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/status.h"
 
 namespace nave::preprocess {
 

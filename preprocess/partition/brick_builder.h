@@ -6,8 +6,8 @@
 
 #include <vector>
 
-#include "core/key_table.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/key_table.h"
 #include "store/brick_mesh.h"
 #include "store/grid.h"
 

@@ -21,11 +21,11 @@
 #include <mutex>
 #include <vector>
 
-#include "core/progress.h"
-#include "core/status.h"
 #include "preprocess/partition/bin_file.h"
 #include "preprocess/partition/temp_dir.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/progress.h"
+#include "src/core/status.h"
 #include "store/brick_tree.h"
 
 namespace nave::preprocess {

@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "core/log.h"
-#include "core/stale_temporaries.h"
+#include "src/core/log.h"
+#include "src/core/stale_temporaries.h"
 
 namespace nave::preprocess {
 namespace {

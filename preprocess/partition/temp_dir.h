@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::preprocess {
 

@@ -6,7 +6,7 @@
 
 #include <array>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess {
 

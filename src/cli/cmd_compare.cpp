@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands.h"
-#include "core/image_error.h"
-#include "imaging/image_io.h"
+#include "src/cli/commands.h"
+#include "src/core/image_error.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::cli {
 namespace {

@@ -4,12 +4,12 @@
 #include <chrono>
 #include <cstdio>
 
-#include "cli/commands.h"
-#include "core/log.h"
-#include "core/memory.h"
-#include "core/progress.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/obj_writer.h"
+#include "src/cli/commands.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 
 namespace nave::cli {
 

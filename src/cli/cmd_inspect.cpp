@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <string>
 
-#include "cli/commands.h"
-#include "core/json_string.h"
-#include "core/memory.h"
-#include "core/progress.h"
+#include "src/cli/commands.h"
+#include "src/core/json_string.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {

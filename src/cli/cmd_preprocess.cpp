@@ -8,10 +8,10 @@
 #include <atomic>
 #include <cstdio>
 
-#include "cli/commands.h"
-#include "core/log.h"
-#include "core/memory.h"
 #include "preprocess/preprocess.h"
+#include "src/cli/commands.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
 
 namespace nave::cli {
 namespace {

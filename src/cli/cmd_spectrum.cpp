@@ -5,11 +5,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/commands.h"
-#include "core/color.h"
-#include "core/illuminant.h"
-#include "core/log.h"
-#include "render/sun/sun.h"
+#include "src/cli/commands.h"
+#include "src/core/color.h"
+#include "src/core/illuminant.h"
+#include "src/core/log.h"
+#include "src/render/sun/sun.h"
 
 namespace nave::cli {
 

@@ -5,10 +5,10 @@
 #include <memory>
 #include <string>
 
-#include "cli/commands.h"
-#include "core/color.h"
-#include "render/sun/sky.h"
-#include "render/sun/sun.h"
+#include "src/cli/commands.h"
+#include "src/core/color.h"
+#include "src/render/sun/sky.h"
+#include "src/render/sun/sun.h"
 
 namespace nave::cli {
 

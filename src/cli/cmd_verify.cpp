@@ -12,11 +12,11 @@
 #include <thread>
 #include <vector>
 
-#include "cli/commands.h"
-#include "core/json_string.h"
-#include "core/log.h"
-#include "core/memory.h"
-#include "core/progress.h"
+#include "src/cli/commands.h"
+#include "src/core/json_string.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {

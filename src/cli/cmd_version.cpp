@@ -1,8 +1,8 @@
 // `nave version`: the version and the libraries nave was built with, for bug reports.
 #include <cstdio>
 
-#include "cli/commands.h"
-#include "core/memory.h"
+#include "src/cli/commands.h"
+#include "src/core/memory.h"
 
 namespace nave::cli {
 

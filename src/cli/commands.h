@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::cli {
 

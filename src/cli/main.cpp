@@ -6,9 +6,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "cli/commands.h"
-#include "core/log.h"
-#include "core/progress.h"
+#include "src/cli/commands.h"
+#include "src/core/log.h"
+#include "src/core/progress.h"
 
 /// jemalloc's settings, read when it starts (before main; MALLOC_CONF in the environment overrides
 /// them). nave allocates and frees pieces of many sizes, from kilobytes to tens of megabytes

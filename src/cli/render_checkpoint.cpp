@@ -1,11 +1,11 @@
-#include "cli/render_checkpoint.h"
+#include "src/cli/render_checkpoint.h"
 
 #include <fmt/format.h>
 
-#include "core/duration.h"
-#include "core/hash.h"
-#include "core/log.h"
-#include "core/stale_temporaries.h"
+#include "src/core/duration.h"
+#include "src/core/hash.h"
+#include "src/core/log.h"
+#include "src/core/stale_temporaries.h"
 
 namespace nave::cli {
 namespace {

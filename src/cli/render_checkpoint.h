@@ -8,9 +8,9 @@
 #include <optional>
 #include <string>
 
-#include "core/status.h"
-#include "render/render_session.h"
-#include "render/scene_config.h"
+#include "src/core/status.h"
+#include "src/render/render_session.h"
+#include "src/render/scene_config.h"
 
 namespace nave::cli {
 

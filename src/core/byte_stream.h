@@ -10,7 +10,7 @@
 #include <string_view>
 #include <type_traits>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave {
 

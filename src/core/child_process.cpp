@@ -1,4 +1,4 @@
-#include "core/child_process.h"
+#include "src/core/child_process.h"
 
 #include <fcntl.h>
 #include <poll.h>

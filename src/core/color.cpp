@@ -1,11 +1,11 @@
-#include "core/color.h"
+#include "src/core/color.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <iterator>
 
-#include "core/spectrum_data.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 

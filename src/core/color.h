@@ -10,9 +10,9 @@
 #include <string>
 #include <string_view>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 
 namespace nave {
 

@@ -1,4 +1,4 @@
-#include "core/duration.h"
+#include "src/core/duration.h"
 
 #include <charconv>
 #include <cmath>

@@ -3,7 +3,7 @@
 
 #include <string_view>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave {
 

@@ -1,9 +1,9 @@
-#include "core/hash.h"
+#include "src/core/hash.h"
 
 #include <fmt/format.h>
 #include <xxhash.h>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave {
 

@@ -1,10 +1,10 @@
-#include "core/illuminant.h"
+#include "src/core/illuminant.h"
 
 #include <cctype>
 #include <charconv>
 #include <string>
 
-#include "core/spectrum_data.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 

@@ -3,9 +3,9 @@
 
 #include <string_view>
 
-#include "core/color.h"
-#include "core/spectrum.h"
-#include "core/status.h"
+#include "src/core/color.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
 
 namespace nave {
 

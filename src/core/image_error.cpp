@@ -1,8 +1,8 @@
-#include "core/image_error.h"
+#include "src/core/image_error.h"
 
 #include <cmath>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave {
 

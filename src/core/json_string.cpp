@@ -1,4 +1,4 @@
-#include "core/json_string.h"
+#include "src/core/json_string.h"
 
 #include <fmt/format.h>
 

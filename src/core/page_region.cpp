@@ -1,4 +1,4 @@
-#include "core/page_region.h"
+#include "src/core/page_region.h"
 
 #include <sys/mman.h>
 #include <unistd.h>

@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave {
 

@@ -1,4 +1,4 @@
-#include "core/progress.h"
+#include "src/core/progress.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "core/log.h"
+#include "src/core/log.h"
 
 namespace nave {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/rgb_to_spectrum.h"
+#include "src/core/rgb_to_spectrum.h"
 
 #include <tbb/parallel_for.h>
 
@@ -7,8 +7,8 @@
 #include <mutex>
 #include <string>
 
-#include "core/check.h"
-#include "core/illuminant.h"
+#include "src/core/check.h"
+#include "src/core/illuminant.h"
 
 namespace nave {
 

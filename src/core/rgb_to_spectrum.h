@@ -13,9 +13,9 @@
 #include <memory>
 #include <vector>
 
-#include "core/color.h"
-#include "core/spectrum.h"
-#include "core/vecmath.h"
+#include "src/core/color.h"
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
 
 namespace nave {
 

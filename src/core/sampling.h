@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave {
 

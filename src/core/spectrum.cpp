@@ -1,11 +1,11 @@
-#include "core/spectrum.h"
+#include "src/core/spectrum.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cstdlib>
 
-#include "core/file.h"
-#include "core/spectrum_data.h"
+#include "src/core/file.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 

@@ -1,4 +1,4 @@
-#include "core/spectrum_data.h"
+#include "src/core/spectrum_data.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -7,7 +7,7 @@
 #include <mutex>
 #include <string>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave {
 namespace detail {

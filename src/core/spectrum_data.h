@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/spectrum.h"
+#include "src/core/spectrum.h"
 
 namespace nave {
 

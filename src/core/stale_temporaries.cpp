@@ -1,4 +1,4 @@
-#include "core/stale_temporaries.h"
+#include "src/core/stale_temporaries.h"
 
 #include <signal.h>
 #include <unistd.h>

@@ -10,7 +10,7 @@
 #include <utility>
 #include <variant>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave {
 

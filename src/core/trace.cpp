@@ -1,4 +1,4 @@
-#include "core/trace.h"
+#include "src/core/trace.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -8,8 +8,8 @@
 #include <numeric>
 #include <type_traits>
 
-#include "core/file.h"
-#include "core/json_string.h"
+#include "src/core/file.h"
+#include "src/core/json_string.h"
 
 namespace nave {
 namespace {

@@ -34,7 +34,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave {
 

@@ -1,4 +1,4 @@
-#include "imaging/image_io.h"
+#include "src/imaging/image_io.h"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 #include <atomic>
 #include <system_error>
 
-#include "imaging/oiio_plugin.h"
+#include "src/imaging/oiio_plugin.h"
 
 namespace nave::imaging {
 namespace {

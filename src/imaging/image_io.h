@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::imaging {
 

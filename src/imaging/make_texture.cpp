@@ -1,4 +1,4 @@
-#include "imaging/make_texture.h"
+#include "src/imaging/make_texture.h"
 
 namespace nave::imaging {
 

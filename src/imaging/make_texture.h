@@ -4,8 +4,8 @@
 
 #include <filesystem>
 
-#include "core/status.h"
-#include "imaging/oiio_plugin.h"
+#include "src/core/status.h"
+#include "src/imaging/oiio_plugin.h"
 
 namespace nave::imaging {
 

@@ -1,4 +1,4 @@
-#include "imaging/oiio_plugin.h"
+#include "src/imaging/oiio_plugin.h"
 
 #include <dlfcn.h>
 

@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::imaging {
 

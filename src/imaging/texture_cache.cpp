@@ -1,9 +1,9 @@
-#include "imaging/texture_cache.h"
+#include "src/imaging/texture_cache.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "imaging/oiio_plugin.h"
+#include "src/imaging/oiio_plugin.h"
 
 namespace nave::imaging {
 

@@ -1,7 +1,7 @@
-#include "render/brick_mesh_cache.h"
+#include "src/render/brick_mesh_cache.h"
 
-#include "core/log.h"
-#include "core/memory.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
 
 namespace nave::render {
 namespace {

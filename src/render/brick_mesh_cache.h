@@ -11,8 +11,8 @@
 #include <mutex>
 #include <vector>
 
-#include "core/status.h"
-#include "render/resident_mesh.h"
+#include "src/core/status.h"
+#include "src/render/resident_mesh.h"
 #include "store/brick_mesh.h"
 #include "store/spill_file.h"
 

@@ -1,4 +1,4 @@
-#include "render/brick_source.h"
+#include "src/render/brick_source.h"
 
 #include <embree3/rtcore.h>
 
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "core/trace.h"
-#include "render/brick_mesh_cache.h"
+#include "src/core/trace.h"
+#include "src/render/brick_mesh_cache.h"
 
 namespace nave::render {
 

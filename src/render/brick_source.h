@@ -15,9 +15,9 @@
 #include <mutex>
 #include <vector>
 
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/resident_mesh.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/resident_mesh.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"

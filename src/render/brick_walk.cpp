@@ -1,4 +1,4 @@
-#include "render/brick_walk.h"
+#include "src/render/brick_walk.h"
 
 namespace nave::render {
 

@@ -7,8 +7,8 @@
 
 #include <cstdint>
 
-#include "core/vecmath.h"
-#include "render/brick_source.h"
+#include "src/core/vecmath.h"
+#include "src/render/brick_source.h"
 #include "store/brick_tree.h"
 
 namespace nave::render {

@@ -1,6 +1,6 @@
-#include "render/camera.h"
+#include "src/render/camera.h"
 
-#include "core/sampling.h"
+#include "src/core/sampling.h"
 
 namespace nave::render {
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "core/vecmath.h"
-#include "render/scene_config.h"
+#include "src/core/vecmath.h"
+#include "src/render/scene_config.h"
 
 namespace nave::render {
 

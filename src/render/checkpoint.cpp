@@ -1,10 +1,10 @@
-#include "render/checkpoint.h"
+#include "src/render/checkpoint.h"
 
 #include <cstring>
 
-#include "core/byte_stream.h"
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/byte_stream.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 
 namespace nave::render {
 namespace {

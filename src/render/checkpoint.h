@@ -17,7 +17,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::render {
 

@@ -3,7 +3,7 @@
 
 #include <mutex>
 
-#include "render/brick_source.h"
+#include "src/render/brick_source.h"
 
 namespace nave::render {
 

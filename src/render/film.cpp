@@ -1,12 +1,12 @@
-#include "render/film.h"
+#include "src/render/film.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/atomic_add.h"
-#include "core/byte_stream.h"
-#include "core/check.h"
-#include "imaging/image_io.h"
+#include "src/core/atomic_add.h"
+#include "src/core/byte_stream.h"
+#include "src/core/check.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::render {
 namespace {

@@ -13,11 +13,11 @@
 #include <utility>
 #include <vector>
 
-#include "core/color.h"
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/scene_config.h"
+#include "src/core/color.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/scene_config.h"
 
 namespace nave {
 class ByteReader;

@@ -1,4 +1,4 @@
-#include "render/grid_bricks.h"
+#include "src/render/grid_bricks.h"
 
 #include <functional>
 #include <unordered_map>

@@ -1,4 +1,4 @@
-#include "render/integrator.h"
+#include "src/render/integrator.h"
 
 #include <tbb/task_arena.h>
 
@@ -6,12 +6,12 @@
 #include <chrono>
 #include <memory>
 
-#include "core/check.h"
-#include "core/memory.h"
-#include "render/light_sampling.h"
-#include "render/path_integrator.h"
-#include "render/sppm_integrator.h"
-#include "render/stream_scheduler.h"
+#include "src/core/check.h"
+#include "src/core/memory.h"
+#include "src/render/light_sampling.h"
+#include "src/render/path_integrator.h"
+#include "src/render/sppm_integrator.h"
+#include "src/render/stream_scheduler.h"
 
 namespace nave::render {
 namespace {

@@ -18,12 +18,12 @@
 #include <functional>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "render/film.h"
-#include "render/pager.h"
-#include "render/render_session.h"
-#include "render/scene.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/render/film.h"
+#include "src/render/pager.h"
+#include "src/render/render_session.h"
+#include "src/render/scene.h"
 
 namespace nave::render {
 

@@ -1,13 +1,13 @@
-#include "render/light_sampling.h"
+#include "src/render/light_sampling.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/log.h"
-#include "core/sampling.h"
-#include "render/materials/frame.h"
-#include "render/stream_scheduler.h"
-#include "render/transport_common.h"
+#include "src/core/log.h"
+#include "src/core/sampling.h"
+#include "src/render/materials/frame.h"
+#include "src/render/stream_scheduler.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 

@@ -9,15 +9,15 @@
 #include <optional>
 #include <vector>
 
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/brick_source.h"
-#include "render/materials/bxdf.h"
-#include "render/path_guide.h"
-#include "render/ray.h"
-#include "render/rng.h"
-#include "render/scene.h"
-#include "render/surface_hit.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/brick_source.h"
+#include "src/render/materials/bxdf.h"
+#include "src/render/path_guide.h"
+#include "src/render/ray.h"
+#include "src/render/rng.h"
+#include "src/render/scene.h"
+#include "src/render/surface_hit.h"
 
 namespace nave::render {
 

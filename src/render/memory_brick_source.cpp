@@ -1,4 +1,4 @@
-#include "render/brick_source.h"
+#include "src/render/brick_source.h"
 
 namespace nave::render {
 

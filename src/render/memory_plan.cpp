@@ -1,10 +1,10 @@
-#include "render/memory_plan.h"
+#include "src/render/memory_plan.h"
 
 #include <algorithm>
 
-#include "core/memory.h"
-#include "render/film.h"
-#include "render/render_session.h"
+#include "src/core/memory.h"
+#include "src/render/film.h"
+#include "src/render/render_session.h"
 
 namespace nave::render {
 

@@ -10,9 +10,9 @@
 #include <optional>
 #include <string>
 
-#include "core/status.h"
-#include "render/pager.h"
-#include "render/scene_config.h"
+#include "src/core/status.h"
+#include "src/render/pager.h"
+#include "src/render/scene_config.h"
 
 namespace nave::render {
 

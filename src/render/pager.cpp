@@ -1,4 +1,4 @@
-#include "render/pager.h"
+#include "src/render/pager.h"
 
 #include <tbb/task_arena.h>
 
@@ -6,15 +6,15 @@
 #include <charconv>
 #include <chrono>
 
-#include "core/log.h"
-#include "core/memory.h"
-#include "core/trace.h"
-#include "render/film.h"
-#include "render/path_guide.h"
-#include "render/photon_emission.h"
-#include "render/ray.h"
-#include "render/scene_config.h"
-#include "render/sppm.h"
+#include "src/core/log.h"
+#include "src/core/memory.h"
+#include "src/core/trace.h"
+#include "src/render/film.h"
+#include "src/render/path_guide.h"
+#include "src/render/photon_emission.h"
+#include "src/render/ray.h"
+#include "src/render/scene_config.h"
+#include "src/render/sppm.h"
 
 namespace nave::render {
 

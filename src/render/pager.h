@@ -20,9 +20,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/memory.h"
-#include "core/status.h"
-#include "render/brick_source.h"
+#include "src/core/memory.h"
+#include "src/core/status.h"
+#include "src/render/brick_source.h"
 
 namespace nave::render {
 

@@ -1,13 +1,13 @@
-#include "render/path_guide.h"
+#include "src/render/path_guide.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <tuple>
 
-#include "core/byte_stream.h"
-#include "core/check.h"
-#include "core/sampling.h"
+#include "src/core/byte_stream.h"
+#include "src/core/check.h"
+#include "src/core/sampling.h"
 
 namespace nave::render {
 namespace {

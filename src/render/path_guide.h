@@ -18,10 +18,10 @@
 #include <optional>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/materials/bxdf.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/materials/bxdf.h"
 
 namespace nave {
 class ByteReader;

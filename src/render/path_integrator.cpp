@@ -1,4 +1,4 @@
-#include "render/path_integrator.h"
+#include "src/render/path_integrator.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,17 +9,17 @@
 #include <cmath>
 #include <optional>
 
-#include "core/byte_stream.h"
-#include "core/image_error.h"
-#include "core/log.h"
-#include "core/progress.h"
-#include "core/sampling.h"
-#include "render/brick_walk.h"
-#include "render/rng.h"
-#include "render/sppm.h"
-#include "render/stopping_rule.h"
-#include "render/surface_hit.h"
-#include "render/transport_common.h"
+#include "src/core/byte_stream.h"
+#include "src/core/image_error.h"
+#include "src/core/log.h"
+#include "src/core/progress.h"
+#include "src/core/sampling.h"
+#include "src/render/brick_walk.h"
+#include "src/render/rng.h"
+#include "src/render/sppm.h"
+#include "src/render/stopping_rule.h"
+#include "src/render/surface_hit.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 

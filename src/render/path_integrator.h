@@ -8,17 +8,17 @@
 #include <memory>
 #include <span>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "render/brick_source.h"
-#include "render/film.h"
-#include "render/integrator.h"
-#include "render/light_sampling.h"
-#include "render/path_guide.h"
-#include "render/ray.h"
-#include "render/render_session.h"
-#include "render/scene.h"
-#include "render/stream_scheduler.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/render/brick_source.h"
+#include "src/render/film.h"
+#include "src/render/integrator.h"
+#include "src/render/light_sampling.h"
+#include "src/render/path_guide.h"
+#include "src/render/ray.h"
+#include "src/render/render_session.h"
+#include "src/render/scene.h"
+#include "src/render/stream_scheduler.h"
 
 namespace nave {
 class ProgressBar;

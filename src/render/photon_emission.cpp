@@ -1,4 +1,4 @@
-#include "render/photon_emission.h"
+#include "src/render/photon_emission.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/byte_stream.h"
-#include "core/sampling.h"
-#include "render/materials/frame.h"
-#include "render/sppm.h"
-#include "render/stream_scheduler.h"
-#include "render/transport_common.h"
+#include "src/core/byte_stream.h"
+#include "src/core/sampling.h"
+#include "src/render/materials/frame.h"
+#include "src/render/sppm.h"
+#include "src/render/stream_scheduler.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 namespace {

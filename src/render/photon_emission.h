@@ -11,13 +11,13 @@
 #include <span>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/light_sampling.h"
-#include "render/photon_guide.h"
-#include "render/photon_portals.h"
-#include "render/scene.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/light_sampling.h"
+#include "src/render/photon_guide.h"
+#include "src/render/photon_portals.h"
+#include "src/render/scene.h"
 
 namespace nave {
 class ByteReader;

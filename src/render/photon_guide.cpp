@@ -1,9 +1,9 @@
-#include "render/photon_guide.h"
+#include "src/render/photon_guide.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave::render {
 

@@ -16,8 +16,8 @@
 #include <span>
 #include <vector>
 
-#include "core/sampling.h"
-#include "core/vecmath.h"
+#include "src/core/sampling.h"
+#include "src/core/vecmath.h"
 
 namespace nave::render {
 

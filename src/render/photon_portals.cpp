@@ -1,11 +1,11 @@
-#include "render/photon_portals.h"
+#include "src/render/photon_portals.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-#include "core/sampling.h"
-#include "render/materials/frame.h"
+#include "src/core/sampling.h"
+#include "src/render/materials/frame.h"
 
 namespace nave::render {
 

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave::render {
 

@@ -1,8 +1,8 @@
-#include "render/procedural_meshes.h"
+#include "src/render/procedural_meshes.h"
 
 #include <cmath>
 
-#include "core/sampling.h"
+#include "src/core/sampling.h"
 
 namespace nave::render {
 

@@ -3,7 +3,7 @@
 
 #include <cstdint>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 #include "store/brick_mesh.h"
 
 namespace nave::render {

@@ -1,7 +1,7 @@
-#include "render/procedural_scenes.h"
+#include "src/render/procedural_scenes.h"
 
-#include "render/grid_bricks.h"
-#include "render/procedural_meshes.h"
+#include "src/render/grid_bricks.h"
+#include "src/render/procedural_meshes.h"
 
 namespace nave::render {
 

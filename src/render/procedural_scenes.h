@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/status.h"
-#include "render/brick_source.h"
+#include "src/core/status.h"
+#include "src/render/brick_source.h"
 #include "store/brick_mesh.h"
 
 namespace nave::render {

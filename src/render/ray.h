@@ -5,8 +5,8 @@
 
 #include <cstdint>
 
-#include "core/spectrum.h"
-#include "core/vecmath.h"
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
 
 namespace nave::render {
 

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <span>
 
-#include "render/ray.h"
-#include "render/ray_queue.h"
+#include "src/render/ray.h"
+#include "src/render/ray_queue.h"
 
 namespace nave::render {
 

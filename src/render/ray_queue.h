@@ -17,7 +17,7 @@
 #include <mutex>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/spill_file.h"
 
 namespace nave::render {

@@ -1,8 +1,8 @@
-#include "render/render_session.h"
+#include "src/render/render_session.h"
 
-#include "core/byte_stream.h"
-#include "core/log.h"
-#include "render/path_guide.h"
+#include "src/core/byte_stream.h"
+#include "src/core/log.h"
+#include "src/render/path_guide.h"
 
 namespace nave::render {
 

@@ -10,9 +10,9 @@
 #include <filesystem>
 #include <functional>
 
-#include "core/status.h"
-#include "render/checkpoint.h"
-#include "render/film.h"
+#include "src/core/status.h"
+#include "src/render/checkpoint.h"
+#include "src/render/film.h"
 
 namespace nave::render {
 

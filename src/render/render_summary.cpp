@@ -1,13 +1,13 @@
-#include "render/render_summary.h"
+#include "src/render/render_summary.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/check.h"
-#include "core/memory.h"
-#include "core/progress.h"
+#include "src/core/check.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 
 namespace nave::render {
 namespace {

@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "render/integrator.h"
-#include "render/scene_config.h"
+#include "src/render/integrator.h"
+#include "src/render/scene_config.h"
 
 namespace nave::render {
 

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
-#include "core/trace.h"
-#include "render/brick_source.h"
+#include "src/core/trace.h"
+#include "src/render/brick_source.h"
 
 namespace nave::render {
 

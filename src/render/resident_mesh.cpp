@@ -1,8 +1,8 @@
-#include "render/resident_mesh.h"
+#include "src/render/resident_mesh.h"
 
 #include <algorithm>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave::render {
 namespace {

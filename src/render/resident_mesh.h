@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <span>
 
-#include "core/page_region.h"
-#include "core/status.h"
-#include "core/vecmath.h"
+#include "src/core/page_region.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 #include "store/brick_mesh.h"
 
 namespace nave::render {

@@ -1,12 +1,12 @@
-#include "render/scene.h"
+#include "src/render/scene.h"
 
 #include <cmath>
 #include <numbers>
 
-#include "core/log.h"
-#include "core/rgb_to_spectrum.h"
-#include "render/materials/ior.h"
-#include "render/sun/sun.h"
+#include "src/core/log.h"
+#include "src/core/rgb_to_spectrum.h"
+#include "src/render/materials/ior.h"
+#include "src/render/sun/sun.h"
 
 namespace nave::render {
 

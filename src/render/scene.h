@@ -10,18 +10,18 @@
 #include <string>
 #include <vector>
 
-#include "core/sampling.h"
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "render/brick_source.h"
-#include "render/camera.h"
-#include "render/materials/bxdf.h"
-#include "render/materials/frame.h"
-#include "render/materials/materials.h"
-#include "render/scene_config.h"
-#include "render/sun/sky.h"
-#include "render/texture/surface_textures.h"
+#include "src/core/sampling.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/brick_source.h"
+#include "src/render/camera.h"
+#include "src/render/materials/bxdf.h"
+#include "src/render/materials/frame.h"
+#include "src/render/materials/materials.h"
+#include "src/render/scene_config.h"
+#include "src/render/sun/sky.h"
+#include "src/render/texture/surface_textures.h"
 
 namespace nave::render {
 

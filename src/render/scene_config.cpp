@@ -1,4 +1,4 @@
-#include "render/scene_config.h"
+#include "src/render/scene_config.h"
 
 #include <toml++/toml.h>
 
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <set>
 
-#include "core/file.h"
-#include "core/memory.h"
-#include "core/spectrum.h"
-#include "render/sun/spa.h"
+#include "src/core/file.h"
+#include "src/core/memory.h"
+#include "src/core/spectrum.h"
+#include "src/render/sun/spa.h"
 
 namespace nave::render {
 

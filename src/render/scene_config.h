@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "core/color.h"
-#include "core/status.h"
-#include "core/vecmath.h"
+#include "src/core/color.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
 
 namespace nave::render {
 

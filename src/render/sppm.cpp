@@ -1,16 +1,16 @@
-#include "render/sppm.h"
+#include "src/render/sppm.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
 
-#include "core/atomic_add.h"
-#include "core/byte_stream.h"
-#include "core/color.h"
-#include "render/rng.h"
-#include "render/scene.h"
-#include "render/transport_common.h"
+#include "src/core/atomic_add.h"
+#include "src/core/byte_stream.h"
+#include "src/core/color.h"
+#include "src/render/rng.h"
+#include "src/render/scene.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 

@@ -46,10 +46,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "core/vecmath.h"
-#include "imaging/texture_cache.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/imaging/texture_cache.h"
 #include "store/brick_tree.h"
 
 namespace nave {

@@ -1,19 +1,19 @@
-#include "render/sppm_integrator.h"
+#include "src/render/sppm_integrator.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
 
-#include "core/byte_stream.h"
-#include "core/image_error.h"
-#include "core/progress.h"
-#include "render/light_sampling.h"
-#include "render/path_integrator.h"
-#include "render/rng.h"
-#include "render/stopping_rule.h"
-#include "render/surface_hit.h"
-#include "render/transport_common.h"
+#include "src/core/byte_stream.h"
+#include "src/core/image_error.h"
+#include "src/core/progress.h"
+#include "src/render/light_sampling.h"
+#include "src/render/path_integrator.h"
+#include "src/render/rng.h"
+#include "src/render/stopping_rule.h"
+#include "src/render/surface_hit.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 

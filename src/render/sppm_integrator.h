@@ -9,16 +9,16 @@
 #include <span>
 #include <vector>
 
-#include "core/status.h"
-#include "render/brick_source.h"
-#include "render/film.h"
-#include "render/integrator.h"
-#include "render/photon_emission.h"
-#include "render/ray.h"
-#include "render/render_session.h"
-#include "render/scene.h"
-#include "render/sppm.h"
-#include "render/stream_scheduler.h"
+#include "src/core/status.h"
+#include "src/render/brick_source.h"
+#include "src/render/film.h"
+#include "src/render/integrator.h"
+#include "src/render/photon_emission.h"
+#include "src/render/ray.h"
+#include "src/render/render_session.h"
+#include "src/render/scene.h"
+#include "src/render/sppm.h"
+#include "src/render/stream_scheduler.h"
 
 namespace nave::render {
 

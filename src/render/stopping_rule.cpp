@@ -1,10 +1,10 @@
-#include "render/stopping_rule.h"
+#include "src/render/stopping_rule.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
 
-#include "core/progress.h"
+#include "src/core/progress.h"
 
 namespace nave::render {
 

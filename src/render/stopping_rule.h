@@ -5,7 +5,7 @@
 #include <chrono>
 #include <functional>
 
-#include "render/scene_config.h"
+#include "src/render/scene_config.h"
 
 namespace nave {
 class ProgressBar;

@@ -1,4 +1,4 @@
-#include "render/stream_scheduler.h"
+#include "src/render/stream_scheduler.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <chrono>
 
-#include "core/check.h"
-#include "core/trace.h"
-#include "render/brick_walk.h"
+#include "src/core/check.h"
+#include "src/core/trace.h"
+#include "src/render/brick_walk.h"
 
 namespace nave::render {
 namespace {

@@ -14,14 +14,14 @@
 #include <utility>
 #include <vector>
 
-#include "core/status.h"
-#include "render/brick_mesh_cache.h"
-#include "render/brick_source.h"
-#include "render/integrator.h"
-#include "render/pager.h"
-#include "render/ray.h"
-#include "render/ray_exchange.h"
-#include "render/ray_queue.h"
+#include "src/core/status.h"
+#include "src/render/brick_mesh_cache.h"
+#include "src/render/brick_source.h"
+#include "src/render/integrator.h"
+#include "src/render/pager.h"
+#include "src/render/ray.h"
+#include "src/render/ray_exchange.h"
+#include "src/render/ray_queue.h"
 #include "store/brick_tree.h"
 
 namespace nave::render {

@@ -1,4 +1,4 @@
-#include "render/surface_hit.h"
+#include "src/render/surface_hit.h"
 
 namespace nave::render {
 

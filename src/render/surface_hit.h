@@ -6,10 +6,10 @@
 #include <array>
 #include <cmath>
 
-#include "core/vecmath.h"
-#include "render/brick_source.h"
-#include "render/materials/bxdf.h"
-#include "render/scene.h"
+#include "src/core/vecmath.h"
+#include "src/render/brick_source.h"
+#include "src/render/materials/bxdf.h"
+#include "src/render/scene.h"
 
 namespace nave::render {
 

@@ -1,4 +1,4 @@
-#include "render/transport_common.h"
+#include "src/render/transport_common.h"
 
 namespace nave::render {
 

@@ -9,13 +9,13 @@
 #include <functional>
 #include <limits>
 
-#include "core/status.h"
-#include "render/brick_walk.h"
-#include "render/ray.h"
-#include "render/rng.h"
-#include "render/scene.h"
-#include "render/stream_scheduler.h"
-#include "render/surface_hit.h"
+#include "src/core/status.h"
+#include "src/render/brick_walk.h"
+#include "src/render/ray.h"
+#include "src/render/rng.h"
+#include "src/render/scene.h"
+#include "src/render/stream_scheduler.h"
+#include "src/render/surface_hit.h"
 
 namespace nave::render {
 

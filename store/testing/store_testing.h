@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "core/status.h"
+#include "src/core/status.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"

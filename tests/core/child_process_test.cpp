@@ -1,7 +1,7 @@
 // RunInChildProcess: what the child sends arrives whole, and a child that aborts, is killed or
 // exits with an error becomes an outcome the parent can report, never the parent's own death.
 
-#include "core/child_process.h"
+#include "src/core/child_process.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/memory.h"
+#include "src/core/memory.h"
 
 namespace nave {
 namespace {

@@ -1,10 +1,10 @@
 // Colorimetry against published values; each test names its source.
 
-#include "core/color.h"
+#include "src/core/color.h"
 
 #include <gtest/gtest.h>
 
-#include "core/illuminant.h"
+#include "src/core/illuminant.h"
 
 namespace nave {
 namespace {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "core/color.h"
-#include "core/illuminant.h"
-#include "core/spectrum_data.h"
+#include "src/core/color.h"
+#include "src/core/illuminant.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 namespace {

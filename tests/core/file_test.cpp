@@ -1,4 +1,4 @@
-#include "core/file.h"
+#include "src/core/file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "core/image_error.h"
+#include "src/core/image_error.h"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-#include "core/page_region.h"
+#include "src/core/page_region.h"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
 
-#include "core/memory.h"
+#include "src/core/memory.h"
 
 namespace nave {
 namespace {

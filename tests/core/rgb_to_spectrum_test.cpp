@@ -1,7 +1,7 @@
 // RGB -> spectrum uplift (Jakob & Hanika 2019): round trips through the CIE observer, bounds,
 // greys, emission.
 
-#include "core/rgb_to_spectrum.h"
+#include "src/core/rgb_to_spectrum.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <random>
 
-#include "core/color.h"
-#include "core/illuminant.h"
+#include "src/core/color.h"
+#include "src/core/illuminant.h"
 
 namespace nave {
 namespace {

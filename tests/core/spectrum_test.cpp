@@ -1,6 +1,6 @@
 // Tests of spectra, wavelength sampling and spectral CSV parsing.
 
-#include "core/spectrum.h"
+#include "src/core/spectrum.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/color.h"
-#include "core/illuminant.h"
-#include "core/spectrum_data.h"
+#include "src/core/color.h"
+#include "src/core/illuminant.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/trace.h"
+#include "src/core/trace.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/file.h"
+#include "src/core/file.h"
 
 namespace nave {
 namespace {

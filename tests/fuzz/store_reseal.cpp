@@ -2,8 +2,8 @@
 
 #include <cstring>
 
-#include "core/check.h"
-#include "core/hash.h"
+#include "src/core/check.h"
+#include "src/core/hash.h"
 #include "store/store_format.h"
 
 namespace nave::fuzz {

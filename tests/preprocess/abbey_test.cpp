@@ -8,14 +8,14 @@
 
 #include <algorithm>
 
-#include "core/spectrum.h"
-#include "core/spectrum_data.h"
-#include "imaging/image_io.h"
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/abbey/glass_textures.h"
 #include "preprocess/abbey/materials.h"
 #include "preprocess/abbey/primitives.h"
+#include "src/core/spectrum.h"
+#include "src/core/spectrum_data.h"
+#include "src/imaging/image_io.h"
 #include "test_util.h"
 
 namespace nave::preprocess {

@@ -13,8 +13,8 @@
 
 #include "common/file_size_limit.h"
 #include "common/run_nave.h"
-#include "core/memory.h"
 #include "preprocess/preprocess.h"
+#include "src/core/memory.h"
 #include "test_util.h"
 
 namespace nave::preprocess {

@@ -10,8 +10,8 @@
 #include <fstream>
 #include <random>
 
-#include "core/file.h"
 #include "preprocess/import/triangle_check.h"
+#include "src/core/file.h"
 #include "test_util.h"
 
 namespace nave::preprocess {

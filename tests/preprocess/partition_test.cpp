@@ -10,14 +10,14 @@
 #include <random>
 #include <set>
 
-#include "core/hash.h"
-#include "core/progress.h"
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/partition/bin_file.h"
 #include "preprocess/partition/partitioner.h"
 #include "preprocess/partition/temp_dir.h"
 #include "preprocess/partition/triangle_box.h"
 #include "preprocess/preprocess.h"
+#include "src/core/hash.h"
+#include "src/core/progress.h"
 #include "store/store_reader.h"
 #include "test_util.h"
 

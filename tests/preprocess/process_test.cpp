@@ -13,7 +13,7 @@
 #include <chrono>
 #include <thread>
 
-#include "core/file.h"
+#include "src/core/file.h"
 #include "store/store_reader.h"
 #include "test_util.h"
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "common/scratch_dir.h"
-#include "core/vecmath.h"
 #include "preprocess/triangle_source.h"
+#include "src/core/vecmath.h"
 
 namespace nave::preprocess::testing {
 

@@ -15,9 +15,9 @@
 #include <fstream>
 #include <regex>
 
-#include "core/color.h"
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/color.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 
 namespace nave::preprocess {
 namespace {

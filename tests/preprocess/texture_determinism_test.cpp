@@ -15,10 +15,10 @@
 #include <thread>
 #include <vector>
 
-#include "core/file.h"
-#include "imaging/image_io.h"
 #include "preprocess/preprocess.h"
 #include "preprocess/texture_convert.h"
+#include "src/core/file.h"
+#include "src/imaging/image_io.h"
 #include "test_util.h"
 
 namespace nave::preprocess {

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "common/run_nave.h"
-#include "core/image_error.h"
-#include "imaging/image_io.h"
+#include "src/core/image_error.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::render {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/brick_mesh_cache.h"
+#include "src/render/brick_mesh_cache.h"
 
 #include <gtest/gtest.h>
 

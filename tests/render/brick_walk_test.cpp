@@ -1,14 +1,14 @@
 // Tracing across bricks: the t-range acceptance finds the same nearest hit whatever the brick
 // count.
 
-#include "render/brick_walk.h"
+#include "src/render/brick_walk.h"
 
 #include <gtest/gtest.h>
 
-#include "render/brick_source.h"
-#include "render/grid_bricks.h"
-#include "render/procedural_meshes.h"
-#include "render/rng.h"
+#include "src/render/brick_source.h"
+#include "src/render/grid_bricks.h"
+#include "src/render/procedural_meshes.h"
+#include "src/render/rng.h"
 
 namespace nave::render {
 namespace {

@@ -1,7 +1,7 @@
 // Checkpoint files: round trip, and every kind of damage refused with a message naming the file
 // and what differs.
 
-#include "render/checkpoint.h"
+#include "src/render/checkpoint.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,8 +11,8 @@
 #include <fstream>
 #include <string>
 
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 
 namespace nave::render {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave::testing {
 

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "common/run_nave.h"
-#include "core/memory.h"
-#include "core/progress.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 
 namespace nave::render {
 namespace {

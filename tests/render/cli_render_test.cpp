@@ -13,8 +13,8 @@
 #include <string>
 
 #include "common/run_nave.h"
-#include "core/file.h"
-#include "imaging/image_io.h"
+#include "src/core/file.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::render {
 namespace {

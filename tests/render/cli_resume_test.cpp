@@ -12,8 +12,8 @@
 #include <string>
 
 #include "common/run_nave.h"
-#include "core/file.h"
-#include "render/checkpoint.h"
+#include "src/core/file.h"
+#include "src/render/checkpoint.h"
 
 namespace nave::render {
 namespace {

@@ -13,10 +13,10 @@
 #include <map>
 
 #include "common/run_nave.h"
-#include "core/file.h"
-#include "core/log.h"
-#include "core/progress.h"
 #include "render_test_util.h"
+#include "src/core/file.h"
+#include "src/core/log.h"
+#include "src/core/progress.h"
 #include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/testing/store_testing.h"

@@ -13,8 +13,8 @@
 #include <cmath>
 #include <string>
 
-#include "core/progress.h"
 #include "render_test_util.h"
+#include "src/core/progress.h"
 
 namespace nave::render {
 namespace {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "core/color.h"
-#include "render/film.h"
+#include "src/core/color.h"
+#include "src/render/film.h"
 
 namespace nave::render {
 namespace {

@@ -2,16 +2,16 @@
 // checkpoint, load scratch, bricks), the wave size chosen when the bricks do not all fit, and the
 // refusals at their boundary (one byte below the least budget that works), without rendering.
 
-#include "render/memory_plan.h"
+#include "src/render/memory_plan.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include "core/memory.h"
-#include "render/film.h"
-#include "render/procedural_scenes.h"
-#include "render/render_session.h"
+#include "src/core/memory.h"
+#include "src/render/film.h"
+#include "src/render/procedural_scenes.h"
+#include "src/render/render_session.h"
 
 namespace nave::render {
 namespace {

@@ -5,11 +5,11 @@
 
 #include <vector>
 
-#include "core/color.h"
-#include "core/image_error.h"
-#include "core/progress.h"
-#include "render/procedural_meshes.h"
 #include "render_test_util.h"
+#include "src/core/color.h"
+#include "src/core/image_error.h"
+#include "src/core/progress.h"
+#include "src/render/procedural_meshes.h"
 
 namespace nave::render {
 namespace {

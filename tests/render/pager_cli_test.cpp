@@ -9,9 +9,9 @@
 
 #include "common/file_size_limit.h"
 #include "common/run_nave.h"
-#include "core/memory.h"
 #include "pager_test_scene.h"
 #include "render_test_util.h"
+#include "src/core/memory.h"
 
 namespace nave::render {
 namespace {

@@ -3,7 +3,7 @@
 // refuses an impossible budget naming the largest brick, and returns a corrupt brick's error when
 // it meets it.
 
-#include "render/pager.h"
+#include "src/render/pager.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,12 +13,12 @@
 
 #include "common/file_size_limit.h"
 #include "common/run_nave.h"
-#include "core/memory.h"
-#include "core/progress.h"
 #include "pager_test_scene.h"
-#include "render/procedural_meshes.h"
-#include "render/ray.h"
 #include "render_test_util.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
+#include "src/render/procedural_meshes.h"
+#include "src/render/ray.h"
 #include "store/store_reader.h"
 
 namespace nave::render {

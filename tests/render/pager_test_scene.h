@@ -1,7 +1,7 @@
 #pragma once
-// The scene of the pager tests (a floor, a grid of balls and a lamp under sun and sky), shared by the
-// in-process pager tests and the `nave render --memory` ones: its material names and its config, a
-// format string whose one field is the render mode.
+// The scene of the pager tests (a floor, a grid of balls and a lamp under sun and sky), shared by
+// the in-process pager tests and the `nave render --memory` ones: its material names and its
+// config, a format string whose one field is the render mode.
 
 #include <string>
 #include <vector>
@@ -18,7 +18,7 @@ look_at = [0, 0, 0.5]
 fov_deg = 50
 resolution = [32, 24]
 )" + testing::SunSkyFloorAndBall() +
-                              R"(
+                                     R"(
 [materials.lamp]
 reflectance = 0.5
 emission = 2.0
@@ -29,6 +29,5 @@ iterations = 2
 photons_per_iteration = 20000
 seed = 5
 )";
-
 
 }  // namespace nave::render

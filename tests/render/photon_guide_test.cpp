@@ -1,10 +1,10 @@
-#include "render/photon_guide.h"
+#include "src/render/photon_guide.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "render/rng.h"
+#include "src/render/rng.h"
 
 namespace nave::render {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/ray_queue.h"
+#include "src/render/ray_queue.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The facts at the end of a render: the EXR metadata keeps the keys and formats bench/ scripts
 // read, and the terminal summary shows the same facts with the same values.
 
-#include "render/render_summary.h"
+#include "src/render/render_summary.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include "core/memory.h"
-#include "core/progress.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
 
 namespace nave::render {
 namespace {

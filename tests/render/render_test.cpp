@@ -6,13 +6,13 @@
 
 #include <filesystem>
 
-#include "core/color.h"
-#include "core/progress.h"
-#include "core/sampling.h"
-#include "render/procedural_meshes.h"
-#include "render/sun/sky.h"
-#include "render/sun/sun.h"
 #include "render_test_util.h"
+#include "src/core/color.h"
+#include "src/core/progress.h"
+#include "src/core/sampling.h"
+#include "src/render/procedural_meshes.h"
+#include "src/render/sun/sky.h"
+#include "src/render/sun/sun.h"
 
 namespace nave::render {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/check.h"
+#include "src/core/check.h"
 
 namespace nave::render::testing {
 

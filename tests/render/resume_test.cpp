@@ -10,15 +10,15 @@
 #include <memory>
 #include <string>
 
-#include "core/byte_stream.h"
-#include "render/checkpoint.h"
-#include "render/film.h"
-#include "render/integrator.h"
-#include "render/procedural_scenes.h"
-#include "render/render_session.h"
-#include "render/scene.h"
-#include "render/scene_config.h"
 #include "render_test_util.h"
+#include "src/core/byte_stream.h"
+#include "src/render/checkpoint.h"
+#include "src/render/film.h"
+#include "src/render/integrator.h"
+#include "src/render/procedural_scenes.h"
+#include "src/render/render_session.h"
+#include "src/render/scene.h"
+#include "src/render/scene_config.h"
 
 namespace nave::render {
 namespace {

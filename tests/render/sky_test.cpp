@@ -1,12 +1,12 @@
 // Preetham et al. (1999) sky: structure of the model and consistency of its spectra.
 
-#include "render/sun/sky.h"
+#include "src/render/sun/sky.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/color.h"
+#include "src/core/color.h"
 
 namespace nave {
 namespace {

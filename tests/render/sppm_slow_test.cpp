@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "core/progress.h"
-#include "render/procedural_meshes.h"
 #include "render_test_util.h"
+#include "src/core/progress.h"
+#include "src/render/procedural_meshes.h"
 
 namespace nave::render {
 namespace {

@@ -1,6 +1,6 @@
 // Solar position and the sun's spectrum against published values; each test names its source.
 
-#include "render/sun/sun.h"
+#include "src/render/sun/sun.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <cmath>
 #include <vector>
 
-#include "core/color.h"
-#include "core/sampling.h"
-#include "render/sun/spa.h"
+#include "src/core/color.h"
+#include "src/core/sampling.h"
+#include "src/render/sun/spa.h"
 
 namespace nave {
 namespace {

@@ -11,11 +11,11 @@
 #include <memory>
 #include <string>
 
-#include "core/color.h"
-#include "core/file.h"
-#include "imaging/texture_cache.h"
-#include "render/texture/surface_textures.h"
 #include "render_test_util.h"
+#include "src/core/color.h"
+#include "src/core/file.h"
+#include "src/imaging/texture_cache.h"
+#include "src/render/texture/surface_textures.h"
 
 namespace nave::render {
 namespace {

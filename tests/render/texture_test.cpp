@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "imaging/texture_cache.h"
-#include "render/texture/spectral_texture.h"
+#include "src/imaging/texture_cache.h"
+#include "src/render/texture/spectral_texture.h"
 
 namespace nave::render {
 namespace {

@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "common/run_nave.h"
-#include "core/file.h"
+#include "src/core/file.h"
 #include "store/store_reader.h"
 #include "store/testing/store_testing.h"
 #include "test_util.h"

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <random>
 
-#include "core/file.h"
-#include "core/hash.h"
+#include "src/core/file.h"
+#include "src/core/hash.h"
 #include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/store_writer.h"

@@ -8,8 +8,8 @@
 
 #include <fstream>
 
-#include "core/file.h"
 #include "fuzz/store_reseal.h"
+#include "src/core/file.h"
 #include "store/store_reader.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-#include "imaging/oiio/oiio_status.h"
+#include "src/imaging/oiio/oiio_status.h"
 
 #include <OpenImageIO/imageio.h>
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/status.h"
+#include "src/core/status.h"
 
 namespace nave::imaging::oiio {
 

@@ -1,4 +1,4 @@
-#include "imaging/oiio/oiio_texture_cache.h"
+#include "src/imaging/oiio/oiio_texture_cache.h"
 
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
@@ -8,8 +8,8 @@
 #include <mutex>
 #include <vector>
 
-#include "core/check.h"
-#include "imaging/oiio/oiio_status.h"
+#include "src/core/check.h"
+#include "src/imaging/oiio/oiio_status.h"
 
 namespace nave::imaging::oiio {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "imaging/texture_cache.h"
+#include "src/imaging/texture_cache.h"
 
 namespace nave::imaging::oiio {
 

@@ -8,10 +8,10 @@
 
 #include <system_error>
 
-#include "imaging/image_io.h"
-#include "imaging/oiio/oiio_status.h"
-#include "imaging/oiio/oiio_texture_cache.h"
-#include "imaging/oiio_plugin.h"
+#include "src/imaging/image_io.h"
+#include "src/imaging/oiio/oiio_status.h"
+#include "src/imaging/oiio/oiio_texture_cache.h"
+#include "src/imaging/oiio_plugin.h"
 
 namespace nave::imaging::oiio {
 namespace {

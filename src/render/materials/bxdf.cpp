@@ -1,4 +1,4 @@
-#include "render/materials/bxdf.h"
+#include "src/render/materials/bxdf.h"
 
 #include <complex>
 

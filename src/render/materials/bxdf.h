@@ -14,10 +14,10 @@
 #include <optional>
 #include <variant>
 
-#include "core/sampling.h"
-#include "core/spectrum.h"
-#include "core/vecmath.h"
-#include "render/materials/frame.h"
+#include "src/core/sampling.h"
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
+#include "src/render/materials/frame.h"
 
 namespace nave {
 

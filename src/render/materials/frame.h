@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "core/vecmath.h"
+#include "src/core/vecmath.h"
 
 namespace nave {
 

@@ -1,10 +1,10 @@
-#include "render/materials/ior.h"
+#include "src/render/materials/ior.h"
 
 #include <cctype>
 #include <cmath>
 #include <string>
 
-#include "core/spectrum_data.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 

@@ -3,8 +3,8 @@
 
 #include <string_view>
 
-#include "core/spectrum.h"
-#include "core/status.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
 
 namespace nave {
 

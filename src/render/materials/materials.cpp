@@ -1,10 +1,10 @@
-#include "render/materials/materials.h"
+#include "src/render/materials/materials.h"
 
 #include <cmath>
 
-#include "core/pane.h"
-#include "core/spectrum_data.h"
-#include "render/materials/ior.h"
+#include "src/core/pane.h"
+#include "src/core/spectrum_data.h"
+#include "src/render/materials/ior.h"
 
 namespace nave {
 

@@ -9,9 +9,9 @@
 #include <variant>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "render/materials/bxdf.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/render/materials/bxdf.h"
 
 namespace nave {
 

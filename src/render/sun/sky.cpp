@@ -1,12 +1,12 @@
-#include "render/sun/sky.h"
+#include "src/render/sun/sky.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-#include "core/check.h"
-#include "core/color.h"
-#include "core/spectrum_data.h"
+#include "src/core/check.h"
+#include "src/core/color.h"
+#include "src/core/spectrum_data.h"
 
 namespace nave {
 

@@ -6,8 +6,8 @@
 // a sun well above the horizon; too bright near the horizon at low sun. Good enough for a first
 // interior daylight.
 
-#include "core/spectrum.h"
-#include "core/vecmath.h"
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
 
 namespace nave {
 

@@ -1,11 +1,11 @@
-#include "render/sun/spa.h"
+#include "src/render/sun/spa.h"
 
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numbers>
 
-#include "render/sun/spa_tables.h"
+#include "src/render/sun/spa_tables.h"
 
 namespace nave {
 

@@ -1,6 +1,6 @@
 // Data of Reda & Andreas (2004), Tables A4.2 and A4.3 (see spa_tables.h).
 
-#include "render/sun/spa_tables.h"
+#include "src/render/sun/spa_tables.h"
 
 #include <cstddef>
 

@@ -1,12 +1,12 @@
-#include "render/sun/sun.h"
+#include "src/render/sun/sun.h"
 
 #include <cmath>
 #include <numbers>
 
-#include "core/check.h"
-#include "core/color.h"
-#include "core/spectrum_data.h"
-#include "render/materials/frame.h"
+#include "src/core/check.h"
+#include "src/core/color.h"
+#include "src/core/spectrum_data.h"
+#include "src/render/materials/frame.h"
 
 namespace nave {
 

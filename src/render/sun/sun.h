@@ -12,10 +12,10 @@
 // λ^-α (Ångström 1929, β from the turbidity as in Preetham et al. 1999); T_g, T_w: O2 and
 // water-vapour bands (Leckner 1978).
 
-#include "core/sampling.h"
-#include "core/spectrum.h"
-#include "core/vecmath.h"
-#include "render/sun/spa.h"
+#include "src/core/sampling.h"
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
+#include "src/render/sun/spa.h"
 
 namespace nave {
 

@@ -1,11 +1,11 @@
-#include "render/texture/spectral_texture.h"
+#include "src/render/texture/spectral_texture.h"
 
 #include <algorithm>
 #include <array>
 #include <charconv>
 #include <string>
 
-#include "imaging/image_io.h"
+#include "src/imaging/image_io.h"
 
 namespace nave::render {
 

@@ -9,10 +9,10 @@
 #include <span>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "imaging/image_io.h"
-#include "imaging/texture_cache.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/imaging/image_io.h"
+#include "src/imaging/texture_cache.h"
 
 namespace nave::render {
 

@@ -1,9 +1,9 @@
-#include "render/texture/surface_textures.h"
+#include "src/render/texture/surface_textures.h"
 
 #include <atomic>
 
-#include "core/log.h"
-#include "core/rgb_to_spectrum.h"
+#include "src/core/log.h"
+#include "src/core/rgb_to_spectrum.h"
 
 namespace nave::render {
 namespace {

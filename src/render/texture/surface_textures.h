@@ -24,11 +24,11 @@
 #include <string>
 #include <vector>
 
-#include "core/spectrum.h"
-#include "core/status.h"
-#include "imaging/texture_cache.h"
-#include "render/brick_source.h"
-#include "render/texture/spectral_texture.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/imaging/texture_cache.h"
+#include "src/render/brick_source.h"
+#include "src/render/texture/spectral_texture.h"
 #include "store/material_record.h"
 
 namespace nave::render {
