@@ -3,7 +3,8 @@
 # -fsanitize=thread into build/deps/tbb-tsan, for the `tsan` preset. ThreadSanitizer sees a TBB task's
 # hand-off from the thread that spawns it to the one that runs it only if libtbb itself is instrumented;
 # with Debian's binary libtbb every parallel_for is reported as a race. Skips everything when the build
-# for this version is already there. `scripts/test.sh tsan` calls it.
+# for this version is already there. `scripts/test.sh tsan` calls it. Exit code 3: what it needs could
+# not be downloaded (no network); anything else non-zero is a failure of the build itself.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,7 +18,10 @@ prefix=build/deps/tbb-tsan
 stamp="$prefix/.built-$version-$debian_revision"
 if [[ -f $stamp ]]; then exit 0; fi
 
-bash scripts/setup-debian.sh build-essential cmake ninja-build curl ca-certificates xz-utils patch libtbb-dev
+if ! bash scripts/setup-debian.sh build-essential cmake ninja-build curl ca-certificates xz-utils patch libtbb-dev; then
+  echo "nave tsan-tbb: cannot install the packages needed to fetch and build oneTBB" >&2
+  exit 3
+fi
 installed=$(dpkg-query -W -f='${Version}' libtbb-dev)
 if [[ $installed != "$version-$debian_revision" ]]; then
   echo "nave tsan-tbb: libtbb-dev $installed is installed but this script builds $version-$debian_revision;" \
@@ -42,8 +46,8 @@ fetch() {  # FILE SHA256: from the Debian pool, or from the snapshot archive onc
 }
 orig=onetbb_$version.orig.tar.xz
 deb=onetbb_$version-$debian_revision.debian.tar.xz
-fetch "$orig" "$orig_sha256"
-fetch "$deb" "$debian_sha256"
+fetch "$orig" "$orig_sha256" || exit 3
+fetch "$deb" "$debian_sha256" || exit 3
 tar -C "$work" -xf "$work/$orig"
 tar -C "$work/oneTBB-$version" -xf "$work/$deb"
 (cd "$work/oneTBB-$version" && while read -r p; do
