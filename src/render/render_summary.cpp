@@ -108,24 +108,22 @@ RenderSummary::RenderSummary(const RenderSettings& settings, const RenderStats& 
     }
 }
 
-void RenderSummary::Add(std::string_view attribute, std::string_view key, Unit unit,
-                        uint64_t integer) {
-    RenderFact fact;
+RenderFact& RenderSummary::Push(std::string_view attribute, std::string_view key, Unit unit) {
+    RenderFact& fact = facts_.emplace_back();
     fact.attribute = attribute;
     fact.key = key;
     fact.unit = unit;
-    fact.integer = integer;
-    facts_.push_back(fact);
+    return fact;
+}
+
+void RenderSummary::Add(std::string_view attribute, std::string_view key, Unit unit,
+                        uint64_t integer) {
+    Push(attribute, key, unit).integer = integer;
 }
 
 void RenderSummary::AddReal(std::string_view attribute, std::string_view key, Unit unit,
                             double real) {
-    RenderFact fact;
-    fact.attribute = attribute;
-    fact.key = key;
-    fact.unit = unit;
-    fact.real = real;
-    facts_.push_back(fact);
+    Push(attribute, key, unit).real = real;
 }
 
 void RenderSummary::RecordProcessPeak(uint64_t bytes) {

@@ -80,6 +80,8 @@ class RenderSummary {
     std::vector<std::string> TerminalLines(const std::string& memory_text) const;
 
   private:
+    /// A new fact of `key` in `attribute`, its value still to set.
+    RenderFact& Push(std::string_view attribute, std::string_view key, RenderFact::Unit unit);
     void Add(std::string_view attribute, std::string_view key, RenderFact::Unit unit,
              uint64_t integer);
     void AddReal(std::string_view attribute, std::string_view key, RenderFact::Unit unit,
