@@ -189,7 +189,7 @@ std::vector<std::string> RenderSummary::TerminalLines(const std::string& memory_
         stat("wall"), own("rays_per_s"), stat("rays"), stat("segments"), stat("shadow_segments"),
         own("photons_per_s")));
     lines.push_back(fmt::format(
-        "rays moved between bricks {}, brick visits {}, loads {}, read {}, peak memory {} ({} "
+        "rays moved between bricks {}, batches {}, loads {}, read {}, peak memory {} ({} "
         "bytes), peak queues {}",
         stat("brick_moves"), stat("batches"), stat("brick_loads"), stat("bytes_read"),
         own("process_peak_rss"), Integer("process_peak_rss"), own("peak_queue_bytes")));

@@ -46,7 +46,7 @@ void ExpectSummaryMatchesMetadata(const std::string& extra, const std::string& b
     for (const std::string& phrase : {
              fmt::format("({} rays: {} segments traced, {} shadow segments)", count("rays"),
                          count("segments"), count("shadow_segments")),
-             fmt::format("rays moved between bricks {}, brick visits {}, loads {}, read {},",
+             fmt::format("rays moved between bricks {}, batches {}, loads {}, read {},",
                          count("brick_moves"), count("batches"), count("brick_loads"),
                          bytes("bytes_read")),
              fmt::format(", evictions {}, reloads {}, prefetched {}, resident when needed {} of ",

@@ -107,7 +107,7 @@ TEST(RenderSummaryTest, TheTerminalShowsTheMetadataFacts) {
         {"segments", " {} segments traced"},
         {"shadow_segments", " {} shadow segments"},
         {"brick_moves", "rays moved between bricks {},"},
-        {"batches", "brick visits {},"},
+        {"batches", "batches {},"},
         {"brick_loads", " loads {},"},
         {"bytes_read", " read {},"},
         {"brick_budget", "bricks: budget {} (--memory 620M)"},
