@@ -32,10 +32,10 @@ int ReadInChild(const std::filesystem::path& path, int fd) {
 // How long Assimp may take on a file: generous for what its slowest readers do with a valid file
 // (a few MiB per minute of text formats and post-processing), so that only a reader stuck in a
 // loop on damaged data reaches it.
+constexpr double kAssimpBaseSeconds = 300;
+constexpr double kAssimpSecondsPerMiB = 60;
 double AssimpTimeLimitSeconds(uintmax_t file_bytes) {
-    constexpr double kBaseSeconds = 300;
-    constexpr double kSecondsPerMiB = 60;
-    return kBaseSeconds + kSecondsPerMiB * double(file_bytes) / double(1 << 20);
+    return kAssimpBaseSeconds + kAssimpSecondsPerMiB * double(file_bytes) / double(1 << 20);
 }
 
 // The last non-empty line a crashed child printed (Assimp's assertion message), shortened.
@@ -69,9 +69,10 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
     if (child.timed_out) {
         return DataLossError(
             "{}: the Assimp importer was stopped after {:.0f} s reading this file of {} bytes "
-            "(its limit: 300 s + 60 s per MiB), the sign of a reader stuck on damaged data; repair "
-            "or re-export it (glTF, OBJ and PLY are read by nave itself)",
-            path.string(), time_limit, ec ? 0 : file_bytes);
+            "(its limit: {:.0f} s + {:.0f} s per MiB), the sign of a reader stuck on damaged data; "
+            "repair or re-export it (glTF, OBJ and PLY are read by nave itself)",
+            path.string(), time_limit, ec ? 0 : file_bytes, kAssimpBaseSeconds,
+            kAssimpSecondsPerMiB);
     }
     if (!child.exited || child.exit_code != 0) {
         const int code = child.exit_code - kErrorExitBase;

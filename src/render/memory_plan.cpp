@@ -7,6 +7,16 @@
 #include "src/render/render_session.h"
 
 namespace nave::render {
+namespace {
+
+// ", of which X for the texture cache" when there is one: the refusal and the plan's line alike.
+std::string TextureCacheClause(uint64_t texture_cache_bytes) {
+    return texture_cache_bytes > 0 ? fmt::format(", of which {} for the texture cache",
+                                                 FormatBytes(texture_cache_bytes))
+                                   : std::string();
+}
+
+}  // namespace
 
 uint64_t TextureCacheCapBytes(const TextureConfig& textures, std::optional<uint64_t> memory_bytes) {
     if (!memory_bytes) return textures.cache_bytes;
@@ -79,12 +89,9 @@ StatusOr<RenderMemoryPlan> RenderMemoryPlan::Make(const RenderMemoryInputs& in) 
             "resident at once take {}, {} bytes)",
             in.memory_text, in.memory_bytes, in.bricks.DescribeLargest(in.pager.prefetch),
             FormatBytes(plan.reserve_bytes_), plan.reserve_bytes_,
-            plan.texture_cache_bytes_ > 0 ? fmt::format(", of which {} for the texture cache",
-                                                        FormatBytes(plan.texture_cache_bytes_))
-                                          : std::string(),
-            FormatBytes(plan.image_writer_bytes_), plan.image_writer_bytes_,
-            FormatBytes(plan.minimum_bytes_), plan.minimum_bytes_, in.brick_count,
-            FormatBytes(in.bricks.total_bytes), in.bricks.total_bytes);
+            TextureCacheClause(plan.texture_cache_bytes_), FormatBytes(plan.image_writer_bytes_),
+            plan.image_writer_bytes_, FormatBytes(plan.minimum_bytes_), plan.minimum_bytes_,
+            in.brick_count, FormatBytes(in.bricks.total_bytes), in.bricks.total_bytes);
     }
     plan.brick_budget_bytes_ = in.memory_bytes - plan.reserve_bytes_;
     // The one budget that would read as in-core (kUnlimitedBrickBudget) is a byte short of it.
@@ -105,10 +112,7 @@ std::string RenderMemoryPlan::Describe() const {
         "reserved{}",
         FormatBytes(memory_bytes_), FormatBytes(brick_budget_bytes_),
         FormatBytes(all_bricks_bytes_), brick_count_, all_bricks_bytes_,
-        FormatBytes(reserve_bytes_), reserve_bytes_,
-        texture_cache_bytes_ > 0
-            ? fmt::format(", of which {} for the texture cache", FormatBytes(texture_cache_bytes_))
-            : std::string());
+        FormatBytes(reserve_bytes_), reserve_bytes_, TextureCacheClause(texture_cache_bytes_));
 }
 
 std::string RenderMemoryPlan::DescribeWaves() const {

@@ -8,6 +8,28 @@
 #include "src/render/brick_source.h"
 
 namespace nave::render {
+namespace {
+
+// Embree's ray over [t0, t1] from `origin` along `dir`, for a hit query and an occlusion query
+// alike.
+RTCRay EmbreeRay(const Vec3f& origin, const Vec3f& dir, float t0, float t1) {
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.tnear = t0;
+    ray.tfar = t1;
+    ray.time = 0;
+    ray.mask = 0xffffffffu;
+    ray.id = 0;
+    ray.flags = 0;
+    return ray;
+}
+
+}  // namespace
 
 uint64_t BvhSettings::BytesPerTriangle() const {
     // Embree's own count of its allocations (its memory monitor) after building abbey bricks of
@@ -136,18 +158,7 @@ bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, f
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
-    rh.ray.org_x = origin.x;
-    rh.ray.org_y = origin.y;
-    rh.ray.org_z = origin.z;
-    rh.ray.dir_x = dir.x;
-    rh.ray.dir_y = dir.y;
-    rh.ray.dir_z = dir.z;
-    rh.ray.tnear = t0;
-    rh.ray.tfar = t1;
-    rh.ray.time = 0;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    rh.ray = EmbreeRay(origin, dir, t0, t1);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(static_cast<RTCScene>(scene_), &context, &rh);
@@ -163,19 +174,7 @@ bool ResidentBrick::Intersect(const Vec3f& origin, const Vec3f& dir, float t0, f
 bool ResidentBrick::Occluded(const Vec3f& origin, const Vec3f& dir, float t0, float t1) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.tnear = t0;
-    ray.tfar = t1;
-    ray.time = 0;
-    ray.mask = 0xffffffffu;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = EmbreeRay(origin, dir, t0, t1);
     rtcOccluded1(static_cast<RTCScene>(scene_), &context, &ray);
     return ray.tfar == -std::numeric_limits<float>::infinity();
 }
