@@ -131,6 +131,10 @@ StatusOr<TextureConvertStats> ConvertTextures(std::vector<store::MaterialRecord>
         std::string file_name =
             fmt::format("{}{}.{}.{}", source.stem().string(), colour ? "" : ".data",
                         ChecksumHex(source_checksum), extension);
+        if (Status synced = SyncFile(temp); !synced.ok()) {
+            std::filesystem::remove(temp, ec);
+            return synced;
+        }
         std::filesystem::rename(temp, folder / file_name, ec);
         if (ec) {
             std::filesystem::remove(temp, ec);

@@ -81,11 +81,11 @@ StatusOr<std::unique_ptr<PreparedSession>> PrepareSession(
 
 void RemoveStaleRenderTemporaries(const std::filesystem::path& output,
                                   const std::filesystem::path& checkpoint) {
-    // Image writes go through "<stem>.tmp-<pid>-<n>.exr" (and .png), checkpoints through
-    // "<name>.tmp-<pid>-<n>" (AtomicFile).
-    const std::string stem = output.stem().string() + ".tmp-";
-    LogRemoved(RemoveStaleTemporaries(DirOf(output), stem, ".exr"));
-    LogRemoved(RemoveStaleTemporaries(DirOf(output), stem, ".png"));
+    // Images and checkpoints are written through "<name>.tmp-<pid>-<n>" (AtomicFile).
+    std::filesystem::path png = output;
+    png.replace_extension(".png");
+    LogRemoved(RemoveStaleTemporaries(DirOf(output), output.filename().string() + ".tmp-"));
+    LogRemoved(RemoveStaleTemporaries(DirOf(png), png.filename().string() + ".tmp-"));
     if (!checkpoint.empty())
         LogRemoved(
             RemoveStaleTemporaries(DirOf(checkpoint), checkpoint.filename().string() + ".tmp-"));

@@ -27,6 +27,15 @@ Status FsyncDirectory(const std::filesystem::path& dir) {
 
 }  // namespace
 
+Status SyncFile(const std::filesystem::path& path) {
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return IoError("cannot open {} to sync it: {}", path.string(), ErrnoText());
+    int rc = ::fsync(fd);
+    ::close(fd);
+    if (rc != 0) return IoError("cannot sync {}: {}", path.string(), ErrnoText());
+    return Status::Ok();
+}
+
 StatusOr<AtomicFile> AtomicFile::Create(const std::filesystem::path& path) {
     std::filesystem::path temp = path;
     temp += fmt::format(".tmp-{}-{}", ::getpid(), g_temp_counter.fetch_add(1));
@@ -89,6 +98,12 @@ Status AtomicFile::WriteAt(uint64_t offset, const void* data, size_t size) {
         left -= size_t(n);
     }
     size_ = std::max(size_, offset + size);
+    return Status::Ok();
+}
+
+Status AtomicFile::Sync() {
+    NAVE_CHECK(fd_ >= 0) << "sync of a closed AtomicFile " << path_;
+    if (::fsync(fd_) != 0) return IoError("cannot sync {}: {}", temp_path_.string(), ErrnoText());
     return Status::Ok();
 }
 

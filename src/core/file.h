@@ -34,6 +34,10 @@ class AtomicFile {
     Status WriteAt(uint64_t offset, const void* data, size_t size);
     /// Bytes written so far (the offset of the next Write).
     uint64_t size() const { return size_; }
+    /// fsync: what was written is on the disk (a full disk that the writes did not report shows
+    /// here), still under the temporary name. For files that must appear together: sync each,
+    /// then commit each.
+    Status Sync();
     /// fsync, rename to the final name, fsync the directory.
     Status Commit();
     /// Removes the temporary file now.
@@ -74,6 +78,10 @@ class ReadOnlyFile {
     int fd_ = -1;
     uint64_t size_ = 0;
 };
+
+/// fsyncs a file another writer (a library) wrote, before it is renamed into place. A full disk
+/// that the writes did not report may show here as an IoError naming the file.
+Status SyncFile(const std::filesystem::path& path);
 
 /// Reads a whole (small) file into a string.
 StatusOr<std::string> ReadFileToString(const std::filesystem::path& path);

@@ -1,33 +1,17 @@
 #include "src/imaging/image_io.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
-#include <system_error>
 
+#include "src/core/file.h"
 #include "src/imaging/oiio_plugin.h"
 
 namespace nave::imaging {
 namespace {
 
-/// Writes through the plugin to a temporary name, then renames into place; the temporary file never
-/// outlives a failure.
-Status WriteAtomically(const std::filesystem::path& path, const ImageWriteRequest& request) {
+StatusOr<EncodedImage> Encode(const std::filesystem::path& path, const ImageWriteRequest& request) {
     NAVE_ASSIGN_OR_RETURN(const OiioPlugin* plugin, LoadOiioPlugin());
-    const std::filesystem::path temp = TemporaryImagePath(path);
-    std::error_code ec;
-    if (Status st = plugin->WriteImage(path, temp, request); !st.ok()) {
-        std::filesystem::remove(temp, ec);
-        return st;
-    }
-    std::filesystem::rename(temp, path, ec);
-    if (ec) {
-        std::filesystem::remove(temp, ec);
-        return IoError("{}: cannot rename {} into place: {}", path.string(), temp.string(),
-                       ec.message());
-    }
-    return Status::Ok();
+    NAVE_ASSIGN_OR_RETURN(std::vector<unsigned char> bytes, plugin->EncodeImage(path, request));
+    return EncodedImage{path, std::move(bytes)};
 }
 
 ImageWriteRequest FloatRequest(const FloatImage& image, const ImageMetadata& metadata) {
@@ -48,21 +32,47 @@ std::string BandChannelName(int b) {
     return fmt::format("band{:02d}", b);
 }
 
-std::filesystem::path TemporaryImagePath(const std::filesystem::path& path) {
-    static std::atomic<int> counter{0};
-    std::filesystem::path p = path;
-    p.replace_filename(path.stem().string() + ".tmp-" + std::to_string(getpid()) + "-" +
-                       std::to_string(counter.fetch_add(1)) + path.extension().string());
-    return p;
+Status WriteImages(const std::vector<EncodedImage>& images) {
+    // All written and synced under temporary names before the first rename: a full disk shows as
+    // a failed write or sync, and then every file that was there before stays as it was.
+    std::vector<AtomicFile> files;
+    files.reserve(images.size());
+    for (const EncodedImage& image : images) {
+        NAVE_ASSIGN_OR_RETURN(AtomicFile file, AtomicFile::Create(image.path));
+        NAVE_RETURN_IF_ERROR(file.Write(image.bytes.data(), image.bytes.size()));
+        NAVE_RETURN_IF_ERROR(file.Sync());
+        files.push_back(std::move(file));
+    }
+    for (AtomicFile& file : files) NAVE_RETURN_IF_ERROR(file.Commit());
+    return Status::Ok();
 }
 
-Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
-                const ImageMetadata& metadata) {
+StatusOr<EncodedImage> EncodeExr(const std::filesystem::path& path, const FloatImage& image,
+                                 const ImageMetadata& metadata) {
     ImageWriteRequest request = FloatRequest(image, metadata);
     // Depth needs float's range and precision; colours are fine in half, as EXR viewers expect.
     for (const std::string& c : image.channels)
         request.stored.push_back(c == "Z" ? StoredPixel::kFloat : StoredPixel::kHalf);
-    return WriteAtomically(path, request);
+    return Encode(path, request);
+}
+
+StatusOr<EncodedImage> EncodeRgb8(const std::filesystem::path& path, int width, int height,
+                                  const std::vector<uint8_t>& rgb, const ImageMetadata& metadata) {
+    NAVE_CHECK_EQ(rgb.size(), size_t(width) * height * 3);
+    ImageWriteRequest request;
+    request.width = width;
+    request.height = height;
+    request.channels = {"R", "G", "B"};
+    request.stored.assign(3, StoredPixel::kUint8);
+    request.pixels = rgb.data();
+    request.metadata = metadata;
+    return Encode(path, request);
+}
+
+Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
+                const ImageMetadata& metadata) {
+    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, EncodeExr(path, image, metadata));
+    return WriteImages({encoded});
 }
 
 Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image, int tile_size,
@@ -77,20 +87,14 @@ Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image,
     if (!dated) request.metadata.emplace_back("DateTime", "");
     request.stored.assign(image.channels.size(), StoredPixel::kHalf);
     request.tile_size = tile_size;
-    return WriteAtomically(path, request);
+    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, Encode(path, request));
+    return WriteImages({encoded});
 }
 
 Status WriteRgb8(const std::filesystem::path& path, int width, int height,
                  const std::vector<uint8_t>& rgb, const ImageMetadata& metadata) {
-    NAVE_CHECK_EQ(rgb.size(), size_t(width) * height * 3);
-    ImageWriteRequest request;
-    request.width = width;
-    request.height = height;
-    request.channels = {"R", "G", "B"};
-    request.stored.assign(3, StoredPixel::kUint8);
-    request.pixels = rgb.data();
-    request.metadata = metadata;
-    return WriteAtomically(path, request);
+    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, EncodeRgb8(path, width, height, rgb, metadata));
+    return WriteImages({encoded});
 }
 
 StatusOr<FloatImage> ReadImage(const std::filesystem::path& path) {

@@ -1,8 +1,9 @@
 #pragma once
 // Reading and writing images through OpenImageIO (in nave's plugin, imaging/oiio_plugin.h). Every
-// OIIO error comes back as a Status naming the file. Files are written under a temporary name in
-// the target's directory and renamed when complete, so an interrupted write never leaves a
-// half-written image under the real name.
+// OIIO error comes back as a Status naming the file. Images are encoded in memory and written by
+// nave (core/file.h's AtomicFile): under a temporary name in the target's directory, synced, and
+// renamed when complete, so an interrupted write or a full disk never leaves a half-written image
+// under the real name.
 
 #include <cstdint>
 #include <filesystem>
@@ -47,8 +48,20 @@ Status WriteRgb8(const std::filesystem::path& path, int width, int height,
 /// Reads an image's first subimage as floats.
 StatusOr<FloatImage> ReadImage(const std::filesystem::path& path);
 
-/// `dir/name.tmp-PID-N.ext` beside `path`: same directory (so the rename is atomic), same extension
-/// (so OpenImageIO picks the same format).
-std::filesystem::path TemporaryImagePath(const std::filesystem::path& path);
+/// An image encoded in memory (its file's bytes), to be written to `path`.
+struct EncodedImage {
+    std::filesystem::path path;
+    std::vector<unsigned char> bytes;
+};
+/// WriteExr's file, in memory.
+StatusOr<EncodedImage> EncodeExr(const std::filesystem::path& path, const FloatImage& image,
+                                 const ImageMetadata& metadata);
+/// WriteRgb8's file, in memory.
+StatusOr<EncodedImage> EncodeRgb8(const std::filesystem::path& path, int width, int height,
+                                  const std::vector<uint8_t>& rgb, const ImageMetadata& metadata);
+/// Writes images as a set: each under `<path>.tmp-<pid>-<n>` (AtomicFile), all synced before any
+/// is renamed into place. A failure (a full disk) is an IoError naming the file; every file that
+/// was there before is left as it was, and no temporary stays.
+Status WriteImages(const std::vector<EncodedImage>& images);
 
 }  // namespace nave::imaging

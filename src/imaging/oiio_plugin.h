@@ -24,7 +24,7 @@ class TextureCache;
 struct FloatImage;
 
 /// Bumped whenever OiioPlugin's methods or the types they take change.
-inline constexpr int kOiioPluginVersion = 3;
+inline constexpr int kOiioPluginVersion = 4;
 
 /// The pixel type a channel is stored as in the file.
 enum class StoredPixel { kFloat, kHalf, kUint8 };
@@ -49,11 +49,11 @@ class OiioPlugin {
   public:
     virtual ~OiioPlugin() = default;
 
-    /// Writes `request` to `temp_path` in the format `format_path`'s extension names (the caller
-    /// renames).
-    virtual Status WriteImage(const std::filesystem::path& format_path,
-                              const std::filesystem::path& temp_path,
-                              const ImageWriteRequest& request) const = 0;
+    /// The bytes of `request` encoded in the format `path`'s extension names, in memory: the
+    /// caller writes them (OpenImageIO's file writers do not report a write that fails when their
+    /// last buffer is flushed, so a full disk could leave a truncated image behind an exit code 0).
+    virtual StatusOr<std::vector<unsigned char>> EncodeImage(
+        const std::filesystem::path& path, const ImageWriteRequest& request) const = 0;
     /// Reads the first subimage as floats.
     virtual StatusOr<FloatImage> ReadImage(const std::filesystem::path& path) const = 0;
     /// A texture cache of its own whose tiles use at most `max_memory_bytes`.

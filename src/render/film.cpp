@@ -216,12 +216,15 @@ Status Film::Write(const std::filesystem::path& exr_path,
         }
         if (output_.aov_depth) out[k++] = aov_count_[p].load() ? aov(6) : INFINITY;
     }
-    NAVE_RETURN_IF_ERROR(imaging::WriteExr(exr_path, image, metadata));
+    NAVE_ASSIGN_OR_RETURN(imaging::EncodedImage exr, imaging::EncodeExr(exr_path, image, metadata));
 
     const std::vector<uint8_t> png = DisplayImage(rgb, output_);
     std::filesystem::path png_path = exr_path;
     png_path.replace_extension(".png");
-    return imaging::WriteRgb8(png_path, width_, height_, png, metadata);
+    NAVE_ASSIGN_OR_RETURN(imaging::EncodedImage display,
+                          imaging::EncodeRgb8(png_path, width_, height_, png, metadata));
+    // Both or neither: an EXR and a PNG of different renders side by side would mislead.
+    return imaging::WriteImages({exr, display});
 }
 
 }  // namespace nave::render

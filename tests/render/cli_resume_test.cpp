@@ -193,14 +193,14 @@ TEST_F(CliResumeTest, StaleTemporariesOfKilledRendersAreRemovedAndSaid) {
     ::waitpid(child, &status, 0);
     const std::string dead = std::to_string(child);
     const std::string alive = std::to_string(::getpid());
-    for (const std::string& name : {"out.tmp-" + dead + "-0.exr", "out.tmp-" + dead + "-1.png",
-                                    "c.ckpt.tmp-" + dead + "-3", "out.tmp-" + alive + "-0.exr",
-                                    "other.tmp-" + dead + "-0.exr", "out.tmp-" + dead + "-x.exr"}) {
+    for (const std::string& name : {"out.exr.tmp-" + dead + "-0", "out.png.tmp-" + dead + "-1",
+                                    "c.ckpt.tmp-" + dead + "-3", "out.exr.tmp-" + alive + "-0",
+                                    "other.exr.tmp-" + dead + "-0", "out.exr.tmp-" + dead + "-x"}) {
         std::ofstream(Path(name)) << "partial";
     }
     const CommandResult r = Clutter("--checkpoint " + Path("c.ckpt"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    for (const std::string& gone : {"out.tmp-" + dead + "-0.exr", "out.tmp-" + dead + "-1.png",
+    for (const std::string& gone : {"out.exr.tmp-" + dead + "-0", "out.png.tmp-" + dead + "-1",
                                     "c.ckpt.tmp-" + dead + "-3"}) {
         EXPECT_FALSE(std::filesystem::exists(Path(gone))) << gone;
         EXPECT_NE(r.output.find("removed " + Path(gone) + ", left by an earlier nave run"),
@@ -208,8 +208,8 @@ TEST_F(CliResumeTest, StaleTemporariesOfKilledRendersAreRemovedAndSaid) {
             << r.output;
     }
     // A live process's, another output's, and a name that is not nave's own stay.
-    for (const std::string& kept : {"out.tmp-" + alive + "-0.exr", "other.tmp-" + dead + "-0.exr",
-                                    "out.tmp-" + dead + "-x.exr"}) {
+    for (const std::string& kept : {"out.exr.tmp-" + alive + "-0", "other.exr.tmp-" + dead + "-0",
+                                    "out.exr.tmp-" + dead + "-x"}) {
         EXPECT_TRUE(std::filesystem::exists(Path(kept))) << kept;
     }
 }

@@ -2,6 +2,7 @@
 // on first use by LoadOiioPlugin; see that header for why OpenImageIO is not linked into `nave`
 // itself.
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -33,13 +34,16 @@ std::string GlobalError() { return OIIO::geterror(); }
 
 class Plugin final : public OiioPlugin {
   public:
-    Status WriteImage(const std::filesystem::path& format_path,
-                      const std::filesystem::path& temp_path,
-                      const ImageWriteRequest& r) const override {
+    StatusOr<std::vector<unsigned char>> EncodeImage(const std::filesystem::path& path,
+                                                     const ImageWriteRequest& r) const override {
         NAVE_CHECK_EQ(r.channels.size(), r.stored.size());
-        auto out = OIIO::ImageOutput::create(format_path.string());
-        if (!out)
-            return OiioError(format_path, "no image writer for this extension", GlobalError());
+        auto out = OIIO::ImageOutput::create(path.string());
+        if (!out) return OiioError(path, "no image writer for this extension", GlobalError());
+        if (!out->supports("ioproxy"))
+            return IoError(
+                "{}: OpenImageIO cannot encode this format in memory; write OpenEXR or "
+                "PNG",
+                path.string());
         const bool uint8 = !r.stored.empty() && r.stored[0] == StoredPixel::kUint8;
         const OIIO::TypeDesc in_type = uint8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
         OIIO::ImageSpec spec(r.width, r.height, int(r.channels.size()), in_type);
@@ -55,17 +59,17 @@ class Plugin final : public OiioPlugin {
             spec.tile_depth = 1;
         }
         for (const auto& [key, value] : r.metadata) spec.attribute(key, value);
-        if (!out->open(temp_path.string(), spec))
-            return IoError("{}: cannot open for writing: {}", format_path.string(),
-                           out->geterror());
+        std::vector<unsigned char> bytes;
+        OIIO::Filesystem::IOVecOutput proxy(bytes);
+        if (!out->set_ioproxy(&proxy) || !out->open(path.string(), spec))
+            return IoError("{}: cannot encode: {}", path.string(), out->geterror());
         if (!out->write_image(in_type, r.pixels)) {
             std::string err = out->geterror();
             out->close();
-            return IoError("{}: write failed: {}", format_path.string(), err);
+            return IoError("{}: cannot encode: {}", path.string(), err);
         }
-        if (!out->close())
-            return IoError("{}: close failed: {}", format_path.string(), out->geterror());
-        return Status::Ok();
+        if (!out->close()) return IoError("{}: cannot encode: {}", path.string(), out->geterror());
+        return bytes;
     }
 
     StatusOr<FloatImage> ReadImage(const std::filesystem::path& path) const override {
@@ -132,6 +136,35 @@ class Plugin final : public OiioPlugin {
                                               output.string(), config))
             return IoError("{}: cannot write the texture converted from {}: {}", output.string(),
                            source.string(), GlobalError());
+        return CheckWrittenToTheEnd(output, source);
+    }
+
+  private:
+    /// make_texture writes through a buffered file whose last flush fails silently on a full disk:
+    /// a texture cut short would pass for converted. Its levels are written largest first, so the
+    /// smallest, read back whole, is at the end of the file.
+    static Status CheckWrittenToTheEnd(const std::filesystem::path& output,
+                                       const std::filesystem::path& source) {
+        auto in = OIIO::ImageInput::open(output.string());
+        if (!in)
+            return IoError(
+                "{}: the texture converted from {} cannot be read back (is the disk "
+                "full?): {}",
+                output.string(), source.string(), GlobalError());
+        int level = 0;
+        while (in->seek_subimage(0, level + 1)) ++level;
+        const OIIO::ImageSpec spec = in->spec(0, level);
+        std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) *
+                                  size_t(spec.nchannels));
+        const bool read =
+            in->read_image(0, level, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+        const std::string error = read ? std::string() : in->geterror();
+        in->close();
+        if (!read)
+            return IoError(
+                "{}: the texture converted from {} is incomplete on disk (is the disk "
+                "full?): {}",
+                output.string(), source.string(), error);
         return Status::Ok();
     }
 };
