@@ -4,8 +4,7 @@
 // crashes by running it in a child process, which fuzz_assimp_isolated checks; docs/fuzzing.md says
 // how to run this target past them and replay them through the isolated path.
 //
-// Assimp's failed assertions do not end this process (below); its segmentation faults and bus
-// errors still do.
+// Assimp's failed assertions do not end this process (below); its other crashes still do.
 
 #include <stdexcept>
 #include <string>
@@ -17,13 +16,14 @@
 #include "preprocess/import/model_wire.h"
 
 // Debian's libassimp5 is built with ASSIMP_BUILD_DEBUG: every ai_assert that fails calls
-// Assimp::aiAssertViolation, whose handler prints the expression and calls abort(). About one
-// mutated input in 40 failed one (most often TriangulateProcess.cpp(238)), and each abort restarted
-// the fuzzer. This definition replaces the library's for this executable only: libassimp exports
-// the function and calls it through its PLT (all of its 1 347 call sites in 5.2.5; `objdump -d`
-// shows no direct call), so the dynamic linker binds those calls to the executable's definition,
-// which comes first in the lookup order. nave's libraries and the `nave` executable do not define
-// it and keep Assimp's abort, which their child process turns into an error.
+// Assimp::aiAssertViolation, whose handler prints the expression and calls abort(). On mutated OFF
+// files about one input in 40 fails one (most often TriangulateProcess.cpp(238)), and each abort
+// would restart the fuzzer. This definition replaces the library's for this executable only:
+// libassimp exports the function and calls it through its PLT (all of its 1 347 call sites
+// in 5.2.5; `objdump -d` shows no direct call), so the dynamic linker binds those calls to the
+// executable's definition, which comes first in the lookup order. nave's libraries and the `nave`
+// executable do not define it and keep Assimp's abort, which their child process turns into an
+// error.
 //
 // Why throwing is sound: the exception is raised at the failed assertion, so Assimp never runs a
 // line past a broken invariant; unwinding runs only destructors and catch handlers. aiImportFile
@@ -35,13 +35,15 @@
 // in std::terminate, an abort that libFuzzer reports like the default handler's: never a silent
 // pass.
 //
-// What it cannot cover: a segmentation fault or bus error in Assimp still kills the process (hence
-// `-fork=1 -ignore_crashes=1` in docs/fuzzing.md); a destructor running over a half-built scene may
-// crash too, and that is reported as Assimp's crash like the others. Whatever Assimp had allocated
-// through raw pointers when the assertion failed is abandoned: those leaks are Assimp's, and
+// What it cannot cover: a segmentation fault, bus error, stack overflow or ASan report in Assimp
+// still ends the process (hence `-fork=1 -ignore_crashes=1` in docs/fuzzing.md); a destructor
+// running over a half-built scene may crash too, and that is reported as Assimp's crash like the
+// others. Whatever Assimp had allocated through raw pointers when the assertion failed is
+// abandoned: those leaks are Assimp's, and
 // __lsan_default_suppressions below suppresses every leak whose allocation stack passes through
 // libassimp. nave's code allocates nothing from inside Assimp (nave installs no IOSystem, logger
-// or progress handler), so leaks in nave's conversion are still reported.
+// or progress handler), so leaks in nave's conversion are still reported (docs/fuzzing.md: the
+// long run turns leak detection off for speed and runs its corpus again with it on).
 namespace Assimp {
 
 void aiAssertViolation(const char* expression, const char* file, int line);
