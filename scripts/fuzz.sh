@@ -15,8 +15,9 @@ seconds=${1:-10}
 shift || true
 targets=("$@")
 if ((${#targets[@]} == 0)); then
-  # fuzz_assimp_in_process is left out: Assimp 5.2 aborts on some inputs within seconds, by design of
-  # its asserts; nave isolates that (fuzz_assimp_isolated). docs/fuzzing.md runs it separately.
+  # fuzz_assimp_in_process is left out: Assimp 5.2 crashes (segmentation faults, bus errors) on some
+  # inputs within seconds; nave isolates that (fuzz_assimp_isolated). docs/fuzzing.md runs it
+  # separately, past those crashes.
   targets=(fuzz_obj fuzz_ply fuzz_stl fuzz_gltf fuzz_assimp_isolated fuzz_model_wire fuzz_store
            fuzz_scene_config)
 fi
@@ -42,6 +43,27 @@ trap 'rm -rf "$scratch"' EXIT
 export TMPDIR=$scratch
 
 models=tests/fixtures/models
+# The Assimp targets' inputs start with a byte that picks the file's extension from kAssimpFormats
+# (tests/fuzz/assimp_formats.h, read here so that the list has one home). Writes each model file
+# given after directory $1 into it, that byte prefixed.
+assimp_formats=()
+mapfile -t assimp_formats < <(sed -n '/kAssimpFormats = {/,/};/p' tests/fuzz/assimp_formats.h |
+                               grep -o '"[^"]*"' | tr -d '"')
+seed_assimp() {
+  local dir=$1 f ext i
+  shift
+  for f in "$@"; do
+    ext=${f##*.}
+    for i in "${!assimp_formats[@]}"; do
+      if [[ ${assimp_formats[i]} == "$ext" ]]; then
+        { printf "\\$(printf %03o "$i")"; cat "$f"; } >"$dir/$(basename "$f")"
+        continue 2
+      fi
+    done
+    echo "fuzz.sh: $f: .$ext is not in tests/fuzz/assimp_formats.h" >&2
+    exit 2
+  done
+}
 # Seeds for one target, written into directory $2.
 seed() {
   local target=$1 dir=$2 f
@@ -60,8 +82,9 @@ seed() {
     fuzz_ply) cp "$models"/*.ply "$dir/" ;;
     fuzz_stl) cp "$models"/*.stl "$dir/" ;;
     fuzz_gltf) cp "$models"/*.gltf "$models"/*.glb "$dir/" ;;
-    fuzz_assimp_in_process) cp "$models/square.off" "$dir/" ;;
-    fuzz_assimp_isolated) cp "$models"/*.off "$dir/" ;;  # square.off and the ones Assimp aborts on
+    fuzz_assimp_in_process) seed_assimp "$dir" "$models/square.off" "$models"/assimp/* ;;
+    # The same, and the OFF files Assimp aborts on.
+    fuzz_assimp_isolated) seed_assimp "$dir" "$models"/*.off "$models"/assimp/* ;;
     fuzz_model_wire)
       # The stream needs a model: fuzz_assimp_in_process's round trip is its test; here start from an
       # empty stream and the magic alone.
