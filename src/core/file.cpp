@@ -15,26 +15,24 @@ std::atomic<uint64_t> g_temp_counter{0};
 
 std::string ErrnoText() { return std::strerror(errno); }
 
-Status FsyncDirectory(const std::filesystem::path& dir) {
-    int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0)
-        return IoError("cannot open directory {} to sync it: {}", dir.string(), ErrnoText());
+/// Opens `path` read-only with `flags` and fsyncs it: files another writer wrote, and directories
+/// after a rename.
+Status SyncPath(const std::filesystem::path& path, int flags, const char* what) {
+    int fd = ::open(path.empty() ? "." : path.c_str(), O_RDONLY | O_CLOEXEC | flags);
+    if (fd < 0) return IoError("cannot open {}{} to sync it: {}", what, path.string(), ErrnoText());
     int rc = ::fsync(fd);
     ::close(fd);
-    if (rc != 0) return IoError("cannot sync directory {}: {}", dir.string(), ErrnoText());
+    if (rc != 0) return IoError("cannot sync {}{}: {}", what, path.string(), ErrnoText());
     return Status::Ok();
+}
+
+Status FsyncDirectory(const std::filesystem::path& dir) {
+    return SyncPath(dir, O_DIRECTORY, "directory ");
 }
 
 }  // namespace
 
-Status SyncFile(const std::filesystem::path& path) {
-    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return IoError("cannot open {} to sync it: {}", path.string(), ErrnoText());
-    int rc = ::fsync(fd);
-    ::close(fd);
-    if (rc != 0) return IoError("cannot sync {}: {}", path.string(), ErrnoText());
-    return Status::Ok();
-}
+Status SyncFile(const std::filesystem::path& path) { return SyncPath(path, 0, ""); }
 
 StatusOr<AtomicFile> AtomicFile::Create(const std::filesystem::path& path) {
     std::filesystem::path temp = path;
@@ -109,7 +107,7 @@ Status AtomicFile::Sync() {
 
 Status AtomicFile::Commit() {
     NAVE_CHECK(fd_ >= 0) << "commit of a closed AtomicFile " << path_;
-    if (::fsync(fd_) != 0) return IoError("cannot sync {}: {}", temp_path_.string(), ErrnoText());
+    NAVE_RETURN_IF_ERROR(Sync());
     if (::close(fd_) != 0) {
         fd_ = -1;
         return IoError("cannot close {}: {}", temp_path_.string(), ErrnoText());
