@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "common/file_size_limit.h"
+#include "common/list_names.h"
 #include "common/run_nave.h"
 #include "preprocess/preprocess.h"
 #include "src/core/memory.h"
@@ -23,16 +24,6 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
 using ::testing::Not;
-
-// Every name in `dir`: the directories the tests give a run hold nothing else, so a failed run
-// must leave them empty.
-std::vector<std::string> Entries(const std::filesystem::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(dir))
-        names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-}
 
 // RunPreprocess(o) with files limited to `limit` bytes: its error, or Ok.
 Status RunWithFileSizeLimit(const PreprocessOptions& o, rlim_t limit) {
@@ -85,8 +76,8 @@ TEST(PreprocessFullDisk, TemporaryBinWriteNamesTheTempDirAndLeavesNothing) {
         EXPECT_THAT(s.message(), HasSubstr(where + "/.nave-tmp-"));  // the bin itself
         EXPECT_THAT(s.message(), HasSubstr(std::strerror(EFBIG)));
         EXPECT_FALSE(std::filesystem::exists(o.output));
-        EXPECT_THAT(Entries(out_dir), IsEmpty());
-        EXPECT_THAT(Entries(temp_dir), IsEmpty());
+        EXPECT_THAT(test::ListNames(out_dir), IsEmpty());
+        EXPECT_THAT(test::ListNames(temp_dir), IsEmpty());
     }
     std::filesystem::remove_all(out_dir);
     std::filesystem::remove_all(temp_dir);
@@ -124,7 +115,7 @@ TEST(PreprocessFullDisk, StoreWriteNamesTheStoreAndLeavesNoFile) {
         EXPECT_THAT(s.message(), HasSubstr(std::strerror(EFBIG)));
         EXPECT_THAT(s.message(), Not(HasSubstr("writing temporary files")));  // not the bins
         EXPECT_FALSE(std::filesystem::exists(o.output));
-        EXPECT_THAT(Entries(out_dir), IsEmpty());
+        EXPECT_THAT(test::ListNames(out_dir), IsEmpty());
     }
     // The same run completes once there is room.
     ASSERT_TRUE(RunWithFileSizeLimit(o, store_bytes).ok());
@@ -151,8 +142,8 @@ TEST(PreprocessFullDisk, CliReportsTheTempDirAndExitsNonZero) {
                                     " (--temp-dir chooses where)"));
     EXPECT_THAT(r.output, HasSubstr(std::strerror(EFBIG)));
     EXPECT_FALSE(std::filesystem::exists(out));
-    EXPECT_THAT(Entries(out_dir), IsEmpty());
-    EXPECT_THAT(Entries(temp_dir), IsEmpty());
+    EXPECT_THAT(test::ListNames(out_dir), IsEmpty());
+    EXPECT_THAT(test::ListNames(temp_dir), IsEmpty());
     std::filesystem::remove_all(out_dir);
     std::filesystem::remove_all(temp_dir);
 }

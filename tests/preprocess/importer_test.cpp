@@ -17,15 +17,12 @@
 namespace nave::preprocess {
 namespace {
 
+using testing::Area;
 using testing::Fixture;
 using ::testing::HasSubstr;
 using testing::ReadError;
 using testing::ReadModel;
 
-double Area(const Triangle& t) {
-    Vec3d a(t.p[0]), b(t.p[1]), c(t.p[2]);
-    return 0.5 * Length(Cross(b - a, c - a));
-}
 Vec3d Normal(const Triangle& t) {
     Vec3d a(t.p[0]), b(t.p[1]), c(t.p[2]);
     return Normalize(Cross(b - a, c - a));

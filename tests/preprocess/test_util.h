@@ -15,6 +15,12 @@ inline std::filesystem::path Fixture(const std::string& name) {
     return std::filesystem::path(NAVE_TEST_FIXTURES) / "models" / name;
 }
 
+/// A triangle's area, in double precision.
+inline double Area(const Triangle& t) {
+    const Vec3d a(t.p[0]), b(t.p[1]), c(t.p[2]);
+    return 0.5 * Length(Cross(b - a, c - a));
+}
+
 /// Opens `path` with OpenModel and reads every triangle; fails the test on error.
 std::vector<Triangle> ReadModel(const std::filesystem::path& path,
                                 std::unique_ptr<TriangleSource>* keep = nullptr);

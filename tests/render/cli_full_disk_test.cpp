@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/file_size_limit.h"
+#include "common/list_names.h"
 #include "common/run_nave.h"
 #include "common/scratch_dir.h"
 
@@ -43,10 +44,8 @@ TEST(CliFullDisk, ImageWriteNamesTheImageAndKeepsThePreviousOne) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find(out.string()), std::string::npos) << r.output;
     EXPECT_EQ(Contents(out), before) << "the previous image changed";
-    for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
-        const std::string name = e.path().filename().string();
-        EXPECT_TRUE(name == "furnace.exr" || name == "furnace.png") << "left behind: " << name;
-    }
+    EXPECT_EQ(test::ListNames(dir.path()),
+              (std::vector<std::string>{"furnace.exr", "furnace.png"}));
 }
 
 TEST(CliFullDisk, CheckpointWriteNamesTheCheckpoint) {
@@ -65,10 +64,8 @@ TEST(CliFullDisk, CheckpointWriteNamesTheCheckpoint) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find(checkpoint.string()), std::string::npos) << r.output;
     EXPECT_FALSE(std::filesystem::exists(checkpoint));
-    for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
-        const std::string name = e.path().filename().string();
+    for (const std::string& name : test::ListNames(dir.path()))
         EXPECT_EQ(name.find(".tmp"), std::string::npos) << "left behind: " << name;
-    }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <string>
 
+#include "common/list_names.h"
 #include "common/run_nave.h"
 #include "src/core/file.h"
 #include "src/imaging/image_io.h"
@@ -143,12 +144,8 @@ aovs = ["albedo", "normal", "depth"]
     // Depth inside a unit sphere seen from near its centre: about 1 m.
     EXPECT_NEAR(image->pixels[size_t(z - image->channels.begin())], 1.0, 0.15);
     // No temporary files are left behind.
-    int files = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir_)) {
-        (void)e;
-        ++files;
-    }
-    EXPECT_EQ(files, 3);  // furnace.toml, furnace.exr, furnace.png
+    EXPECT_EQ(test::ListNames(dir_),
+              (std::vector<std::string>{"furnace.exr", "furnace.png", "furnace.toml"}));
 }
 
 TEST_F(CliRenderTest, ConfigErrorsNameFileLineAndKeyWithExitCode2) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/file_size_limit.h"
+#include "common/list_names.h"
 #include "common/scratch_dir.h"
 #include "src/imaging/image_io.h"
 #include "src/imaging/make_texture.h"
@@ -40,14 +41,6 @@ std::string Contents(const std::filesystem::path& p) {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-std::vector<std::string> Names(const std::filesystem::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(dir))
-        names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
 TEST(ImageWrite, AnExrOneByteShortOfItsSizeIsAnError) {
     const test::ScratchDir dir("image_write_short");
     const FloatImage image = VariedImage();
@@ -62,7 +55,7 @@ TEST(ImageWrite, AnExrOneByteShortOfItsSizeIsAnError) {
     }
     EXPECT_EQ(st.code(), StatusCode::kIoError) << st.ToString();
     EXPECT_NE(st.message().find((dir / "short.exr").string()), std::string::npos) << st.ToString();
-    EXPECT_EQ(Names(dir.path()), std::vector<std::string>{"whole.exr"});
+    EXPECT_EQ(test::ListNames(dir.path()), std::vector<std::string>{"whole.exr"});
 }
 
 TEST(ImageWrite, ASetIsWrittenWholeOrLeavesWhatWasThere) {
@@ -83,12 +76,12 @@ TEST(ImageWrite, ASetIsWrittenWholeOrLeavesWhatWasThere) {
     EXPECT_NE(st.message().find((dir / "a.png").string()), std::string::npos) << st.ToString();
     EXPECT_EQ(Contents(dir / "a.exr"), "old exr");
     EXPECT_EQ(Contents(dir / "a.png"), "old png");
-    EXPECT_EQ(Names(dir.path()), (std::vector<std::string>{"a.exr", "a.png"}));
+    EXPECT_EQ(test::ListNames(dir.path()), (std::vector<std::string>{"a.exr", "a.png"}));
 
     ASSERT_TRUE(WriteImages(images).ok());
     EXPECT_EQ(Contents(dir / "a.exr"), std::string(1000, 'e'));
     EXPECT_EQ(Contents(dir / "a.png"), std::string(100000, 'p'));
-    EXPECT_EQ(Names(dir.path()), (std::vector<std::string>{"a.exr", "a.png"}));
+    EXPECT_EQ(test::ListNames(dir.path()), (std::vector<std::string>{"a.exr", "a.png"}));
 }
 
 TEST(ImageWrite, ATextureOneByteShortOfItsSizeIsAnError) {
