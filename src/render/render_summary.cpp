@@ -30,7 +30,6 @@ std::string RenderFact::MetadataText() const {
         case Unit::kSeconds:
             return fmt::format("{:.3f}s", real);
         case Unit::kPerSecond:
-            return fmt::format("{:.6g}", real);
         case Unit::kRatio:
             return fmt::format("{:.6g}", real);
     }

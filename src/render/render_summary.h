@@ -18,7 +18,7 @@ namespace nave::render {
 /// The metadata attribute that holds a fact as key=value, or kTerminalOnly.
 inline constexpr std::string_view kStatisticsAttribute = "nave:statistics";
 inline constexpr std::string_view kTexturesAttribute = "nave:textures";
-inline constexpr std::string_view kTerminalOnly = "";
+inline constexpr std::string_view kTerminalOnly{};  // empty
 
 /// One fact of a render's summary.
 struct RenderFact {

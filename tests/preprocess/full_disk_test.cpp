@@ -36,18 +36,18 @@ Status RunWithFileSizeLimit(const PreprocessOptions& o, rlim_t limit) {
 // A 32 x 32 grid of quads whose 2048 triangles each have their own material, as CAD exports often
 // name one per part: the store is mostly its material table, larger than the temporary bins.
 void WriteManyMaterialGrid(const std::filesystem::path& dir) {
-    constexpr int n = 32;
+    constexpr int kSide = 32;
     std::ofstream mtl(dir / "grid.mtl");
-    for (int i = 0; i < 2 * n * n; ++i) mtl << "newmtl part_" << i << "\nKd 0.5 0.5 0.5\n";
+    for (int i = 0; i < 2 * kSide * kSide; ++i) mtl << "newmtl part_" << i << "\nKd 0.5 0.5 0.5\n";
     std::ofstream obj(dir / "grid.obj");
     obj << "mtllib grid.mtl\n";
-    for (int y = 0; y <= n; ++y) {
-        for (int x = 0; x <= n; ++x) obj << "v " << x << " " << y << " 0\n";
+    for (int y = 0; y <= kSide; ++y) {
+        for (int x = 0; x <= kSide; ++x) obj << "v " << x << " " << y << " 0\n";
     }
     int material = 0;
-    for (int y = 0; y < n; ++y) {
-        for (int x = 0; x < n; ++x) {
-            const int a = y * (n + 1) + x + 1, b = a + 1, c = a + n + 1, d = c + 1;
+    for (int y = 0; y < kSide; ++y) {
+        for (int x = 0; x < kSide; ++x) {
+            const int a = y * (kSide + 1) + x + 1, b = a + 1, c = a + kSide + 1, d = c + 1;
             obj << "usemtl part_" << material++ << "\nf " << a << " " << b << " " << d << "\n";
             obj << "usemtl part_" << material++ << "\nf " << a << " " << d << " " << c << "\n";
         }

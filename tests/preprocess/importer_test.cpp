@@ -327,11 +327,11 @@ TEST(ImporterRobustness, GarbageAndTruncationsNeverCrash) {
             std::string bytes(size_t(rng() % 600), '\0');
             for (char& c : bytes) c = char(rng());
             if (i % 4 == 1)
-                bytes =
-                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n" +
-                    bytes;
-            if (i % 4 == 2) bytes = "solid x\n" + bytes;
-            if (i % 4 == 3) bytes = "v 1 2 3\nf 1 1 1\n" + bytes;
+                bytes.insert(
+                    0,
+                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n");
+            if (i % 4 == 2) bytes.insert(0, "solid x\n");
+            if (i % 4 == 3) bytes.insert(0, "v 1 2 3\nf 1 1 1\n");
             auto path = dir / (std::to_string(i) + ext);
             std::FILE* f = std::fopen(path.c_str(), "wb");
             std::fwrite(bytes.data(), 1, bytes.size(), f);
