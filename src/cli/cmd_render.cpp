@@ -256,9 +256,8 @@ void PrintSummary(const RenderOptions& o, const std::filesystem::path& out,
     if (log::GetLevel() > log::Level::kInfo) return;  // -q: errors only, no summary
     // The whole process's peak, image writing included: what --memory bounds.
     summary->RecordProcessPeak(PeakRssBytes());
-    std::filesystem::path png = out;
-    png.replace_extension(".png");
-    std::string text = fmt::format("nave render: wrote {} and {}\n", out.string(), png.string());
+    std::string text = fmt::format("nave render: wrote {} and {}\n", out.string(),
+                                   render::Film::DisplayPathOf(out).string());
     for (const std::string& line : summary->TerminalLines(o.memory)) text += "  " + line + "\n";
     std::fputs(text.c_str(), stderr);
 }

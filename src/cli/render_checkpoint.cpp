@@ -6,6 +6,7 @@
 #include "src/core/hash.h"
 #include "src/core/log.h"
 #include "src/core/stale_temporaries.h"
+#include "src/render/film.h"
 
 namespace nave::cli {
 namespace {
@@ -82,8 +83,7 @@ StatusOr<std::unique_ptr<PreparedSession>> PrepareSession(
 void RemoveStaleRenderTemporaries(const std::filesystem::path& output,
                                   const std::filesystem::path& checkpoint) {
     // Images and checkpoints are written through "<name>.tmp-<pid>-<n>" (AtomicFile).
-    std::filesystem::path png = output;
-    png.replace_extension(".png");
+    const std::filesystem::path png = render::Film::DisplayPathOf(output);
     LogRemoved(RemoveStaleTemporaries(DirOf(output), output.filename().string() + ".tmp-"));
     LogRemoved(RemoveStaleTemporaries(DirOf(png), png.filename().string() + ".tmp-"));
     if (!checkpoint.empty())

@@ -32,7 +32,7 @@ std::string BandChannelName(int b) {
     return fmt::format("band{:02d}", b);
 }
 
-Status WriteImages(const std::vector<EncodedImage>& images) {
+Status WriteImages(std::span<const EncodedImage> images) {
     // All written and synced under temporary names before the first rename: a full disk shows as
     // a failed write or sync, and then every file that was there before stays as it was.
     std::vector<AtomicFile> files;
@@ -71,8 +71,8 @@ StatusOr<EncodedImage> EncodeRgb8(const std::filesystem::path& path, int width, 
 
 Status WriteExr(const std::filesystem::path& path, const FloatImage& image,
                 const ImageMetadata& metadata) {
-    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, EncodeExr(path, image, metadata));
-    return WriteImages({encoded});
+    NAVE_ASSIGN_OR_RETURN(const EncodedImage encoded, EncodeExr(path, image, metadata));
+    return WriteImages({&encoded, 1});
 }
 
 Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image, int tile_size,
@@ -87,14 +87,15 @@ Status WriteTiledExr(const std::filesystem::path& path, const FloatImage& image,
     if (!dated) request.metadata.emplace_back("DateTime", "");
     request.stored.assign(image.channels.size(), StoredPixel::kHalf);
     request.tile_size = tile_size;
-    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, Encode(path, request));
-    return WriteImages({encoded});
+    NAVE_ASSIGN_OR_RETURN(const EncodedImage encoded, Encode(path, request));
+    return WriteImages({&encoded, 1});
 }
 
 Status WriteRgb8(const std::filesystem::path& path, int width, int height,
                  const std::vector<uint8_t>& rgb, const ImageMetadata& metadata) {
-    NAVE_ASSIGN_OR_RETURN(EncodedImage encoded, EncodeRgb8(path, width, height, rgb, metadata));
-    return WriteImages({encoded});
+    NAVE_ASSIGN_OR_RETURN(const EncodedImage encoded,
+                          EncodeRgb8(path, width, height, rgb, metadata));
+    return WriteImages({&encoded, 1});
 }
 
 StatusOr<FloatImage> ReadImage(const std::filesystem::path& path) {

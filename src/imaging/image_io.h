@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -62,6 +63,6 @@ StatusOr<EncodedImage> EncodeRgb8(const std::filesystem::path& path, int width, 
 /// Writes images as a set: each under `<path>.tmp-<pid>-<n>` (AtomicFile), all synced before any
 /// is renamed into place. A failure (a full disk) is an IoError naming the file; every file that
 /// was there before is left as it was, and no temporary stays.
-Status WriteImages(const std::vector<EncodedImage>& images);
+Status WriteImages(std::span<const EncodedImage> images);
 
 }  // namespace nave::imaging

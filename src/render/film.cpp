@@ -219,12 +219,13 @@ Status Film::Write(const std::filesystem::path& exr_path,
     NAVE_ASSIGN_OR_RETURN(imaging::EncodedImage exr, imaging::EncodeExr(exr_path, image, metadata));
 
     const std::vector<uint8_t> png = DisplayImage(rgb, output_);
-    std::filesystem::path png_path = exr_path;
-    png_path.replace_extension(".png");
-    NAVE_ASSIGN_OR_RETURN(imaging::EncodedImage display,
-                          imaging::EncodeRgb8(png_path, width_, height_, png, metadata));
-    // Both or neither: an EXR and a PNG of different renders side by side would mislead.
-    return imaging::WriteImages({exr, display});
+    NAVE_ASSIGN_OR_RETURN(
+        imaging::EncodedImage display,
+        imaging::EncodeRgb8(DisplayPathOf(exr_path), width_, height_, png, metadata));
+    // Both or neither: an EXR and a PNG of different renders side by side would mislead. Moved,
+    // not copied: the encoded EXR is megabytes, under the render's memory budget.
+    const imaging::EncodedImage both[] = {std::move(exr), std::move(display)};
+    return imaging::WriteImages(both);
 }
 
 }  // namespace nave::render

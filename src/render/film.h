@@ -79,9 +79,15 @@ class Film {
     Vec3d PixelXYZ(uint32_t pixel) const { return SumXYZ(pixel) * (1.0 / spp_); }
 
     /// Writes linear RGB (plus AOV channels) as EXR with `metadata`, and a tone-mapped sRGB PNG
-    /// beside it (same name, .png). Both through temp name + rename.
+    /// beside it (DisplayPathOf), as one set: both or neither (imaging::WriteImages).
     Status Write(const std::filesystem::path& exr_path,
                  const std::vector<std::pair<std::string, std::string>>& metadata) const;
+    /// The PNG that Write puts beside the EXR `exr_path`: the same name, .png.
+    static std::filesystem::path DisplayPathOf(const std::filesystem::path& exr_path) {
+        std::filesystem::path png = exr_path;
+        png.replace_extension(".png");
+        return png;
+    }
     /// The bytes SaveState appends for a film of width x height (`aov`: with AOV buffers).
     static uint64_t StateBytes(int width, int height, bool aov) {
         return 64 + uint64_t(width) * uint64_t(height) * (5 * 8 + (aov ? 7 * 4 + 4 : 0));
