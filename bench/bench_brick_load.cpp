@@ -26,7 +26,7 @@
 
 #include "src/core/file.h"
 #include "src/core/hash.h"
-#include "src/render/brick_source.h"
+#include "src/render/bricks/brick_source.h"
 #include "store/brick_codec.h"  // internal to nave_store: the mesh section decoder
 #include "store/store_reader.h"
 

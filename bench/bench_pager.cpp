@@ -8,8 +8,9 @@
 
 #include <random>
 
-#include "src/render/brick_source.h"
-#include "src/render/pager.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/bricks/memory_brick_source.h"
+#include "src/render/stream/pager.h"
 #include "store/brick_tree.h"
 
 namespace nave::render {

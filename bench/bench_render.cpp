@@ -6,13 +6,14 @@
 #include <benchmark/benchmark.h>
 
 #include "src/core/progress.h"
-#include "src/render/brick_source.h"
-#include "src/render/film.h"
-#include "src/render/grid_bricks.h"
-#include "src/render/integrator.h"
-#include "src/render/procedural_meshes.h"
-#include "src/render/scene.h"
-#include "src/render/scene_config.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/bricks/grid_bricks.h"
+#include "src/render/bricks/memory_brick_source.h"
+#include "src/render/bricks/procedural_meshes.h"
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_streams.h"
+#include "src/render/scene/scene.h"
+#include "src/render/scene/scene_config.h"
 
 namespace nave::render {
 namespace {

@@ -15,15 +15,17 @@
 #include "src/core/log.h"
 #include "src/core/memory.h"
 #include "src/core/trace.h"
-#include "src/render/brick_source.h"
-#include "src/render/film.h"
-#include "src/render/integrator.h"
-#include "src/render/memory_plan.h"
-#include "src/render/pager.h"
-#include "src/render/procedural_scenes.h"
-#include "src/render/render_summary.h"
-#include "src/render/scene.h"
-#include "src/render/scene_config.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/bricks/procedural_scenes.h"
+#include "src/render/bricks/store_brick_source.h"
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_memory.h"
+#include "src/render/integrators/render_streams.h"
+#include "src/render/integrators/render_summary.h"
+#include "src/render/scene/scene.h"
+#include "src/render/scene/scene_config.h"
+#include "src/render/stream/memory_plan.h"
+#include "src/render/stream/pager.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {
@@ -130,14 +132,14 @@ StatusOr<OpenedModel> OpenModel(const RenderOptions& o,
 /// OpenImageIO's texture system.
 StatusOr<std::unique_ptr<render::TextureCache>> AttachModelTextures(
     const RenderOptions& o, const render::SceneConfig& config, const render::BrickSource& source,
-    std::optional<uint64_t> memory_limit, render::RenderScene* scene) {
+    std::optional<uint64_t> memory_bytes, render::RenderScene* scene) {
     const bool any_texture =
         std::any_of(source.materials().begin(), source.materials().end(),
                     [](const store::MaterialRecord& m) { return !m.textures.empty(); });
     if (!config.textures.enabled || !any_texture) return std::unique_ptr<render::TextureCache>();
     NAVE_ASSIGN_OR_RETURN(
         std::unique_ptr<render::TextureCache> textures,
-        render::TextureCache::Create(render::TextureCacheCapBytes(config.textures, memory_limit)));
+        render::TextureCache::Create(render::TextureCacheCapBytes(config.textures, memory_bytes)));
     std::filesystem::path base = std::filesystem::path(o.model).parent_path();
     std::vector<std::string> warnings;
     NAVE_RETURN_IF_ERROR(
@@ -171,8 +173,10 @@ Status PlanMemory(const RenderOptions& o, uint64_t memory_bytes, const render::S
     inputs.settings = scene->settings;
     inputs.width = config.camera.width;
     inputs.height = config.camera.height;
-    inputs.aov = config.output.aov_albedo || config.output.aov_normal || config.output.aov_depth;
-    inputs.checkpoints = checkpoints;
+    inputs.state = render::RenderStateMemory(
+        scene->settings, config.camera.width, config.camera.height,
+        config.output.aov_albedo || config.output.aov_normal || config.output.aov_depth,
+        checkpoints);
     inputs.texture_cache_bytes = textures ? textures->max_memory_bytes() : 0;
     inputs.image_library_loaded = textures != nullptr;
     NAVE_ASSIGN_OR_RETURN(render::RenderMemoryPlan plan, render::RenderMemoryPlan::Make(inputs));
@@ -266,10 +270,10 @@ Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(CheckOptions(o));
     const std::filesystem::path out = o.output;
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, BuildConfig(o));
-    std::optional<uint64_t> memory_limit;  // --memory, in bytes
+    std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
-        memory_limit = bytes;
+        memory_bytes = bytes;
     }
 
     // Huge pages for Embree's BVHs: a fresh 4 KiB page costs a fault, and on virtual machines
@@ -282,7 +286,7 @@ Status RunRender(const RenderOptions& o) {
                           StartSession(o, model, config, out));
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, source));
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<render::TextureCache> textures,
-                          AttachModelTextures(o, config, source, memory_limit, &scene));
+                          AttachModelTextures(o, config, source, memory_bytes, &scene));
     log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source.brick_count(),
               scene.materials.size(), config.camera.width, config.camera.height,
               ModeName(config.render.mode),
@@ -293,8 +297,8 @@ Status RunRender(const RenderOptions& o) {
     NAVE_ASSIGN_OR_RETURN(render::PagerOptions pager, BuildPagerOptions(o, out, trace.get()));
     // The brick sizes the memory plan counts depend on how their BVHs are built.
     NAVE_RETURN_IF_ERROR(source.SetBvhSettings(pager.bvh));
-    if (memory_limit) {
-        NAVE_RETURN_IF_ERROR(PlanMemory(o, *memory_limit, config, source, textures.get(),
+    if (memory_bytes) {
+        NAVE_RETURN_IF_ERROR(PlanMemory(o, *memory_bytes, config, source, textures.get(),
                                         session->checkpoints(), &pager, &scene));
     }
 
@@ -302,13 +306,13 @@ Status RunRender(const RenderOptions& o) {
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(
         render::RenderStreams(scene, &film, &stats, {}, &pager, &session->options));
-    NAVE_RETURN_IF_ERROR(CheckNotInterrupted(*session, config.render, stats, out));
+    NAVE_RETURN_IF_ERROR(CheckNotInterrupted(*session, scene.settings, stats, out));
     // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),
     // so that the two never add up (the allocator keeps freed pages a while otherwise).
     for (uint32_t b = 0; b < source.brick_count(); ++b) source.Evict(b);
     ReturnFreeMemory();
 
-    render::RenderSummary summary(config.render, stats, TextureFacts(textures.get()));
+    render::RenderSummary summary(scene.settings, stats, TextureFacts(textures.get()));
     NAVE_RETURN_IF_ERROR(WriteImage(o, model, out, scene, film, summary));
     if (trace) NAVE_RETURN_IF_ERROR(trace->Write(o.trace).WithContext("--trace"));
     PrintSummary(o, out, &summary);

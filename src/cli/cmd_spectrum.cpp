@@ -9,7 +9,7 @@
 #include "src/core/color.h"
 #include "src/core/illuminant.h"
 #include "src/core/log.h"
-#include "src/render/sun/sun.h"
+#include "src/render/scene/sun/sun.h"
 
 namespace nave::cli {
 

@@ -7,8 +7,8 @@
 
 #include "src/cli/commands.h"
 #include "src/core/color.h"
-#include "src/render/sun/sky.h"
-#include "src/render/sun/sun.h"
+#include "src/render/scene/sun/sky.h"
+#include "src/render/scene/sun/sun.h"
 
 namespace nave::cli {
 

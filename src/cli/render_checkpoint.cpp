@@ -6,7 +6,7 @@
 #include "src/core/hash.h"
 #include "src/core/log.h"
 #include "src/core/stale_temporaries.h"
-#include "src/render/film.h"
+#include "src/render/film/film.h"
 
 namespace nave::cli {
 namespace {

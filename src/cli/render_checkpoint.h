@@ -9,8 +9,8 @@
 #include <string>
 
 #include "src/core/status.h"
-#include "src/render/render_session.h"
-#include "src/render/scene_config.h"
+#include "src/render/integrators/render_session.h"
+#include "src/render/scene/scene_config.h"
 
 namespace nave::cli {
 

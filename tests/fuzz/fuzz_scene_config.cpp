@@ -2,7 +2,7 @@
 // escapes, a crash or a sanitizer report.
 
 #include "fuzz_file.h"
-#include "src/render/scene_config.h"
+#include "src/render/scene/scene_config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     (void)nave::render::ParseSceneConfig(nave::fuzz::AsView(data, size), "fuzz.toml");

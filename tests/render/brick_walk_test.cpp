@@ -1,14 +1,15 @@
 // Tracing across bricks: the t-range acceptance finds the same nearest hit whatever the brick
 // count.
 
-#include "src/render/brick_walk.h"
+#include "src/render/bricks/brick_walk.h"
 
 #include <gtest/gtest.h>
 
-#include "src/render/brick_source.h"
-#include "src/render/grid_bricks.h"
-#include "src/render/procedural_meshes.h"
-#include "src/render/rng.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/bricks/grid_bricks.h"
+#include "src/render/bricks/memory_brick_source.h"
+#include "src/render/bricks/procedural_meshes.h"
+#include "src/render/transport/rng.h"
 
 namespace nave::render {
 namespace {

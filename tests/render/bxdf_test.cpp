@@ -1,13 +1,13 @@
 // BxDFs: Fresnel against published values, sampling against pdfs (χ²), energy conservation.
 
-#include "src/render/materials/bxdf.h"
+#include "src/render/scene/materials/bxdf.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "chi2.h"
-#include "src/render/materials/ior.h"
+#include "src/render/scene/materials/ior.h"
 
 namespace nave {
 namespace {

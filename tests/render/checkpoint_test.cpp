@@ -1,7 +1,7 @@
 // Checkpoint files: round trip, and every kind of damage refused with a message naming the file
 // and what differs.
 
-#include "src/render/checkpoint.h"
+#include "src/render/film/checkpoint.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -13,7 +13,7 @@
 
 #include "common/run_nave.h"
 #include "src/core/file.h"
-#include "src/render/checkpoint.h"
+#include "src/render/film/checkpoint.h"
 
 namespace nave::render {
 namespace {

@@ -17,6 +17,7 @@
 #include "src/core/file.h"
 #include "src/core/log.h"
 #include "src/core/progress.h"
+#include "src/render/bricks/store_brick_source.h"
 #include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/testing/store_testing.h"

@@ -3,10 +3,10 @@
 // so that it can), photon mapping with photons that keep only their hero wavelength in the glass.
 // Two scenes: a ball whose caustic the camera sees directly on the floor, and a slab the camera
 // looks through at the floor under it (its camera paths keep one wavelength too, lit by the photons
-// of their shared-wavelength channel, sppm.h). The two modes must agree on the light and its
-// colour, which fails if a mode mishandles terminated wavelengths (all four kept: no colour; the
-// hero counted as one of four: a quarter of the light; points seen through the glass left unlit:
-// black).
+// of their shared-wavelength channel, visible_points.h). The two modes must agree on the light and
+// its colour, which fails if a mode mishandles terminated wavelengths (all four kept: no colour;
+// the hero counted as one of four: a quarter of the light; points seen through the glass left
+// unlit: black).
 
 #include <gtest/gtest.h>
 

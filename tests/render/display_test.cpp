@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "src/core/color.h"
-#include "src/render/film.h"
+#include "src/render/film/film.h"
 
 namespace nave::render {
 namespace {

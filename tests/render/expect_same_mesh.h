@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "src/render/resident_mesh.h"
+#include "src/render/bricks/resident_mesh.h"
 #include "store/brick_mesh.h"
 
 namespace nave::render::testing {

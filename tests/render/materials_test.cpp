@@ -1,12 +1,12 @@
 // Materials: dispersion, Beer absorption, thin glass from measured transmittance, built-in names.
 
-#include "src/render/materials/materials.h"
+#include "src/render/scene/materials/materials.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "src/render/materials/ior.h"
+#include "src/render/scene/materials/ior.h"
 
 namespace nave {
 namespace {

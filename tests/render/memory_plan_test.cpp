@@ -2,16 +2,20 @@
 // checkpoint, load scratch, bricks), the wave size chosen when the bricks do not all fit, and the
 // refusals at their boundary (one byte below the least budget that works), without rendering.
 
-#include "src/render/memory_plan.h"
+#include "src/render/stream/memory_plan.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "src/core/memory.h"
-#include "src/render/film.h"
-#include "src/render/procedural_scenes.h"
-#include "src/render/render_session.h"
+#include "src/render/bricks/procedural_scenes.h"
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_memory.h"
+#include "src/render/integrators/render_session.h"
+#include "src/render/transport/path_guide.h"
+#include "src/render/transport/photon_emitters.h"
+#include "src/render/transport/visible_points.h"
 
 namespace nave::render {
 namespace {
@@ -37,14 +41,54 @@ RenderMemoryInputs SmallModel() {
     in.bricks.total_bytes = 20 * kMiB;
     in.load_scratch_bytes = 1 * kMiB;
     in.process_bytes = 100 * kMiB;
+    in.state = RenderStateMemory(in.settings, in.width, in.height, /*aov=*/false,
+                                 /*checkpoints=*/false);
     return in;
 }
 
 uint64_t ReserveOf(const RenderMemoryInputs& in, const RenderSettings& settings,
                    uint64_t queue_memory_bytes) {
-    return RenderReserveBytes(settings, in.width, in.height, in.brick_count, in.pager.wave_overlap,
-                              in.process_bytes, queue_memory_bytes) +
-           in.load_scratch_bytes;
+    return RenderReserveBytes(in, settings, queue_memory_bytes) + in.load_scratch_bytes;
+}
+
+TEST(RenderMemoryPlanTest, QueueMemoryIsAShareOfTheWholeBudget) {
+    PagerOptions paging;
+    paging.memory_bytes = 0;  // no --memory
+    EXPECT_EQ(QueueMemoryBytes(paging), 32 * kMiB);
+    paging.memory_bytes = 4096 * kMiB;
+    EXPECT_EQ(QueueMemoryBytes(paging), 128 * kMiB);
+    // The brick budget is not its base: one base, --memory.
+    paging.brick_budget_bytes = 64 * kMiB;
+    EXPECT_EQ(QueueMemoryBytes(paging), 128 * kMiB);
+    paging.queue_memory_bytes = 5 * kMiB;  // the user's choice
+    EXPECT_EQ(QueueMemoryBytes(paging), 5 * kMiB);
+}
+
+TEST(RenderMemoryPlanTest, RenderStateCountsTheFilmAndTheModesState) {
+    RenderSettings path;
+    path.mode = RenderSettings::Mode::kPath;
+    path.path_guiding = true;
+    RenderStateBytes state = RenderStateMemory(path, 64, 48, false, false);
+    EXPECT_EQ(state.film, Film::MemoryBytes(64, 48));
+    EXPECT_EQ(state.transport, PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells));
+    EXPECT_EQ(state.checkpoint, 0u);
+    path.path_guiding = false;
+    EXPECT_EQ(RenderStateMemory(path, 64, 48, false, false).transport, 0u);
+
+    RenderSettings photon;
+    photon.mode = RenderSettings::Mode::kPhoton;
+    photon.photons_per_iteration = 100000;
+    state = RenderStateMemory(photon, 64, 48, true, true);
+    EXPECT_EQ(state.transport,
+              VisiblePoints::MemoryBytes(64 * 48) + PhotonEmitters::LearningBytes(100000));
+    EXPECT_EQ(state.checkpoint, CheckpointMemoryBytes(photon, 64, 48, true));
+
+    // The plan reserves them.
+    RenderMemoryInputs in = SmallModel();
+    const uint64_t without = RenderReserveBytes(in, in.settings, 0);
+    in.state.transport += 7 * kMiB;
+    in.state.film += 3 * kMiB;
+    EXPECT_EQ(RenderReserveBytes(in, in.settings, 0), without + 10 * kMiB);
 }
 
 TEST(RenderMemoryPlanTest, BricksGetWhatTheReserveLeaves) {
@@ -52,7 +96,10 @@ TEST(RenderMemoryPlanTest, BricksGetWhatTheReserveLeaves) {
     StatusOr<RenderMemoryPlan> plan = RenderMemoryPlan::Make(in);
     ASSERT_TRUE(plan.ok()) << plan.status().ToString();
     // Queues: the automatic share of the whole budget.
-    EXPECT_EQ(plan->queue_memory_bytes(), QueueMemoryBytes(in.memory_bytes));
+    PagerOptions whole_budget;
+    whole_budget.memory_bytes = in.memory_bytes;
+    EXPECT_EQ(plan->queue_memory_bytes(), QueueMemoryBytes(whole_budget));
+    EXPECT_EQ(plan->queue_memory_bytes(), in.memory_bytes / 32);
     EXPECT_EQ(plan->reserve_bytes(), ReserveOf(in, in.settings, plan->queue_memory_bytes()));
     EXPECT_EQ(plan->load_scratch_bytes(), in.load_scratch_bytes);
     EXPECT_EQ(plan->texture_cache_bytes(), 0u);
@@ -72,7 +119,7 @@ TEST(RenderMemoryPlanTest, BricksGetWhatTheReserveLeaves) {
     plan->Apply(&pager, &settings);
     EXPECT_EQ(pager.brick_budget_bytes, plan->brick_budget_bytes());
     EXPECT_EQ(pager.queue_memory_bytes, plan->queue_memory_bytes());
-    EXPECT_EQ(pager.process_memory_bytes, in.memory_bytes);
+    EXPECT_EQ(pager.memory_bytes, in.memory_bytes);
     EXPECT_EQ(settings.wave_paths, in.settings.wave_paths);
 
     const std::string text = plan->Describe();
@@ -90,8 +137,8 @@ TEST(RenderMemoryPlanTest, TextureCacheAndCheckpointAreReserved) {
     RenderMemoryInputs in = SmallModel();
     in.texture_cache_bytes = 12 * kMiB;
     in.image_library_loaded = true;
-    in.checkpoints = true;
-    in.aov = true;
+    in.state = RenderStateMemory(in.settings, in.width, in.height, /*aov=*/true,
+                                 /*checkpoints=*/true);
     StatusOr<RenderMemoryPlan> plan = RenderMemoryPlan::Make(in);
     ASSERT_TRUE(plan.ok()) << plan.status().ToString();
     const uint64_t checkpoint = CheckpointMemoryBytes(in.settings, in.width, in.height, true);

@@ -9,7 +9,7 @@
 #include "src/core/color.h"
 #include "src/core/image_error.h"
 #include "src/core/progress.h"
-#include "src/render/procedural_meshes.h"
+#include "src/render/bricks/procedural_meshes.h"
 
 namespace nave::render {
 namespace {

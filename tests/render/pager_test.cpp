@@ -3,7 +3,7 @@
 // refuses an impossible budget naming the largest brick, and returns a corrupt brick's error when
 // it meets it.
 
-#include "src/render/pager.h"
+#include "src/render/stream/pager.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -17,8 +17,9 @@
 #include "render_test_util.h"
 #include "src/core/memory.h"
 #include "src/core/progress.h"
-#include "src/render/procedural_meshes.h"
-#include "src/render/ray.h"
+#include "src/render/bricks/procedural_meshes.h"
+#include "src/render/bricks/store_brick_source.h"
+#include "src/render/stream/ray.h"
 #include "store/store_reader.h"
 
 namespace nave::render {
@@ -123,13 +124,13 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
         EXPECT_EQ(paged->stats.spilled_rays > 0, variant == 4) << variant;
         // With the cache, every brick is decoded once and every reload read back from it.
         if (options.brick_cache) {
-            EXPECT_EQ(paged->stats.cache_reads, paged->stats.residency.reloads) << variant;
-            EXPECT_EQ(paged->stats.cache_bricks_written + paged->stats.residency.reloads,
+            EXPECT_EQ(paged->stats.brick_cache_reads, paged->stats.residency.reloads) << variant;
+            EXPECT_EQ(paged->stats.brick_cache_written + paged->stats.residency.reloads,
                       paged->stats.residency.loads)
                 << variant;
         } else {
-            EXPECT_EQ(paged->stats.cache_reads, 0u);
-            EXPECT_EQ(paged->stats.cache_bricks_written, 0u);
+            EXPECT_EQ(paged->stats.brick_cache_reads, 0u);
+            EXPECT_EQ(paged->stats.brick_cache_written, 0u);
         }
     }
 }
@@ -177,7 +178,7 @@ TEST_F(PagerTest, FreePagesGoBackAtBatchEndsNearTheProcessLimitAlsoWithoutLoads)
     // Every brick fits, so the loads end early; a process limit below the resident size makes
     // every check return pages: more returns than loads means batch ends check too.
     PagerOptions options;
-    options.process_memory_bytes = 1;
+    options.memory_bytes = 1;
     const auto paged = RenderBallGrid("path", &options);
     ASSERT_TRUE(paged != nullptr);
     ASSERT_TRUE(paged->status.ok()) << paged->status.ToString();
@@ -338,12 +339,12 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    ASSERT_TRUE(ParsePagerTunables("cache=off,cache_limit=3G", &o).ok());
+    ASSERT_TRUE(ParsePagerTunables("brick_cache=off,brick_cache_limit=3G", &o).ok());
     EXPECT_FALSE(o.brick_cache);
     EXPECT_EQ(o.brick_cache_limit_bytes, uint64_t(3) << 30);
     for (const char* bad :
          {"prefetch=maybe", "nearly_empty_rays=-3", "prefer_resident=x", "speed=11", "prefetch",
-          "evict=random", "wave_overlap=2", "cache=yes", "cache_limit=lots"}) {
+          "evict=random", "wave_overlap=2", "brick_cache=yes", "brick_cache_limit=lots"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));

@@ -3,7 +3,7 @@
 // guided path tracing in a room lit by the sun and sky through a window in its roof: the same image
 // in expectation as BSDF sampling alone, and the same image whatever the bricks and threads.
 
-#include "src/render/path_guide.h"
+#include "src/render/transport/path_guide.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 
 #include "render_test_util.h"
 #include "src/core/sampling.h"
-#include "src/render/materials/bxdf.h"
+#include "src/render/scene/materials/bxdf.h"
 
 namespace nave::render {
 namespace {

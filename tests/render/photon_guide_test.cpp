@@ -1,10 +1,10 @@
-#include "src/render/photon_guide.h"
+#include "src/render/transport/photon_guide.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "src/render/rng.h"
+#include "src/render/transport/rng.h"
 
 namespace nave::render {
 namespace {

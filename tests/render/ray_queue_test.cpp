@@ -1,4 +1,4 @@
-#include "src/render/ray_queue.h"
+#include "src/render/stream/ray_queue.h"
 
 #include <gtest/gtest.h>
 

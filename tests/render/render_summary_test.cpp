@@ -1,7 +1,7 @@
 // The facts at the end of a render: the EXR metadata keeps the keys and formats bench/ scripts
 // read, and the terminal summary shows the same facts with the same values.
 
-#include "src/render/render_summary.h"
+#include "src/render/integrators/render_summary.h"
 
 #include <gtest/gtest.h>
 
@@ -42,10 +42,10 @@ RenderStats BusyStats() {
     s.residency.resident_hits = 1111;
     s.residency.memory_returns = 3;
     s.residency.stall_seconds = 3.25;
-    s.cache_bricks_written = 131;
-    s.cache_reads = 180;
-    s.cache_disk_bytes = 300 * kMiB;
-    s.cache_mesh_bytes = 600 * kMiB;
+    s.brick_cache_written = 131;
+    s.brick_cache_reads = 180;
+    s.brick_cache_disk_bytes = 300 * kMiB;
+    s.brick_cache_mesh_bytes = 600 * kMiB;
     s.spilled_rays = 5555555;
     s.spill_bytes_written = 77 * kMiB;
     s.spill_peak_disk_bytes = 44 * kMiB;

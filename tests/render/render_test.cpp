@@ -10,9 +10,10 @@
 #include "src/core/color.h"
 #include "src/core/progress.h"
 #include "src/core/sampling.h"
-#include "src/render/procedural_meshes.h"
-#include "src/render/sun/sky.h"
-#include "src/render/sun/sun.h"
+#include "src/render/bricks/procedural_meshes.h"
+#include "src/render/bricks/store_brick_source.h"
+#include "src/render/scene/sun/sky.h"
+#include "src/render/scene/sun/sun.h"
 
 namespace nave::render {
 namespace {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "src/core/check.h"
+#include "src/render/bricks/memory_brick_source.h"
 
 namespace nave::render::testing {
 

@@ -13,15 +13,15 @@
 
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
-#include "src/render/brick_source.h"
-#include "src/render/film.h"
-#include "src/render/grid_bricks.h"
-#include "src/render/integrator.h"
-#include "src/render/pager.h"
-#include "src/render/procedural_meshes.h"
-#include "src/render/render_session.h"
-#include "src/render/scene.h"
-#include "src/render/scene_config.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/bricks/grid_bricks.h"
+#include "src/render/bricks/procedural_meshes.h"
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_session.h"
+#include "src/render/integrators/render_streams.h"
+#include "src/render/scene/scene.h"
+#include "src/render/scene/scene_config.h"
+#include "src/render/stream/pager.h"
 #include "store/brick_mesh.h"
 #include "store/material_record.h"
 #include "store/store_writer.h"
@@ -48,7 +48,7 @@ Status WriteGridBricksStore(const std::filesystem::path& path, const store::Bric
 // ----------------------------------------------------------------------------------------------
 // Scenes and renders
 
-/// RenderStreams' arguments beyond the scene, film and statistics (integrator.h): the defaults
+/// RenderStreams' arguments beyond the scene, film and statistics (render_streams.h): the defaults
 /// render in-core with the pager's brick order.
 struct RunOptions {
     BrickPicker picker;

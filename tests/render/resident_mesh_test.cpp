@@ -1,4 +1,4 @@
-#include "src/render/resident_mesh.h"
+#include "src/render/bricks/resident_mesh.h"
 
 #include <gtest/gtest.h>
 

@@ -12,13 +12,13 @@
 
 #include "render_test_util.h"
 #include "src/core/byte_stream.h"
-#include "src/render/checkpoint.h"
-#include "src/render/film.h"
-#include "src/render/integrator.h"
-#include "src/render/procedural_scenes.h"
-#include "src/render/render_session.h"
-#include "src/render/scene.h"
-#include "src/render/scene_config.h"
+#include "src/render/bricks/procedural_scenes.h"
+#include "src/render/film/checkpoint.h"
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_session.h"
+#include "src/render/integrators/render_streams.h"
+#include "src/render/scene/scene.h"
+#include "src/render/scene/scene_config.h"
 
 namespace nave::render {
 namespace {

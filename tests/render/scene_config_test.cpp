@@ -1,6 +1,6 @@
 // Scene configs: every key parsed, and bad keys, types and dates rejected with file, line and key.
 
-#include "src/render/scene_config.h"
+#include "src/render/scene/scene_config.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Preetham et al. (1999) sky: structure of the model and consistency of its spectra.
 
-#include "src/render/sun/sky.h"
+#include "src/render/scene/sun/sky.h"
 
 #include <gtest/gtest.h>
 

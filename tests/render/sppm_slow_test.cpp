@@ -5,7 +5,7 @@
 
 #include "render_test_util.h"
 #include "src/core/progress.h"
-#include "src/render/procedural_meshes.h"
+#include "src/render/bricks/procedural_meshes.h"
 
 namespace nave::render {
 namespace {

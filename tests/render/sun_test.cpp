@@ -1,6 +1,6 @@
 // Solar position and the sun's spectrum against published values; each test names its source.
 
-#include "src/render/sun/sun.h"
+#include "src/render/scene/sun/sun.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "src/core/color.h"
 #include "src/core/sampling.h"
-#include "src/render/sun/spa.h"
+#include "src/render/scene/sun/spa.h"
 
 namespace nave {
 namespace {

@@ -15,7 +15,7 @@
 #include "src/core/color.h"
 #include "src/core/file.h"
 #include "src/imaging/texture_cache.h"
-#include "src/render/texture/surface_textures.h"
+#include "src/render/scene/texture/surface_textures.h"
 
 namespace nave::render {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "src/imaging/texture_cache.h"
-#include "src/render/texture/spectral_texture.h"
+#include "src/render/scene/texture/spectral_texture.h"
 
 namespace nave::render {
 namespace {

@@ -1,0 +1,179 @@
+#include "src/render/bricks/brick_source.h"
+
+#include <embree3/rtcore.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "src/core/trace.h"
+#include "src/render/bricks/brick_cache.h"
+
+namespace nave::render {
+
+BrickHandle& BrickHandle::operator=(BrickHandle&& o) noexcept {
+    if (this != &o) {
+        Reset();
+        source_ = o.source_;
+        brick_ = o.brick_;
+        o.source_ = nullptr;
+        o.brick_ = nullptr;
+    }
+    return *this;
+}
+
+void BrickHandle::Reset() {
+    if (source_ != nullptr && brick_ != nullptr) source_->Release(brick_->id());
+    source_ = nullptr;
+    brick_ = nullptr;
+}
+
+BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                         std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
+                         Bounds3f bounds)
+    : device_(std::move(device)),
+      tree_(std::move(tree)),
+      cells_(std::move(cells)),
+      materials_(std::move(materials)),
+      bounds_(bounds) {
+    slots_.reserve(cells_.size());
+    for (size_t i = 0; i < cells_.size(); ++i) slots_.push_back(std::make_unique<Slot>());
+}
+
+BrickSource::~BrickSource() = default;
+
+StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
+    if (id >= slots_.size()) {
+        return InvalidArgumentError("brick {} requested but the model has {} bricks", id,
+                                    slots_.size());
+    }
+    acquires_.fetch_add(1, std::memory_order_relaxed);
+    Slot& slot = *slots_[id];
+    // Pin first, then check: an evictor takes the slot lock and refuses while pins > 0.
+    slot.pins.fetch_add(1, std::memory_order_acq_rel);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
+        return BrickHandle(this, b);
+    std::lock_guard<std::mutex> lock(slot.mutex);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
+        return BrickHandle(this, b);
+    if (!slot.error.ok()) {
+        slot.pins.fetch_sub(1, std::memory_order_acq_rel);
+        return slot.error;
+    }
+    auto start = std::chrono::steady_clock::now();
+    TraceSpan load(trace_, "load", "pager");
+    load.AddArg({"brick", id});
+    uint64_t bytes = 0;
+    const bool cached = brick_cache_ != nullptr && brick_cache_->Has(id);
+    TraceSpan decode(trace_, cached ? "read from the brick cache" : "read and decode", "pager");
+    // The mesh ends in pages of its own (ResidentMesh): read back from the cache straight into
+    // them, or decoded into the heap and copied, so that what the heap holds is freed before the
+    // next load.
+    StatusOr<ResidentMesh> mesh = ResidentMesh();
+    if (cached) {
+        mesh = brick_cache_->Get(id);
+    } else {
+        if (decode_limit_ > 0) {
+            std::unique_lock<std::mutex> decode_lock(decode_mutex_);
+            decode_cv_.wait(decode_lock, [&] { return decodes_ < decode_limit_; });
+            ++decodes_;
+        }
+        StatusOr<store::BrickMesh> decoded = LoadMesh(id, &bytes);
+        if (decoded.ok() && brick_cache_ != nullptr) {
+            TraceSpan put(trace_, "write to the brick cache", "pager");
+            brick_cache_->Put(id, *decoded);
+        }
+        mesh = decoded.ok() ? ResidentMesh::CopyOf(*decoded)
+                            : StatusOr<ResidentMesh>(decoded.status());
+        if (decode_limit_ > 0) {
+            {
+                std::lock_guard<std::mutex> decode_lock(decode_mutex_);
+                --decodes_;
+            }
+            decode_cv_.notify_one();
+        }
+    }
+    decode.End();
+    if (mesh.ok()) load.AddArg({"triangles", mesh->TriangleCount()});
+    load.AddArg({"bytes_read", bytes});
+    TraceSpan build(trace_, "bvh build", "pager");
+    StatusOr<std::unique_ptr<ResidentBrick>> built =
+        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(),
+                                         &alpha_masks_, bvh_)
+                  : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
+    build.End();
+    double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!built.ok()) {
+        slot.error = built.status().WithContext(fmt::format("loading brick {}", id));
+        slot.pins.fetch_sub(1, std::memory_order_acq_rel);
+        return slot.error;
+    }
+    slot.brick = std::move(built).value();
+    {
+        std::lock_guard<std::mutex> stats_lock(stats_mutex_);
+        stats_.loads += 1;
+        stats_.bytes_read += bytes;
+        stats_.load_seconds += seconds;
+        stats_.resident_bytes += slot.brick->memory_bytes();
+        stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, stats_.resident_bytes);
+    }
+    slot.ready.store(slot.brick.get(), std::memory_order_release);
+    return BrickHandle(this, slot.brick.get());
+}
+
+void BrickSource::SetAlphaMasks(AlphaMasks masks) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "alpha masks set while bricks are resident";
+    alpha_masks_ = std::move(masks);
+}
+
+Status BrickSource::SetBvhSettings(const BvhSettings& bvh) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (bvh == bvh_) return Status::Ok();
+    if (stats_.resident_bytes != 0) {
+        return InvalidArgumentError(
+            "the BVH settings of a brick source cannot change while {} of bricks are resident",
+            stats_.resident_bytes);
+    }
+    bvh_ = bvh;
+    return Status::Ok();
+}
+
+void BrickSource::Release(uint32_t id) {
+    uint32_t before = slots_[id]->pins.fetch_sub(1, std::memory_order_acq_rel);
+    NAVE_CHECK_GT(before, 0u) << "brick " << id << " released more often than acquired";
+}
+
+bool BrickSource::IsResident(uint32_t id) const {
+    return id < slots_.size() && slots_[id]->ready.load(std::memory_order_acquire) != nullptr;
+}
+
+bool BrickSource::Evict(uint32_t id) {
+    if (id >= slots_.size()) return false;
+    Slot& slot = *slots_[id];
+    std::lock_guard<std::mutex> lock(slot.mutex);
+    if (slot.brick == nullptr || slot.pins.load(std::memory_order_acquire) != 0) return false;
+    slot.ready.store(nullptr, std::memory_order_release);
+    // A reader that pinned between our check and the store above would hold a dangling pointer;
+    // re-check.
+    if (slot.pins.load(std::memory_order_acquire) != 0) {
+        slot.ready.store(slot.brick.get(), std::memory_order_release);
+        return false;
+    }
+    uint64_t bytes = slot.brick->memory_bytes();
+    slot.brick.reset();
+    std::lock_guard<std::mutex> stats_lock(stats_mutex_);
+    stats_.evictions += 1;
+    stats_.resident_bytes -= bytes;
+    return true;
+}
+
+BrickSourceStats BrickSource::stats() const {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    BrickSourceStats s = stats_;
+    s.acquires = acquires_.load(std::memory_order_relaxed);
+    return s;
+}
+
+}  // namespace nave::render

@@ -1,0 +1,160 @@
+#pragma once
+// Access to the bricks of a model through pinned handles. The renderer never holds a brick except
+// through a BrickHandle, and never assumes that a brick it does not hold is resident: which bricks
+// stay in memory is the source's policy (StoreBrickSource keeps every brick it has loaded; the
+// out-of-core pager replaces that policy under a memory budget). A resident brick carries its
+// decoded mesh and its Embree scene, built when the brick is loaded (resident_brick.h).
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/bricks/embree_device.h"
+#include "src/render/bricks/resident_brick.h"
+#include "store/brick_mesh.h"
+#include "store/brick_tree.h"
+#include "store/material_record.h"
+
+namespace nave {
+class TraceRecorder;
+}
+
+namespace nave::render {
+
+class BrickSource;
+class BrickCache;
+
+/// A pin on a resident brick: while a handle lives, its brick stays in memory. Move-only; releasing
+/// (or destroying) the handle unpins it.
+class BrickHandle {
+  public:
+    BrickHandle() = default;
+    BrickHandle(BrickSource* source, const ResidentBrick* brick) : source_(source), brick_(brick) {}
+    BrickHandle(BrickHandle&& o) noexcept : source_(o.source_), brick_(o.brick_) {
+        o.source_ = nullptr;
+        o.brick_ = nullptr;
+    }
+    BrickHandle& operator=(BrickHandle&& o) noexcept;
+    BrickHandle(const BrickHandle&) = delete;
+    BrickHandle& operator=(const BrickHandle&) = delete;
+    ~BrickHandle() { Reset(); }
+
+    void Reset();
+    const ResidentBrick* get() const { return brick_; }
+    const ResidentBrick* operator->() const { return brick_; }
+    const ResidentBrick& operator*() const { return *brick_; }
+    explicit operator bool() const { return brick_ != nullptr; }
+
+  private:
+    BrickSource* source_ = nullptr;
+    const ResidentBrick* brick_ = nullptr;
+};
+
+/// Counters a source keeps for the final statistics (all since creation).
+struct BrickSourceStats {
+    uint64_t acquires = 0;        ///< Acquire calls (brick visits)
+    uint64_t loads = 0;           ///< bricks read and built
+    uint64_t evictions = 0;       ///< bricks dropped from memory
+    uint64_t bytes_read = 0;      ///< payload bytes read from disk
+    uint64_t resident_bytes = 0;  ///< bytes of the bricks in memory now
+    uint64_t peak_resident_bytes = 0;
+    double load_seconds = 0;  ///< time spent reading, decoding and building Embree scenes
+};
+
+/// Where bricks come from, and which stay resident. Thread-safe: many workers may acquire at once;
+/// loading one brick never blocks acquiring another that is already resident (one lock per brick,
+/// double-checked as in OpenVDB's LeafBuffer).
+class BrickSource {
+  public:
+    virtual ~BrickSource();
+
+    uint32_t brick_count() const { return uint32_t(slots_.size()); }
+    const store::BrickTree& tree() const { return tree_; }
+    /// The cell of every brick, by id.
+    const std::vector<Bounds3f>& cells() const { return cells_; }
+    const std::vector<store::MaterialRecord>& materials() const { return materials_; }
+    /// Box of all geometry.
+    const Bounds3f& bounds() const { return bounds_; }
+
+    /// Pins brick `id`, loading it first if it is not resident. Errors (corrupt brick, Embree
+    /// failure) name the brick and are returned to every caller that asks for it.
+    StatusOr<BrickHandle> Acquire(uint32_t id);
+    /// Whether brick `id` is in memory now (a hint: it may be evicted right after unless pinned).
+    bool IsResident(uint32_t id) const;
+    /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's
+    /// tool; the default policy never calls it.
+    bool Evict(uint32_t id);
+    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes), known without
+    /// loading it.
+    virtual uint64_t EstimatedResidentBytes(uint32_t id) const = 0;
+    BrickSourceStats stats() const;
+    /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
+    /// portals).
+    EmbreeDevice& device() const { return *device_; }
+    /// Cut-outs by material id, applied to every brick built from now on. Call before any brick is
+    /// loaded (checked): a resident brick keeps the masks it was built with.
+    void SetAlphaMasks(AlphaMasks masks);
+    /// How bricks build their BVH (and what EstimatedResidentBytes assumes). FailedPrecondition if
+    /// bricks built otherwise are resident (they would not match the estimates).
+    Status SetBvhSettings(const BvhSettings& bvh);
+    const BvhSettings& bvh_settings() const { return bvh_; }
+    /// Records every load (read and decode, BVH build) as spans on `trace` (null: no tracing). Set
+    /// before loads start; `trace` must outlive them.
+    void SetTrace(TraceRecorder* trace) { trace_ = trace; }
+    /// Loads read decoded meshes back from `cache` when it has them, and put there those they
+    /// decode (null: every load decodes from the store). Set before loads start; `cache` must
+    /// outlive them.
+    void SetBrickCache(BrickCache* cache) { brick_cache_ = cache; }
+    /// At most `limit` loads decode at once (0: no limit); under a budget one decode's scratch
+    /// memory is reserved, not one per loader. Set before loads start.
+    void SetDecodeLimit(int limit) { decode_limit_ = limit; }
+    /// Memory a load of brick `id` needs beside the brick itself while it decodes (0 for sources
+    /// that do not decode).
+    virtual uint64_t LoadScratchBytes(uint32_t id) const {
+        (void)id;
+        return 0;
+    }
+
+  protected:
+    BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+                std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
+                Bounds3f bounds);
+    /// Reads and decodes brick `id` (no caching: the base class caches). Adds to `bytes_read`.
+    virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
+
+  private:
+    friend class BrickHandle;
+    void Release(uint32_t id);
+
+    struct Slot {
+        std::mutex mutex;  // held while loading this brick
+        std::atomic<const ResidentBrick*> ready{nullptr};
+        std::unique_ptr<ResidentBrick> brick;
+        std::atomic<uint32_t> pins{0};
+        Status error;  // sticky load error
+    };
+    std::shared_ptr<EmbreeDevice> device_;
+    store::BrickTree tree_;
+    std::vector<Bounds3f> cells_;
+    std::vector<store::MaterialRecord> materials_;
+    Bounds3f bounds_;
+    AlphaMasks alpha_masks_;
+    BvhSettings bvh_;
+    TraceRecorder* trace_ = nullptr;
+    BrickCache* brick_cache_ = nullptr;
+    int decode_limit_ = 0;
+    std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
+    std::condition_variable decode_cv_;
+    int decodes_ = 0;
+    std::vector<std::unique_ptr<Slot>> slots_;
+    mutable std::mutex stats_mutex_;
+    BrickSourceStats stats_;
+    std::atomic<uint64_t> acquires_{0};
+};
+
+}  // namespace nave::render

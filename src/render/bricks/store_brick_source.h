@@ -1,0 +1,35 @@
+#pragma once
+// Bricks read from a store file (store/store_reader.h) on first touch.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+
+#include "src/core/status.h"
+#include "src/render/bricks/brick_source.h"
+
+namespace nave::store {
+class Store;
+}
+
+namespace nave::render {
+
+/// Bricks read from a store file on first touch and kept resident.
+class StoreBrickSource final : public BrickSource {
+  public:
+    static StatusOr<std::unique_ptr<StoreBrickSource>> Open(const std::filesystem::path& path,
+                                                            std::shared_ptr<EmbreeDevice> device);
+    ~StoreBrickSource() override;
+    const store::Store& store() const { return *store_; }
+    uint64_t EstimatedResidentBytes(uint32_t id) const override;
+    uint64_t LoadScratchBytes(uint32_t id) const override;
+
+  protected:
+    StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+
+  private:
+    StoreBrickSource(std::unique_ptr<store::Store> store, std::shared_ptr<EmbreeDevice> device);
+    std::unique_ptr<store::Store> store_;
+};
+
+}  // namespace nave::render

@@ -1,0 +1,165 @@
+#include "src/render/integrators/path_integrator.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "src/core/byte_stream.h"
+#include "src/core/image_error.h"
+#include "src/core/log.h"
+#include "src/render/transport/transport_common.h"
+
+namespace nave::render {
+
+StatusOr<std::unique_ptr<PathIntegrator>> PathIntegrator::Create(const RenderScene& scene,
+                                                                 Film* film,
+                                                                 StreamScheduler& scheduler) {
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<LightSampler> lights,
+                          LightSampler::Create(scene, scheduler, nullptr));
+    std::unique_ptr<PathGuide> guide;
+    if (scene.settings.path_guiding && !scene.source->bounds().Empty()) {
+        guide = std::make_unique<PathGuide>(scene.source->bounds(), kGuideCoarseCellsLongAxis,
+                                            kGuideMaxCells, GuideRadianceScale(scene));
+    }
+    return std::unique_ptr<PathIntegrator>(
+        new PathIntegrator(scene, film, scheduler, std::move(lights), std::move(guide)));
+}
+
+PathIntegrator::PathIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
+                               std::unique_ptr<LightSampler> lights,
+                               std::unique_ptr<PathGuide> guide)
+    : CameraPaths(scene, film, scheduler, *lights, guide.get()),
+      owned_lights_(std::move(lights)),
+      owned_guide_(std::move(guide)) {}
+
+double PathIntegrator::GuideRadianceScale(const RenderScene& scene) {
+    // The radiance of a white surface in full sun (or, without a sun, the sky's brightest axis):
+    // the order of the light that surfaces reflect toward the paths' vertices.
+    const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
+    double scale = 0;
+    if (scene.sun >= 0) {
+        const Light& sun = scene.lights[size_t(scene.sun)];
+        const double solid_angle = sun.SunSolidAngle();
+        scale = double(sun.spectrum.Sample(green).Average()) * solid_angle * kInvPi;
+    }
+    if (scene.sky) {
+        for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
+                               Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
+            scale = std::max(scale, double(scene.SkyRadiance(w, green).Average()));
+    }
+    return scale > 0 ? scale : 1.0;
+}
+
+ProgressUnits PathIntegrator::progress_units() const {
+    // Advanced by every path as it ends, on the workers: a wave can be the whole image.
+    return {"render", "paths", uint64_t(scene_.camera->width()) * scene_.camera->height()};
+}
+
+Status PathIntegrator::Restore(const RenderSession& session) {
+    if (!owned_guide_) return Status::Ok();
+    NAVE_ASSIGN_OR_RETURN(std::string_view bytes, session.Section("path_guide"));
+    ByteReader in(bytes, session.resume_name() + " section path_guide");
+    NAVE_RETURN_IF_ERROR(owned_guide_->LoadState(&in));
+    return in.ExpectEnd();
+}
+
+void PathIntegrator::Save(Checkpoint* checkpoint) const {
+    if (!owned_guide_) return;
+    ByteWriter out;
+    owned_guide_->SaveState(&out);
+    checkpoint->sections["path_guide"] = out.Take();
+}
+
+StatusOr<int> PathIntegrator::RenderRounds(int s, bool boundaries) {
+    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const int spp = scene_.settings.spp;
+    const uint64_t wave = scene_.settings.wave_paths;
+    // Small images put several passes in one wave, so that the streams stay long enough to keep
+    // every thread busy; large images split a pass into waves to bound the memory of the queues.
+    // A render that may be checkpointed ends every pass with a complete drain instead: its state
+    // is then the film and the guide alone, and the order in which the film adds up its samples
+    // does not depend on when checkpoints were written.
+    const int passes_per_wave =
+        boundaries ? 1 : int(std::clamp<uint64_t>(wave / pixels, 1, uint64_t(spp)));
+    // With a noise target or a time limit, a wave stops for a check at least every quarter of the
+    // passes done so far (2, 3, 4, 5, ... 8, 10, 12, 15...): at most ~25 % more passes than needed.
+    const bool checks = scene_.settings.noise_target > 0 || scene_.settings.time_limit_s > 0;
+    const int group =
+        checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
+    int s_end = std::min(spp, s + group);
+    // The guide learns from every pass and updates its distributions after passes 1, 2, 4,
+    // 8...: each update follows a complete drain, so that what it learned from does not depend
+    // on the waves, the memory budget or the threads.
+    const int next_update = owned_guide_ ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
+    const bool update = owned_guide_ && s_end >= next_update;
+    if (update) s_end = next_update;
+    for (uint64_t first = 0; first < pixels; first += wave) {
+        const uint64_t last = std::min(pixels, first + wave);
+        for (int k = s; k < s_end; ++k)
+            NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k)));
+        NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
+    }
+    if (update || boundaries) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
+    if (update) {
+        owned_guide_->Update();
+        log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
+                   owned_guide_->cells_used(), owned_guide_->cells_guiding());
+    }
+    // The last wave's tail may still be in flight: the noise estimate then misses a little of the
+    // last pass, which the final estimate, after the last drain, does not.
+    return s_end;
+}
+
+Status PathIntegrator::Finish(int passes, RenderStats* stats) {
+    NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));  // the last wave's tail
+    stats->samples_per_pixel = passes;
+    stats->noise_relmse = NoiseEstimate(passes);
+    if (owned_guide_) {
+        stats->guide_cells = owned_guide_->cells_used();
+        stats->guide_cells_guiding = owned_guide_->cells_guiding();
+    }
+    stats->camera_paths =
+        uint64_t(scene_.camera->width()) * scene_.camera->height() * uint64_t(passes);
+    film_->SetSamplesPerPixel(passes);
+    return Status::Ok();
+}
+
+double PathIntegrator::NoiseEstimate(int passes) const {
+    if (passes < 2) return std::nan("");
+    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
+        return std::array<double, 2>{film_->HalfLuminance(uint32_t(p), 0, passes),
+                                     film_->HalfLuminance(uint32_t(p), 1, passes)};
+    });
+}
+
+bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                               const SurfaceHit& h, bool last, RayOutbox& out) {
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    // The side the path sees of the surface, which keeps the guide's histograms of a floor and
+    // of the wall above it apart.
+    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const GuidedBsdf continuation(bsdf, owned_guide_.get(), h.p, side);
+    if (flags & (kBxdfDiffuse | kBxdfGlossy)) {
+        // What next-event estimation finds here, reflected once more, is light arriving at the
+        // path's previous vertex from this one: its shadow rays credit the guide there.
+        uint32_t credit = PathGuide::kNoCredit;
+        float credit_scale = 0;
+        const float beta = r.beta.Average();
+        if (owned_guide_ && r.depth > 0 && !(r.flags & kSpecularBounce) && beta > 0 &&
+            r.prev_pdf > 0) {
+            credit =
+                owned_guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir);
+            credit_scale = 1 / (beta * r.prev_pdf);
+        }
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky, credit,
+                       credit_scale, out);
+    }
+    return Continue(r, h, continuation, rng, side, last);
+}
+
+}  // namespace nave::render

@@ -1,0 +1,28 @@
+#include "src/render/integrators/render_memory.h"
+
+#include "src/render/film/film.h"
+#include "src/render/integrators/render_session.h"
+#include "src/render/transport/path_guide.h"
+#include "src/render/transport/photon_emitters.h"
+#include "src/render/transport/visible_points.h"
+
+namespace nave::render {
+
+RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, int height, bool aov,
+                                   bool checkpoints) {
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    RenderStateBytes state;
+    state.film = Film::MemoryBytes(width, height);
+    if (settings.mode == RenderSettings::Mode::kPhoton) {
+        // The visible points and what the photon emitters learn from.
+        state.transport = VisiblePoints::MemoryBytes(pixels) +
+                          PhotonEmitters::LearningBytes(settings.photons_per_iteration);
+    } else if (settings.path_guiding) {
+        state.transport = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
+    }
+    // Writing a checkpoint holds the film's and the guide's state beside them.
+    state.checkpoint = checkpoints ? CheckpointMemoryBytes(settings, width, height, aov) : 0;
+    return state;
+}
+
+}  // namespace nave::render

@@ -1,0 +1,87 @@
+#include "src/render/integrators/render_streams.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+
+#include "src/core/check.h"
+#include "src/core/memory.h"
+#include "src/core/progress.h"
+#include "src/render/integrators/integrator.h"
+#include "src/render/integrators/stopping_rule.h"
+#include "src/render/stream/stream_scheduler.h"
+
+namespace nave::render {
+namespace {
+
+/// Renders rounds of `integrator` until it has all it asks for, the stopping rule of `settings`
+/// ends the render or the session ends this run, then has it complete the film and fill `stats`:
+/// the part every mode shares (resume, progress, the stopping rule, checkpoints).
+Status RenderRounds(const RenderSettings& settings, Integrator& integrator, RenderSession& session,
+                    RenderStats* stats) {
+    const int start = session.start();
+    NAVE_RETURN_IF_ERROR(session.RestoreFilm());
+    if (session.resume() != nullptr) NAVE_RETURN_IF_ERROR(integrator.Restore(session));
+    session.ReleaseResumed();
+    const int wanted = integrator.rounds_wanted();
+    const ProgressUnits units = integrator.progress_units();
+    ProgressBar progress(std::string(units.task),
+                         units.per_round * uint64_t(std::max(wanted, start)),
+                         std::string(units.unit));
+    progress.Add(units.per_round * uint64_t(start));
+    integrator.set_progress(&progress);
+    struct Unset {
+        Integrator& integrator;
+        ~Unset() { integrator.set_progress(nullptr); }
+    } unset{integrator};  // before `progress` goes, whichever way this returns
+    StoppingRule stop(settings, &progress, session.elapsed_before_s());
+    int done = start;
+    while (done < wanted) {
+        NAVE_ASSIGN_OR_RETURN(done, integrator.RenderRounds(done, session.active()));
+        const bool enough = stop.ShouldStop([&] { return integrator.NoiseEstimate(done); });
+        bool end_run = false;
+        NAVE_RETURN_IF_ERROR(session.AtBoundary(
+            done, stop.Elapsed(), enough || done >= wanted,
+            [&](Checkpoint* checkpoint) { integrator.Save(checkpoint); }, &end_run));
+        if (enough || end_run) break;
+    }
+    NAVE_RETURN_IF_ERROR(integrator.Finish(done, stats));
+    progress.Finish();
+    return Status::Ok();
+}
+
+}  // namespace
+
+Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker,
+                     const PagerOptions* paging, const SessionOptions* session_options) {
+    NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
+    int threads = scene.settings.threads > 0 ? scene.settings.threads
+                                             : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    Status status;
+    arena.execute([&] {
+        status = [&]() -> Status {
+            // In-core too, the pager loads bricks in the background while the workers trace.
+            NAVE_ASSIGN_OR_RETURN(
+                std::unique_ptr<StreamScheduler> scheduler,
+                StreamScheduler::Create(*scene.source, paging != nullptr ? *paging : PagerOptions(),
+                                        std::move(picker), scene.settings.wave_paths));
+            RenderSession session(session_options, film);
+            const auto start = std::chrono::steady_clock::now();
+            const BrickSourceStats before = scene.source->stats();
+            NAVE_ASSIGN_OR_RETURN(std::unique_ptr<Integrator> integrator,
+                                  Integrator::Create(scene, film, *scheduler));
+            NAVE_RETURN_IF_ERROR(RenderRounds(scene.settings, *integrator, session, stats));
+            stats->wall_seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            scheduler->FillStats(before, stats);
+            stats->peak_rss_bytes = PeakRssBytes();
+            return Status::Ok();
+        }();
+    });
+    return status;
+}
+
+}  // namespace nave::render

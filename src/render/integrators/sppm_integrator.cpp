@@ -1,0 +1,192 @@
+#include "src/render/integrators/sppm_integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "src/core/byte_stream.h"
+#include "src/core/image_error.h"
+#include "src/core/progress.h"
+#include "src/render/scene/surface_hit.h"
+#include "src/render/transport/rng.h"
+#include "src/render/transport/transport_common.h"
+
+namespace nave::render {
+
+StatusOr<std::unique_ptr<SppmIntegrator>> SppmIntegrator::Create(const RenderScene& scene,
+                                                                 Film* film,
+                                                                 StreamScheduler& scheduler) {
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<PhotonEmitters> emitters,
+                          PhotonEmitters::Build(scene, scheduler));
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<LightSampler> lights,
+                          LightSampler::Create(scene, scheduler, emitters->sky_portals()));
+    return std::unique_ptr<SppmIntegrator>(
+        new SppmIntegrator(scene, film, scheduler, std::move(emitters), std::move(lights)));
+}
+
+namespace {
+
+/// r_1: render.initial_radius_m, or 1 % of the model's diameter.
+float InitialRadius(const RenderScene& scene, const PhotonEmitters& emitters) {
+    return scene.settings.initial_radius_m > 0 ? scene.settings.initial_radius_m
+                                               : 0.01f * 2 * emitters.scene_radius();
+}
+
+}  // namespace
+
+SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
+                               std::unique_ptr<PhotonEmitters> emitters,
+                               std::unique_ptr<LightSampler> lights)
+    : scene_(scene),
+      film_(film),
+      scheduler_(scheduler),
+      emitters_(std::move(emitters)),
+      lights_(std::move(lights)),
+      visible_(std::make_unique<VisiblePoints>(
+          uint64_t(scene.camera->width()) * scene.camera->height(), scene.source->brick_count(),
+          InitialRadius(scene, *emitters_), scene.settings.alpha)),
+      camera_pass_(scene, film, scheduler, *lights_, visible_.get()),
+      sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
+
+Status SppmIntegrator::Restore(const RenderSession& session) {
+    NAVE_ASSIGN_OR_RETURN(std::string_view points, session.Section("visible_points"));
+    ByteReader points_in(points, session.resume_name() + " section visible_points");
+    NAVE_RETURN_IF_ERROR(visible_->LoadState(&points_in));
+    NAVE_ASSIGN_OR_RETURN(std::string_view learned, session.Section("photon_emitters"));
+    ByteReader learned_in(learned, session.resume_name() + " section photon_emitters");
+    return emitters_->LoadState(&learned_in);
+}
+
+void SppmIntegrator::Save(Checkpoint* checkpoint) const {
+    ByteWriter points, learned;
+    visible_->SaveState(&points);
+    emitters_->SaveState(&learned);
+    checkpoint->sections["visible_points"] = points.Take();
+    checkpoint->sections["photon_emitters"] = learned.Take();
+}
+
+StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
+    // Every iteration ends with its photons drained: a checkpoint needs no extra drain.
+    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const uint64_t photons = scene_.settings.photons_per_iteration;
+    const uint64_t wave = scene_.settings.wave_paths;
+    iteration_ = uint32_t(done);
+    camera_pass_.set_iteration(iteration_);
+    visible_->BeginIteration(uint64_t(scene_.settings.seed), iteration_, photons);
+    // Visible points must all be in place before photons arrive: waves overlap within each pass
+    // only. So the queues hold camera paths and their shadow rays, then photons, never both,
+    // and each pass is drained by its own processor.
+    for (uint64_t first = 0; first < pixels; first += wave) {
+        NAVE_RETURN_IF_ERROR(
+            camera_pass_.GenerateCameraRays(first, std::min(pixels, first + wave), 0));
+        NAVE_RETURN_IF_ERROR(
+            scheduler_.Drain(camera_pass_, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
+    }
+    visible_->BuildBrickGrids(scheduler_.tree());
+    deposited_.assign(emitters_->learned_photons(), 0.f);
+    for (uint64_t first = 0; first < photons; first += wave) {
+        emitters_->EmitPhotons(first, std::min(photons, first + wave), iteration_, scheduler_);
+        NAVE_RETURN_IF_ERROR(
+            scheduler_.Drain(*this, first + wave < photons ? scheduler_.WaveOverlap() : 0));
+    }
+    emitters_->Learn(deposited_);
+    visible_->EndIteration(Film::SampleHalf(iteration_));
+    if (progress_ != nullptr) progress_->Add(1);
+    return done + 1;
+}
+
+Status SppmIntegrator::Finish(int done, RenderStats* stats) {
+    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const uint64_t photons = scene_.settings.photons_per_iteration;
+    // Direct light and specular chains were summed by the film over `done` iterations; the photon
+    // estimate is added as `done` times the per-iteration mean so the film's division by its sample
+    // count holds.
+    film_->SetSamplesPerPixel(done);
+    const double emitted = double(photons) * done;
+    for (uint64_t p = 0; p < pixels; ++p) {
+        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done),
+                      Film::kNoHalf);
+    }
+    stats->noise_relmse = NoiseEstimate(done);
+    stats->iterations = done;
+    stats->samples_per_pixel = done;
+    stats->camera_paths = pixels * uint64_t(done);
+    stats->photons = emitted;
+    return Status::Ok();
+}
+
+double SppmIntegrator::NoiseEstimate(int iterations) const {
+    if (iterations < 2) return std::nan("");
+    // Each half: the film's direct light and specular chains of its iterations (even or odd) plus
+    // the photon estimate of the same iterations. Pixel by pixel: no image is held.
+    const double photons = double(scene_.settings.photons_per_iteration);
+    const double emitted[2] = {photons * ((iterations + 1) / 2), photons * (iterations / 2)};
+    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
+        std::array<double, 2> half;
+        for (int h = 0; h < 2; ++h) {
+            half[h] = film_->HalfLuminance(uint32_t(p), h, iterations) +
+                      visible_->IndirectHalfY(uint32_t(p), h, emitted[h]);
+        }
+        return half;
+    });
+}
+
+void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                                  std::span<const RayRecord> rays, RayOutbox& out) {
+    for (RayRecord r : rays) {
+        TraceInBrick(
+            r, brick, resident, scheduler_, out,
+            [&](RayRecord& photon, const BrickHit& hit) {
+                return ShadePhoton(photon, brick, resident, hit);
+            },
+            [](const RayRecord&) {});  // photons leaving the model carry nothing back
+    }
+}
+
+bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                                 const BrickHit& hit) {
+    SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    AbsorbInsideGlass(mat, h, &r);
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    // Direct light from the sun and the other delta or disc lights is next-event estimated at the
+    // visible points: deposit only photons that bounced, or that come from emitters no estimator
+    // samples (emissive surfaces; the sky with render.sky_direct = "photons").
+    if ((r.depth > 0 || (r.flags & kFromAreaLight) ||
+         ((r.flags & kFromSky) && sky_direct_photons_)) &&
+        (flags & kBxdfDiffuse)) {
+        const float added = visible_->Deposit(
+            b, h.p, h.ng, wo, r.beta, r.lambda,
+            VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)));
+        // One writer per photon: a photon is traced by one thread at a time.
+        if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
+    }
+    // As for paths, a photon at its last bounce still passes through thin glass.
+    const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);
+    if (last && mat.thin_glass() == nullptr) return false;
+    VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamPhoton));
+    std::optional<BsdfSample> bs = bsdf.Sample(
+        wo, rng.Uniform(kDimBsdfChoice), Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)),
+        r.lambda, TransportMode::kImportance);
+    if (!bs) return false;
+    SampledSpectrum beta = r.beta * bs->f * (std::abs(Dot(bs->wi, h.ns)) / bs->pdf);
+    r.vertex += 1;
+    if (IsPassThrough(mat, *bs)) {
+        // Through a window pane: not a bounce, so a photon that arrives next at a diffuse surface
+        // is still direct sunlight, which next-event estimation through glass already counts.
+        r.beta = beta;
+        return PassThrough(r, h, bs->wi);
+    }
+    if (last) return false;
+    // Russian roulette on the photon's change of power (pbrt-v4 SPPM photon pass).
+    float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
+    if (rng.Uniform(kDimRoulette) < q) return false;
+    r.beta = beta / (1 - q);
+    return Bounce(r, h, bs->wi);
+}
+
+}  // namespace nave::render

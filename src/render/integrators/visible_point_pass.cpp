@@ -1,0 +1,47 @@
+#include "src/render/integrators/visible_point_pass.h"
+
+#include "src/render/transport/transport_common.h"
+
+namespace nave::render {
+
+VisiblePointPass::VisiblePointPass(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
+                                   const LightSampler& lights, VisiblePoints* visible_points)
+    : CameraPaths(scene, film, scheduler, lights, nullptr),
+      visible_points_(visible_points),
+      sky_from_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
+
+bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                                 const SurfaceHit& h, bool last, RayOutbox& out) {
+    const SurfaceMaterial& mat = *h.material;
+    const Vec3f wo = -r.dir;
+    if (mat.dispersive() && !r.lambda.SecondaryTerminated() &&
+        r.beta.MaxValue() == r.beta.MinValue()) {
+        // The path is about to keep one wavelength. Nothing it did so far depended on its own (the
+        // throughput is the same at all four), so it may take its iteration's shared wavelengths
+        // instead, which some photons carry too (visible_points.h).
+        r.lambda = IterationWavelengths(uint64_t(scene_.settings.seed), iteration(),
+                                        VisiblePoints::PixelChannel(r.pixel));
+    }
+    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    const uint8_t flags = bsdf.Flags();
+    if (flags == kBxdfUnset) return false;
+    VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    if (flags & kBxdfDiffuse) {
+        // With render.sky_direct = "photons", the sky's photons bring its direct light here.
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, nullptr, scene_.sky && !sky_from_photons_,
+                       PathGuide::kNoCredit, 0, out);
+        // SPPM: indirect light at the visible point comes from photons.
+        visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, h.footprint,
+                             r.beta, r.lambda);
+        return false;
+    }
+    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
+    if (flags & kBxdfGlossy) {
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky,
+                       PathGuide::kNoCredit, 0, out);
+    }
+    return Continue(r, h, continuation, rng, side, last);
+}
+
+}  // namespace nave::render

@@ -1,0 +1,313 @@
+#include "src/render/scene/scene.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "src/core/log.h"
+#include "src/core/rgb_to_spectrum.h"
+#include "src/render/scene/materials/ior.h"
+#include "src/render/scene/sun/sun.h"
+
+namespace nave::render {
+
+Spectrum ToSpectrum(const SpectrumSpec& spec) {
+    if (spec.kind == SpectrumSpec::Kind::kConstant)
+        return Spectrum::Constant(spec.value * spec.scale);
+    return Spectrum::FromFunction(
+        [&](double lambda_nm) { return spec.Evaluate(float(lambda_nm)); });
+}
+
+float SurfaceMaterial::AlbedoForAov() const {
+    if (black) return 0;
+    if (const auto* d = std::get_if<DiffuseMaterial>(&material)) return d->albedo.Evaluate(550);
+    return 1;
+}
+
+Spectrum HorizontalIrradiance(const RenderScene& scene) {
+    std::vector<double> e(Spectrum::kNumSamples, 0.0);
+    if (scene.preetham) {
+        // ∫ L cos θ dω = ∫∫ L(μ, φ) μ dμ dφ over μ in (0, 1].
+        constexpr int kMu = 64, kPhi = 128;
+        const double cell = (1.0 / kMu) * (2 * std::numbers::pi / kPhi) * scene.sky_scale;
+        for (int i = 0; i < kMu; ++i) {
+            const double mu = (i + 0.5) / kMu, r = std::sqrt(1 - mu * mu);
+            for (int j = 0; j < kPhi; ++j) {
+                const double phi = (j + 0.5) * 2 * std::numbers::pi / kPhi;
+                const Spectrum l = scene.preetham->RadianceSpectrum(
+                    Vec3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(mu)));
+                for (int k = 0; k < Spectrum::kNumSamples; ++k)
+                    e[size_t(k)] += double(l.sample(k)) * mu * cell;
+            }
+        }
+    } else if (scene.sky) {
+        for (int k = 0; k < Spectrum::kNumSamples; ++k)
+            e[size_t(k)] = std::numbers::pi * scene.sky_radiance.sample(k);
+    }
+    if (scene.sun >= 0) {
+        const Light& sun = scene.lights[size_t(scene.sun)];
+        const double sun_e = sun.SunSolidAngle() * std::max(0.0, double(sun.to_light.z));
+        for (int k = 0; k < Spectrum::kNumSamples; ++k)
+            e[size_t(k)] += sun_e * sun.spectrum.sample(k);
+    }
+    return Spectrum::FromFunction(
+        [&](double lambda) { return e[size_t(int(lambda - kLambdaMinNm))]; });
+}
+
+namespace {
+
+/// The extinction coefficient k of a glass config: `k` as given, or `kappa` times n (ñ = n(1 +
+/// iκ)).
+Spectrum GlassK(const MaterialConfig& mc) {
+    const Spectrum k = ToSpectrum(*mc.glass_k);
+    return mc.glass_k_is_kappa ? k * ToSpectrum(mc.eta) : k;
+}
+
+/// The physics material a config table describes.
+StatusOr<Material> ToMaterial(const MaterialConfig& mc, const std::string& name) {
+    if (!mc.builtin.empty()) {
+        StatusOr<Material> m = BuiltinMaterial(mc.builtin);
+        if (!m.ok())
+            return m.status().WithContext(fmt::format("{}: materials.{}.builtin", mc.where, name));
+        return m;
+    }
+    switch (mc.kind) {
+        case MaterialConfig::Kind::kDiffuse:
+            return Material(DiffuseMaterial{ToSpectrum(mc.reflectance)});
+        case MaterialConfig::Kind::kConductor: {
+            float a = RoughnessToAlpha(mc.roughness);
+            return Material(ConductorMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.k), a, a});
+        }
+        case MaterialConfig::Kind::kDielectric: {
+            DielectricMaterial d;
+            d.eta = ToSpectrum(mc.eta);
+            d.alpha = RoughnessToAlpha(mc.roughness);
+            if (mc.glass_k) d.absorption_per_m = AbsorptionPerMetre(GlassK(mc));
+            return Material(d);
+        }
+        case MaterialConfig::Kind::kThinDielectric:
+            if (mc.glass_k) {
+                // Internal transmittance of one pass at normal incidence: exp(-α d), α = 4πk/λ.
+                return Material(ThinGlassMaterial::FromAbsorption(ToSpectrum(mc.eta),
+                                                                  AbsorptionPerMetre(GlassK(mc)),
+                                                                  double(mc.thickness_mm) * 1e-3));
+            }
+            if (mc.total_transmittance) {
+                return Material(ThinGlassMaterial::FromTotalTransmittance(
+                    ToSpectrum(mc.eta), ToSpectrum(*mc.total_transmittance)));
+            }
+            return Material(ThinGlassMaterial{ToSpectrum(mc.eta), ToSpectrum(mc.transmittance)});
+        case MaterialConfig::Kind::kBlack:
+            break;
+    }
+    return Material(DiffuseMaterial{Spectrum::Constant(0.f)});
+}
+
+}  // namespace
+
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
+    SunState s;
+    if (sun.direction) {
+        s.to_sun = *sun.direction;
+        s.angular_radius_rad = double(sun.angular_radius_deg) * std::numbers::pi / 180;
+        s.zenith_deg = std::acos(std::clamp(s.to_sun.z, -1.f, 1.f)) * 180.0 / std::numbers::pi;
+        s.azimuth_deg =
+            std::fmod(std::atan2(s.to_sun.x, s.to_sun.y) * 180.0 / std::numbers::pi + 360.0, 360.0);
+        if (sun.radiance) {
+            s.radiance = ToSpectrum(*sun.radiance);
+        } else {
+            // A fixed direction without a spectrum: the clear-sky spectrum of the physics model for
+            // that zenith angle would need a date; use the extraterrestrial spectrum (ASTM E-490)
+            // spread over the disc, i.e. the sun without an atmosphere.
+            const double omega = ConeSolidAngle(s.angular_radius_rad);
+            s.radiance = ExtraterrestrialSolarSpectrum() * float(1.0 / omega);
+        }
+    } else {
+        SunInput in;
+        in.time = CivilTime{sun.when.year,
+                            sun.when.month,
+                            sun.when.day,
+                            sun.when.hour,
+                            sun.when.minute,
+                            sun.when.second,
+                            sun.when.utc_offset_minutes / 60.0};
+        in.latitude_deg = sun.latitude_deg;
+        in.longitude_deg = sun.longitude_deg;
+        in.elevation_m = sun.elevation_m;
+        in.atmosphere.pressure_hpa = sun.pressure_mbar;  // 1 mbar = 1 hPa
+        in.atmosphere.temperature_c = sun.temperature_c;
+        in.atmosphere.turbidity = sun.turbidity;
+        StatusOr<Sun> model = ComputeSun(in);
+        if (!model.ok()) return model.status().WithContext(fmt::format("{}: [sun]", file));
+        s.to_sun = model->direction;
+        s.zenith_deg = model->position.zenith_deg;
+        s.azimuth_deg = model->position.azimuth_deg;
+        s.angular_radius_rad = model->angular_radius_rad;
+        s.radiance = sun.radiance ? ToSpectrum(*sun.radiance) : model->radiance;
+        s.above_horizon = model->AboveHorizon();
+    }
+    s.radiance *= sun.scale;
+    return s;
+}
+
+namespace {
+
+/// The config mapping of a model material: its own, else "default", else null.
+const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config,
+                                                                const std::string& name) {
+    auto it = config.materials.find(name);
+    if (it == config.materials.end()) it = config.materials.find("default");
+    return it == config.materials.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir,
+                      TextureCache& cache, RenderScene* scene, std::vector<std::string>* warnings) {
+    if (!config.textures.enabled) return Status::Ok();
+    const auto& records = scene->source->materials();
+    NAVE_CHECK_EQ(records.size(), scene->materials.size());
+    AlphaMasks masks(records.size());
+    bool any_mask = false;
+    for (size_t i = 0; i < records.size(); ++i) {
+        const store::MaterialRecord& rec = records[i];
+        if (rec.textures.empty()) continue;
+        const auto* mapping = FindMapping(config, rec.name);
+        NAVE_CHECK(mapping != nullptr);  // BuildRenderScene refused unmapped materials
+        const MaterialConfig& mc = mapping->second;
+        if (!mc.textures) continue;
+        SurfaceMaterial& m = scene->materials[i];
+        SurfaceTextureOptions options;
+        options.use_albedo = std::holds_alternative<DiffuseMaterial>(m.material);
+        options.use_transmittance = std::holds_alternative<ThinGlassMaterial>(m.material);
+        options.use_emission =
+            !mc.emission;  // the config's emission overrides the model's, texture included
+        options.emission_scale = mc.emission_scale;
+        std::shared_ptr<const SurfaceTextures> t =
+            OpenSurfaceTextures(cache, rec, base_dir, options, warnings);
+        if (t == nullptr) continue;
+        if (t->emission) m.emissive = true;
+        if (t->alpha) {
+            masks[i] = t;
+            any_mask = true;
+        }
+        m.textures = std::move(t);
+    }
+    if (any_mask) scene->source->SetAlphaMasks(std::move(masks));
+    return Status::Ok();
+}
+
+StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source) {
+    RenderScene scene;
+    scene.source = &source;
+    scene.camera = std::make_unique<Camera>(config.camera);
+    scene.settings = config.render;
+    scene.output = config.output;
+    const std::string file = config.path.string();
+
+    // Materials: every model material needs a mapping (or the default).
+    const auto& records = source.materials();
+    for (size_t i = 0; i < records.size(); ++i) {
+        const store::MaterialRecord& rec = records[i];
+        const auto* it = FindMapping(config, rec.name);
+        if (it == nullptr) {
+            return InvalidArgumentError(
+                "{}: the model's material '{}' has no mapping: add [materials.{}] or "
+                "[materials.default]",
+                file, rec.name, rec.name);
+        }
+        const MaterialConfig& mc = it->second;
+        SurfaceMaterial m;
+        m.name = rec.name;
+        NAVE_ASSIGN_OR_RETURN(m.material, ToMaterial(mc, it->first));
+        m.black = mc.builtin.empty() && mc.kind == MaterialConfig::Kind::kBlack;
+        m.portal = mc.portal;
+        if (mc.emission) {
+            m.emissive = true;
+            m.emission = ToSpectrum(*mc.emission);
+        } else if (rec.emission[0] > 0 || rec.emission[1] > 0 || rec.emission[2] > 0) {
+            // [texture] The model's own emission (MTL Ke, glTF emissiveFactor) is linear sRGB:
+            // lifted to a spectrum with its chromaticity (core/rgb_to_spectrum.h, Jakob & Hanika
+            // 2019 times the D65 white), whose luminance is the Rec. 709 luma of the RGB; a config
+            // emission overrides it.
+            m.emissive = true;
+            m.emission =
+                RgbEmission(Vec3f(rec.emission[0], rec.emission[1], rec.emission[2])).ToSpectrum();
+        }
+        scene.materials.push_back(std::move(m));
+    }
+    for (const auto& entry : config.materials) {
+        // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
+        const std::string& name = entry.first;
+        if (name == "default") continue;
+        bool used = std::any_of(records.begin(), records.end(),
+                                [&](const auto& r) { return r.name == name; });
+        if (!used)
+            log::Warning("{}: [materials.{}] maps no material of the model", entry.second.where,
+                         name);
+    }
+
+    if (config.sun.enabled) {
+        NAVE_ASSIGN_OR_RETURN(SunState sun, ResolveSun(config.sun, file));
+        if (!sun.above_horizon)
+            log::Warning("{}: the sun is below the horizon at that date and place", file);
+        Light l;
+        l.kind = Light::Kind::kSun;
+        l.to_light = sun.to_sun;
+        l.sun_radius_rad = sun.angular_radius_rad;
+        l.spectrum = sun.radiance;
+        scene.sun = int(scene.lights.size());
+        scene.lights.push_back(std::move(l));
+        scene.sun_description = fmt::format("azimuth {:.2f} deg, elevation {:.2f} deg",
+                                            sun.azimuth_deg, 90.0 - sun.zenith_deg);
+    }
+    for (const LightConfig& lc : config.lights) {
+        Light l;
+        l.spectrum = ToSpectrum(lc.spectrum);
+        switch (lc.kind) {
+            case LightConfig::Kind::kDirectional:
+                l.kind = Light::Kind::kDirectional;
+                l.to_light = -lc.direction;
+                break;
+            case LightConfig::Kind::kPoint:
+                l.kind = Light::Kind::kPoint;
+                l.position = lc.position;
+                break;
+            case LightConfig::Kind::kSpot:
+                l.kind = Light::Kind::kSpot;
+                l.position = lc.position;
+                l.spot_axis = lc.direction;
+                l.cos_cone = std::cos(lc.cone_deg * kPi / 180.f);
+                l.cos_falloff = std::cos(lc.falloff_start_deg * kPi / 180.f);
+                break;
+        }
+        scene.lights.push_back(std::move(l));
+    }
+    if (config.sky.kind == SkyConfig::Kind::kUniform) {
+        scene.sky = true;
+        scene.sky_radiance = ToSpectrum(config.sky.radiance);
+    } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
+        scene.sky = true;
+        double turbidity =
+            std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
+        const Light& sun = scene.lights[size_t(scene.sun)];
+        scene.preetham = std::make_shared<PreethamSky>(sun.to_light, float(turbidity));
+        scene.sky_scale = config.sky.scale;
+        if (config.sky.ground_albedo) {
+            // Lambertian: L = ρ E / π (the parser checked ρ is within [0, 1]).
+            scene.ground_radiance = ToSpectrum(*config.sky.ground_albedo) *
+                                    HorizontalIrradiance(scene) * float(1 / std::numbers::pi);
+        }
+    }
+    if (scene.output.white_balance == "scene") {
+        const Vec3d white = SpectrumToXYZ(HorizontalIrradiance(scene));
+        if (!(white.y > 0)) {
+            return InvalidArgumentError(
+                "{}: [output] white_balance = \"scene\" needs a sun above the horizon or a sky",
+                file);
+        }
+        scene.output.scene_white = XYZToChromaticity(white);
+    }
+    return scene;
+}
+
+}  // namespace nave::render

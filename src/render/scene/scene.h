@@ -1,0 +1,191 @@
+#pragma once
+// A scene ready to render: the config resolved against a model. Material names of the model are
+// mapped to spectral materials (a name with no mapping is an error naming it, unless a "default"
+// mapping exists), config spectra are tabulated, and the sun's direction and spectrum are computed
+// from date and place.
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "src/core/sampling.h"
+#include "src/core/spectrum.h"
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/scene/camera.h"
+#include "src/render/scene/materials/bxdf.h"
+#include "src/render/scene/materials/frame.h"
+#include "src/render/scene/materials/materials.h"
+#include "src/render/scene/scene_config.h"
+#include "src/render/scene/sun/sky.h"
+#include "src/render/scene/texture/surface_textures.h"
+
+namespace nave::render {
+
+/// A spectral material as the integrators use it: the physics library's Material
+/// (render/scene/materials/ materials.h) plus what the scene adds: emission, the portal flag, and
+/// black (absorbs everything).
+struct SurfaceMaterial {
+    std::string name;
+    Material material;   ///< physics: diffuse, conductor, dielectric, thin glass
+    bool black = false;  ///< no scattering at all
+    bool emissive = false;
+    Spectrum emission;    ///< radiance, W m^-2 sr^-1 nm^-1, both sides
+    bool portal = false;  ///< photons are aimed at it (render.photon_target = "portals")
+    /// The model's textures for this material (albedo of a diffuse material, alpha, emission);
+    /// null: none.
+    std::shared_ptr<const SurfaceTextures> textures;
+
+    /// The BSDF at a hit with unit shading normal `ns`. Dispersive refraction terminates the
+    /// secondary wavelengths of `lambda`.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda) const {
+        if (black) return Bsdf(ns, Vec3f(0, 0, 0), Bxdf());
+        return Bsdf(ns, Vec3f(0, 0, 0), GetBxdf(material, *lambda));
+    }
+    /// The BSDF at a hit with texture coordinates `uv` (null when the mesh has none), textures
+    /// filtered over `footprint`.
+    Bsdf MakeBsdf(const Vec3f& ns, SampledWavelengths* lambda, const std::array<float, 2>* uv,
+                  const TextureFootprint& footprint = {}) const {
+        if (textures && textures->albedo && uv != nullptr && !black &&
+            std::holds_alternative<DiffuseMaterial>(material))
+            return Bsdf(ns, Vec3f(0, 0, 0),
+                        Bxdf(DiffuseBxdf(textures->Albedo(*uv, footprint, *lambda))));
+        if (const ThinGlassMaterial* glass = thin_glass();
+            glass && textures && textures->transmittance && uv) {
+            SampledSpectrum tau = textures->Transmittance(*uv, *lambda);
+            return Bsdf(ns, Vec3f(0, 0, 0), glass->GetBxdf(*lambda, &tau));
+        }
+        return MakeBsdf(ns, lambda);
+    }
+    /// The internal transmittance of a thin glass pane at a hit with texture coordinates `uv` (null
+    /// when the mesh has none): the spectral transmittance texture's where there is one. Call only
+    /// on thin glass.
+    SampledSpectrum GlassInternalTransmittance(const std::array<float, 2>* uv,
+                                               const SampledWavelengths& lambda) const {
+        if (textures && textures->transmittance && uv != nullptr)
+            return textures->Transmittance(*uv, lambda);
+        return thin_glass()->internal_transmittance.Sample(lambda);
+    }
+    /// Radiance emitted at a hit with texture coordinates `uv` (null when the mesh has none): the
+    /// emission texture's where there is one, else the config's spectrum. Call only when
+    /// `emissive`.
+    SampledSpectrum Emitted(const std::array<float, 2>* uv,
+                            const SampledWavelengths& lambda) const {
+        if (textures && textures->emission) {
+            return uv != nullptr ? textures->Emission(*uv, lambda) : textures->MeanEmission(lambda);
+        }
+        return emission.Sample(lambda);
+    }
+    /// Solid glass that absorbs (a dielectric with an absorption coefficient), else null.
+    const DielectricMaterial* absorbing_dielectric() const {
+        const DielectricMaterial* d = black ? nullptr : std::get_if<DielectricMaterial>(&material);
+        return d != nullptr && d->absorption_per_m.MaxValue() > 0 ? d : nullptr;
+    }
+    /// The window pane, if this is thin glass (rays cross it without bending).
+    const ThinGlassMaterial* thin_glass() const {
+        return black ? nullptr : std::get_if<ThinGlassMaterial>(&material);
+    }
+    /// Whether this is solid glass whose index varies with wavelength (a path through it keeps only
+    /// its hero wavelength).
+    bool dispersive() const {
+        const DielectricMaterial* d = black ? nullptr : std::get_if<DielectricMaterial>(&material);
+        return d != nullptr && d->IsDispersive();
+    }
+    /// Diffuse albedo at 550 nm for the albedo AOV (1 for specular materials, 0 for black).
+    float AlbedoForAov() const;
+};
+
+/// A light that next-event estimation samples.
+struct Light {
+    enum class Kind { kSun, kDirectional, kPoint, kSpot };
+    Kind kind = Kind::kSun;
+    Vec3f to_light{0, 0, 1};              ///< sun and directional: unit direction toward the light
+    Vec3f position;                       ///< point and spot
+    Vec3f spot_axis{0, 0, -1};            ///< spot: direction light travels
+    float cos_cone = 1, cos_falloff = 1;  ///< spot
+    double sun_radius_rad = 0;            ///< sun: the disc's angular radius
+    Spectrum spectrum;  ///< sun: radiance; directional: irradiance (normal incidence); point/spot:
+                        ///< intensity
+    /// Sun: the disc's solid angle (sr) and the pdf of SampleSun, in double where it matters (the
+    /// disc spans 1 - cos θ ≈ 1.1e-5).
+    double SunSolidAngle() const { return ConeSolidAngle(sun_radius_rad); }
+    float SunPdf() const { return float(1 / SunSolidAngle()); }
+    /// Sun: a direction uniform over the disc.
+    Vec3f SampleSun(Point2f u) const {
+        return Normalize(
+            Frame::FromZ(to_light).FromLocal(SampleUniformNarrowCone(u, sun_radius_rad)));
+    }
+    /// Sun: whether direction `w` (unit) is within the disc.
+    bool SeesSun(const Vec3f& w) const { return InNarrowCone(w, to_light, sun_radius_rad); }
+};
+
+struct RenderScene {
+    BrickSource* source = nullptr;
+    std::unique_ptr<Camera> camera;
+    std::vector<SurfaceMaterial> materials;  ///< indexed by the store's material id
+    std::vector<Light> lights;
+    int sun = -1;  ///< index of the sun in `lights`, or -1
+    bool sky = false;
+    Spectrum sky_radiance;  ///< uniform sky
+    std::shared_ptr<const PreethamSky>
+        preetham;  ///< physical sky (physics: render/scene/sun/sky.h), or null
+    float sky_scale = 1;
+    /// With a physical sky and [sky] ground_albedo: the radiance of the ground below the horizon
+    /// (albedo / π times HorizontalIrradiance); otherwise zero there.
+    Spectrum ground_radiance;
+    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths: below the
+    /// horizon of a physical sky, the ground's.
+    SampledSpectrum SkyRadiance(const Vec3f& w, const SampledWavelengths& lambda) const {
+        if (preetham) {
+            return w.z > 0 ? preetham->Radiance(w, lambda) * sky_scale
+                           : ground_radiance.Sample(lambda);
+        }
+        return sky_radiance.Sample(lambda);
+    }
+    /// The same as a full spectrum (for tools and the photon emitters' power).
+    Spectrum SkySpectrum(const Vec3f& w) const {
+        if (preetham) return w.z > 0 ? preetham->RadianceSpectrum(w) * sky_scale : ground_radiance;
+        return sky_radiance;
+    }
+    RenderSettings settings;
+    OutputConfig output;
+    std::string sun_description;  ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary
+};
+
+/// Resolves `config` against the model in `source`.
+StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source);
+
+/// Attaches the model's textures (config.textures.enabled, and each material's `textures` key) to
+/// the materials of `scene`: albedo, emission (making the material emissive) and alpha cut-outs,
+/// which are handed to the brick source, so call before any brick is loaded. Texture paths in the
+/// material table are relative to `base_dir` (the store's directory). A texture that cannot be
+/// opened is a warning in `warnings` and the material keeps its flat value. `cache` must outlive
+/// the render.
+Status AttachTextures(const SceneConfig& config, const std::filesystem::path& base_dir,
+                      TextureCache& cache, RenderScene* scene, std::vector<std::string>* warnings);
+
+/// The tabulated form of a config spectrum.
+Spectrum ToSpectrum(const SpectrumSpec& spec);
+
+/// The sun's position and spectrum for a place and time: the physics sun model (NREL SPA, clear-sky
+/// transmittance, render/scene/sun/sun.h), or the config's fixed direction and spectrum.
+struct SunState {
+    Vec3f to_sun;  ///< unit vector, world frame (+X east, +Y north, +Z up)
+    double zenith_deg = 0, azimuth_deg = 0;
+    double angular_radius_rad = 0;  ///< the disc's angular radius
+    Spectrum radiance;              ///< disc radiance at the ground, W m^-2 sr^-1 nm^-1
+    bool above_horizon = true;
+};
+StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file);
+
+/// The spectral irradiance (W m⁻² nm⁻¹) of `scene`'s sun and sky above the horizon on an unshadowed
+/// horizontal surface facing up: the sun's L Ω cos z and the sky's ∫ L cos θ dω over the upper
+/// hemisphere (π L for a uniform sky; a 64 x 128 midpoint quadrature in cos θ and φ for a physical
+/// one). The light a white card on open ground reflects: the ground's under [sky] ground_albedo,
+/// and the white of output.white_balance = "scene".
+Spectrum HorizontalIrradiance(const RenderScene& scene);
+
+}  // namespace nave::render

@@ -1,0 +1,59 @@
+#pragma once
+// The compact record of a ray in flight. Everything a worker needs to continue the ray in whichever
+// brick it lands in travels with it: geometry, the segment in the current brick, the path's
+// identity (for the counter-based random numbers), its throughput and wavelengths.
+
+#include <cstdint>
+
+#include "src/core/spectrum.h"
+#include "src/core/vecmath.h"
+
+namespace nave::render {
+
+enum RayKind : uint8_t {
+    kPathRay = 0,    ///< camera ray or continuation of a camera path
+    kShadowRay = 1,  ///< carries a potential contribution, added if nothing occludes it up to t_max
+    kPhotonRay = 2,  ///< a photon of SPPM's photon pass
+};
+
+enum RayFlags : uint8_t {
+    kSpecularBounce =
+        1 << 0,  ///< the last scattering was specular (no light sampling possible there)
+    kFromAreaLight =
+        1 << 1,  ///< photon emitted by a surface (its direct light is not next-event estimated)
+    kFromSky = 1 << 2,  ///< photon from the sky
+};
+
+struct RayRecord {
+    Vec3f origin;
+    float t_max = 0;      ///< end of the ray (infinity, or just short of a point light)
+    Vec3f dir;            ///< unit length
+    float t_enter = 0;    ///< start of the segment in the current brick's cell
+    float t_exit = 0;     ///< end of the segment in the current brick's cell
+    uint32_t pixel = 0;   ///< pixel index (y * width + x), or photon index
+    uint32_t sample = 0;  ///< sample index within the pixel
+    uint16_t depth = 0;   ///< scatterings so far (straight passes through thin glass do not count)
+    uint8_t kind = kPathRay;
+    uint8_t flags = 0;
+    uint16_t vertex =
+        0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
+    uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's surface
+    float prev_pdf = 0;  ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
+    float since_vertex =
+        0;  ///< distance from the last scattering vertex to `origin` (passes through thin
+            ///< glass move the origin along the ray; the sky's MIS needs the vertex)
+    uint32_t guide_credit =
+        0xffffffffu;  ///< shadow rays of guided paths: PathGuide::CreditKey of the path's
+                      ///< previous vertex and direction (PathGuide::kNoCredit: none)
+    float guide_scale =
+        0;  ///< shadow rays of guided paths: the contribution's luminance times this is the
+            ///< credit (1 / (throughput at the vertex * pdf of the direction from the previous))
+    SampledSpectrum
+        beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
+    SampledWavelengths lambda;
+};
+// docs/render.md and docs/pager.md give this size (queue memory per ray in flight): change them
+// with it.
+static_assert(sizeof(RayRecord) == 116, "RayRecord's size is documented in docs/render.md");
+
+}  // namespace nave::render

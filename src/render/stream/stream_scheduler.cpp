@@ -1,0 +1,232 @@
+#include "src/render/stream/stream_scheduler.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "src/core/check.h"
+#include "src/core/trace.h"
+#include "src/render/bricks/brick_walk.h"
+#include "src/render/stream/memory_plan.h"
+
+namespace nave::render {
+namespace {
+
+/// Rays per task within a batch.
+constexpr size_t kChunk = 256;
+
+}  // namespace
+
+StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths)
+    : source_(source),
+      tree_(source.tree()),
+      picker_(std::move(picker)),
+      wave_paths_(wave_paths),
+      queues_(source.brick_count()),
+      max_batch_(MaxBatchRays(0)) {}
+
+StreamScheduler::~StreamScheduler() {
+    pager_.reset();  // joins the loaders before the cache they use goes
+    if (brick_cache_) source_.SetBrickCache(nullptr);
+    source_.SetDecodeLimit(0);
+}
+
+StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& source,
+                                                                   const PagerOptions& paging,
+                                                                   BrickPicker picker,
+                                                                   uint64_t wave_paths) {
+    std::unique_ptr<StreamScheduler> scheduler(
+        new StreamScheduler(source, std::move(picker), wave_paths));
+    NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
+    return scheduler;
+}
+
+Status StreamScheduler::StartPaging(const PagerOptions& options) {
+    NAVE_RETURN_IF_ERROR(source_.SetBvhSettings(options.bvh));
+    source_.SetTrace(options.trace);
+    // Under a budget one decode runs at a time: its scratch memory is reserved once (the memory
+    // plan counts LoadScratchBytes), and with the brick cache only first loads decode.
+    if (!options.in_core()) source_.SetDecodeLimit(1);
+    if (!options.in_core() && options.brick_cache) {
+        NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::SpillFile> file,
+                              store::SpillFile::Create(options.spill_dir, "the brick cache"));
+        uint64_t limit = options.brick_cache_limit_bytes;
+        if (limit == 0) {
+            std::error_code ec;
+            const std::filesystem::space_info space = std::filesystem::space(file->dir(), ec);
+            limit = ec ? 0 : space.available / 2;
+        }
+        brick_cache_ = std::make_unique<BrickCache>(std::move(file), source_.brick_count(), limit);
+        source_.SetBrickCache(brick_cache_.get());
+    }
+    const uint64_t queue_memory = QueueMemoryBytes(options);
+    if (!options.in_core() && queue_memory > 0) {
+        NAVE_ASSIGN_OR_RETURN(queue_spill_,
+                              store::SpillFile::Create(options.spill_dir, "the ray queues"));
+        queue_memory_ = queue_memory;
+        max_batch_ = MaxBatchRays(queue_memory_);
+    }
+    trace_ = options.trace;
+    if (trace_ != nullptr) trace_->NameThread("scheduler");
+    NAVE_ASSIGN_OR_RETURN(
+        pager_, Pager::Create(source_, options, [this](uint32_t b) { return queues_.Waiting(b); }));
+    return Status::Ok();
+}
+
+StatusOr<BrickHandle> StreamScheduler::Acquire(uint32_t brick) { return pager_->Acquire(brick); }
+
+uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) const {
+    BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current);
+    r.t_enter = s.t_enter;
+    r.t_exit = s.t_exit;
+    return s.brick;
+}
+
+void StreamScheduler::Flush(RayOutbox& out) {
+    std::vector<std::pair<uint32_t, RayRecord>>& rays = out.rays;
+    std::sort(rays.begin(), rays.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<RayRecord> group;
+    for (size_t i = 0; i < rays.size();) {
+        size_t j = i;
+        group.clear();
+        while (j < rays.size() && rays[j].first == rays[i].first) group.push_back(rays[j++].second);
+        exchange_.Send(rays[i].first, group);
+        i = j;
+    }
+    rays.clear();
+    const RayCounts& c = out.counts;
+    segments_traced_.fetch_add(c.segments_traced, std::memory_order_relaxed);
+    shadow_segments_.fetch_add(c.shadow_segments, std::memory_order_relaxed);
+    brick_moves_.fetch_add(c.brick_moves, std::memory_order_relaxed);
+    rays_.fetch_add(c.rays, std::memory_order_relaxed);
+    out.counts = RayCounts();
+}
+
+Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
+    std::vector<RayRecord> batch;
+    std::vector<size_t> waiting(queues_.brick_count());
+    for (;;) {
+        size_t total = 0;
+        for (uint32_t i = 0; i < queues_.brick_count(); ++i)
+            total += waiting[i] = queues_.Waiting(i);
+        if (total <= stop_below) break;
+        if (trace_ != nullptr) {
+            trace_->Counter("rays waiting", {{"rays", total}});
+            trace_->Counter("memory", {{"resident_bricks", source_.stats().resident_bytes},
+                                       {"queues", queues_.MemoryBytes()}});
+        }
+        NAVE_RETURN_IF_ERROR(SpillIfOverCap(waiting));
+        const uint32_t b = picker_ ? picker_(waiting, source_) : pager_->Pick(waiting);
+        NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
+            << "the brick picker chose brick " << b << " which has no rays waiting";
+        // If b must be loaded now, the loader loads the next brick meanwhile: two loads at once
+        // while the workers would idle anyway.
+        if (!source_.IsResident(b)) pager_->Prefetch(waiting, b, 0);
+        NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(b));
+        NAVE_RETURN_IF_ERROR(queues_.Take(b, max_batch_, &batch, queue_spill_.get()).status());
+        batches_.fetch_add(1, std::memory_order_relaxed);
+        waiting[b] -= batch.size();
+        pager_->Prefetch(waiting, b,
+                         batch.size());  // loads the next brick while this one is traced
+        const ResidentBrick& brick = *handle;
+        TraceSpan span(trace_, "batch", "scheduler");
+        span.AddArg({"brick", b});
+        span.AddArg({"rays", batch.size()});
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, batch.size(), kChunk),
+            [&](const tbb::blocked_range<size_t>& range) {
+                RayOutbox out;
+                processor.ProcessBatch(
+                    b, brick,
+                    std::span<const RayRecord>(batch).subspan(range.begin(), range.size()), out);
+                Flush(out);
+            });
+        handle.Reset();
+        pager_->BatchDone();
+    }
+    return Status::Ok();
+}
+
+Status StreamScheduler::SpillIfOverCap() {
+    if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
+    std::vector<size_t> waiting(queues_.brick_count());
+    for (uint32_t i = 0; i < queues_.brick_count(); ++i) waiting[i] = queues_.Waiting(i);
+    return SpillIfOverCap(waiting);
+}
+
+Status StreamScheduler::SpillIfOverCap(const std::vector<size_t>& waiting) {
+    if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
+    return SpillQueues(waiting);
+}
+
+Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
+    // The bricks with the most rays load next: their queues stay. Of the others, the largest
+    // queues in memory go first (fewest writes for the bytes freed).
+    std::vector<uint32_t> order(waiting.size());
+    for (uint32_t b = 0; b < order.size(); ++b) order[b] = b;
+    std::sort(order.begin(), order.end(),
+              [&](uint32_t a, uint32_t b) { return waiting[a] > waiting[b]; });
+    const size_t keep = size_t(std::max(1, pager_->options().loaders)) + 1;
+    // Resident bricks' queues too, after the others: when every brick fits (a small model under a
+    // large wave) only they hold rays, and the cap must hold all the same.
+    std::vector<uint32_t> victims;
+    for (size_t i = keep; i < order.size() && waiting[order[i]] > 0; ++i)
+        victims.push_back(order[i]);
+    std::vector<uint8_t> resident(waiting.size(), 0);
+    for (uint32_t b : victims) resident[b] = source_.IsResident(b) ? 1 : 0;
+    std::sort(victims.begin(), victims.end(), [&](uint32_t a, uint32_t b) {
+        if (resident[a] != resident[b]) return resident[a] < resident[b];
+        return queues_.InMemory(a) > queues_.InMemory(b);
+    });
+    TraceSpan span(trace_, "spill queues", "scheduler");
+    for (uint32_t b : victims) {
+        if (queues_.MemoryBytes() <= queue_memory_ / 2) break;
+        StatusOr<size_t> n = queues_.Spill(b, *queue_spill_);
+        if (!n.ok()) {
+            return n.status().WithContext(
+                "spilling ray queues beyond the memory budget (--temp-dir chooses where)");
+        }
+        spilled_rays_ += *n;
+    }
+    return Status::Ok();
+}
+
+size_t StreamScheduler::WaveOverlap() const {
+    if (pager_->options().in_core()) return 0;
+    return size_t(pager_->options().wave_overlap * double(wave_paths_));
+}
+
+void StreamScheduler::FillStats(const BrickSourceStats& before, StreamStats* stats) const {
+    const BrickSourceStats after = source_.stats();
+    stats->segments_traced = segments_traced_.load();
+    stats->shadow_segments = shadow_segments_.load();
+    stats->brick_moves = brick_moves_.load();
+    stats->rays = rays_.load();
+    stats->batches = batches_.load();
+    stats->peak_queue_bytes =
+        std::max<uint64_t>(stats->peak_queue_bytes, queues_.PeakMemoryBytes());
+    stats->bytes_read = after.bytes_read - before.bytes_read;
+    PagerStats& residency = stats->residency;
+    residency = pager_->stats();
+    if (pager_->options().in_core()) residency.brick_budget_bytes = 0;
+    // The source counts every load, the pager's and any before it.
+    residency.loads = after.loads - before.loads;
+    if (queue_spill_) {
+        const store::SpillStats q = queue_spill_->stats();
+        stats->spilled_rays = spilled_rays_;
+        stats->spill_bytes_written = q.stored_bytes_written;
+        stats->spill_peak_disk_bytes = q.peak_stored_bytes;
+    }
+    if (brick_cache_) {
+        const BrickCacheStats c = brick_cache_->stats();
+        stats->brick_cache_written = c.bricks_written;
+        stats->brick_cache_reads = c.reads;
+        stats->brick_cache_disk_bytes = c.disk_bytes;
+        stats->brick_cache_mesh_bytes = c.mesh_bytes;
+    }
+}
+
+}  // namespace nave::render

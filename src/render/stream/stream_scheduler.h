@@ -1,0 +1,152 @@
+#pragma once
+// The stream scheduler (docs/render.md, "Scheduling"; docs/pager.md): the per-brick queues of rays
+// in flight and the loop that drains them. Drain repeatedly picks a brick (the pager's choice, or a
+// BrickPicker's), pins it through the pager, takes a batch of its rays and hands the batch to a
+// RayProcessor on all threads; what the processor sends on is flushed, grouped by brick, to the
+// RayExchange, which queues it at the brick's owner. The scheduler knows rays and bricks only: what
+// happens to a ray inside a brick (shading, lights, the film) is the processor's, so paging is
+// tuned here without touching the physics.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "src/core/status.h"
+#include "src/render/bricks/brick_cache.h"
+#include "src/render/bricks/brick_source.h"
+#include "src/render/stream/brick_picker.h"
+#include "src/render/stream/pager.h"
+#include "src/render/stream/ray.h"
+#include "src/render/stream/ray_exchange.h"
+#include "src/render/stream/ray_queue.h"
+#include "src/render/stream/stream_stats.h"
+#include "store/brick_tree.h"
+
+namespace nave::render {
+
+/// Work counted by the workers, summed into StreamStats by the scheduler (the same names).
+struct RayCounts {
+    /// Ray segments traced inside a brick (closest-hit queries).
+    uint64_t segments_traced = 0;
+    /// Shadow-ray segments traced inside a brick (occlusion queries).
+    uint64_t shadow_segments = 0;
+    /// Rays sent to another brick than the one they were traced or made in.
+    uint64_t brick_moves = 0;
+    /// Rays started: camera, continuation, shadow rays and photons.
+    uint64_t rays = 0;
+};
+
+/// What one task produced: the rays it sends on (spawned, or leaving the brick's cell) and its
+/// counts. One per task, so not thread-safe; StreamScheduler::Flush hands it to the exchange and
+/// empties it.
+struct RayOutbox {
+    /// Holds `r` for brick `next` until the flush. A move when `next` is not `current`, the brick
+    /// the ray was traced or made in (store::kNoBrick for rays made outside a batch, like camera
+    /// rays).
+    void Send(uint32_t next, uint32_t current, const RayRecord& r) {
+        if (next != current) ++counts.brick_moves;
+        rays.emplace_back(next, r);
+    }
+
+    std::vector<std::pair<uint32_t, RayRecord>> rays;  ///< (brick, ray), in the order sent
+    RayCounts counts;
+};
+
+/// The work on the rays of one brick: what Drain does with a batch.
+class RayProcessor {
+  public:
+    virtual ~RayProcessor() = default;
+    /// Traces `rays`, taken from the queue of brick `brick` (pinned as `resident` for the call),
+    /// and sends every ray that goes on in another brick to `out`. Called from many threads at
+    /// once, each with its own part of the batch and its own outbox, which the scheduler flushes
+    /// after the call.
+    virtual void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
+                              std::span<const RayRecord> rays, RayOutbox& out) = 0;
+};
+
+/// The ray queues of one render and the loop that drains them. Acquire, Drain, SpillIfOverCap and
+/// FillStats are called from the render's thread; Route and Flush from any thread (workers call
+/// them).
+class StreamScheduler {
+  public:
+    /// Schedules rays over the bricks of `source`, which must outlive the scheduler, with its
+    /// bricks paged under `paging` (PagerOptions(): in-core, loaded in the background while the
+    /// workers trace). `picker` empty: the pager's choice. `wave_paths`: camera paths (or photons)
+    /// per wave, the unit of WaveOverlap. Errors: an impossible budget (the pager's
+    /// ResourceExhausted error), spill files that cannot be made.
+    static StatusOr<std::unique_ptr<StreamScheduler>> Create(BrickSource& source,
+                                                             const PagerOptions& paging,
+                                                             BrickPicker picker,
+                                                             uint64_t wave_paths);
+    ~StreamScheduler();
+    StreamScheduler(const StreamScheduler&) = delete;
+    StreamScheduler& operator=(const StreamScheduler&) = delete;
+
+    /// Pins brick `brick` for a batch or a pass over the bricks, through the pager. Load errors
+    /// name the brick.
+    StatusOr<BrickHandle> Acquire(uint32_t brick);
+    /// Sets r's segment to the first brick after `from_t` other than `current`; returns it or
+    /// store::kNoBrick (the ray leaves the model, or reaches t_max, first).
+    uint32_t Route(RayRecord& r, float from_t, uint32_t current) const;
+    /// Sends the rays of `out` to the exchange, grouped by brick, adds its counts to the render's
+    /// and empties it.
+    void Flush(RayOutbox& out);
+    /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty), tracing
+    /// every batch with `processor`. Errors: a brick that cannot be pinned.
+    Status Drain(RayProcessor& processor, size_t stop_below = 0);
+    /// Spills queues to disk if they hold more than the queue memory cap (a no-op in-core).
+    /// For the integrators between chunks of a wave's new rays, so that a wave larger than the cap
+    /// is spilled as it is generated rather than queued whole first. Not concurrent with Drain or
+    /// Flush.
+    Status SpillIfOverCap();
+    /// Camera paths to generate between two SpillIfOverCap calls: as many as a batch takes, for
+    /// which the queue reserve has room (MaxBatchRays, memory_plan.h).
+    size_t generate_chunk() const { return max_batch_; }
+    /// Rays left waiting when the next wave is generated: under a budget the next wave joins the
+    /// tail of the previous one, whose few scattered rays would otherwise cost a load each
+    /// (docs/pager.md); in-core, waves do not overlap.
+    size_t WaveOverlap() const;
+    /// Fills `stats` (rays, segments, brick moves, batches, bytes read, residency, peak queue
+    /// bytes, brick cache, spilling). `before`: the source's counters when the render started.
+    void FillStats(const BrickSourceStats& before, StreamStats* stats) const;
+
+    /// The source's brick tree, along which rays are routed.
+    const store::BrickTree& tree() const { return tree_; }
+
+  private:
+    StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths);
+    /// Sets the source up for `paging` (BVH settings, decode limit, brick cache), makes the queues'
+    /// spill file and starts the pager.
+    Status StartPaging(const PagerOptions& paging);
+    /// SpillIfOverCap with the rays waiting per brick already counted.
+    Status SpillIfOverCap(const std::vector<size_t>& waiting);
+    /// Spills queues of bricks that are not resident until their memory is below half the cap.
+    Status SpillQueues(const std::vector<size_t>& waiting);
+
+    BrickSource& source_;
+    const store::BrickTree& tree_;
+    const BrickPicker picker_;  // empty: the pager picks
+    const uint64_t wave_paths_;
+    BrickQueues<RayRecord> queues_;
+    LocalRayExchange local_exchange_{queues_};
+    RayExchange& exchange_ = local_exchange_;  // every ray leaving a batch goes through here
+
+    // Under a budget: queue blocks spilled to disk beyond queue_memory_ (null: none).
+    std::unique_ptr<store::SpillFile> queue_spill_;
+    uint64_t queue_memory_ = 0;
+    uint64_t spilled_rays_ = 0;
+    size_t max_batch_;  // rays taken from a queue per batch
+    // Under a budget: decoded meshes of loaded bricks, for their reloads (null: none). Outlives
+    // the pager, whose loaders read and write it.
+    std::unique_ptr<BrickCache> brick_cache_;
+    // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
+    std::unique_ptr<Pager> pager_;
+    TraceRecorder* trace_ = nullptr;
+    std::atomic<uint64_t> segments_traced_{0}, shadow_segments_{0}, brick_moves_{0}, batches_{0},
+        rays_{0};
+};
+
+}  // namespace nave::render

@@ -1,0 +1,188 @@
+#include "src/render/transport/light_sampling.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/core/log.h"
+#include "src/core/sampling.h"
+#include "src/render/scene/materials/frame.h"
+#include "src/render/stream/stream_scheduler.h"
+#include "src/render/transport/transport_common.h"
+
+namespace nave::render {
+
+StatusOr<std::unique_ptr<SkyPortals>> SkyPortals::Build(
+    const BrickSource& source, std::vector<std::array<Vec3f, 3>> triangles) {
+    std::unique_ptr<SkyPortals> portals(new SkyPortals());
+    store::BrickMesh mesh;
+    portals->area_cdf_.assign(1, 0.0);
+    for (const auto& t : triangles) {
+        uint32_t base = uint32_t(mesh.positions.size());
+        mesh.positions.insert(mesh.positions.end(), {t[0], t[1], t[2]});
+        mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+        mesh.material_ids.push_back(0);
+        portals->area_ += 0.5 * double(Length(Cross(t[1] - t[0], t[2] - t[0])));
+        portals->area_cdf_.push_back(portals->area_);
+    }
+    for (double& c : portals->area_cdf_) c /= portals->area_;
+    portals->triangles_ = std::move(triangles);
+    NAVE_ASSIGN_OR_RETURN(portals->scene_, ResidentBrick::Build(source.device(), 0, source.bounds(),
+                                                                std::move(mesh)));
+    return portals;
+}
+
+Vec3f SkyPortals::SamplePoint(double u_triangle, Point2f u, size_t* triangle) const {
+    size_t i = size_t(std::upper_bound(area_cdf_.begin() + 1, area_cdf_.end(), u_triangle) -
+                      (area_cdf_.begin() + 1));
+    i = std::min(i, triangles_.size() - 1);
+    if (triangle != nullptr) *triangle = i;
+    const std::array<float, 3> w = SampleUniformTriangle(u);
+    const auto& t = triangles_[i];
+    return t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+}
+
+StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& scene,
+                                                             StreamScheduler& scheduler,
+                                                             const SkyPortals* photon_portals) {
+    std::unique_ptr<LightSampler> sampler(new LightSampler(scene));
+    if (!scene.sky || scene.settings.sky_sampling != RenderSettings::SkySampling::kPortals) {
+        return sampler;
+    }
+    if (scene.settings.mode == RenderSettings::Mode::kPhoton) {
+        // Photons from the sky are aimed at the portals only with photon_target = "portals"; the
+        // visible points' sky sampling shares those portals rather than changing where photons go.
+        if (photon_portals == nullptr) {
+            log::Warning(
+                "render.sky_sampling = \"portals\" in photon mode needs render.photon_target = "
+                "\"portals\"; the sky is sampled uniformly");
+        }
+        sampler->portals_ = photon_portals;
+        return sampler;
+    }
+    std::vector<std::array<Vec3f, 3>> triangles;
+    if (std::none_of(scene.materials.begin(), scene.materials.end(),
+                     [](const auto& m) { return m.portal; })) {
+        return InvalidArgumentError(
+            "render.sky_sampling = \"portals\" but no material has portal = true");
+    }
+    NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
+        scene, scheduler, [](const SurfaceMaterial& m) { return m.portal; },
+        [&](const ResidentMesh& m, size_t t, uint32_t) {
+            triangles.push_back(m.TrianglePositions(t));
+        }));
+    if (triangles.empty()) {
+        return InvalidArgumentError(
+            "render.sky_sampling = \"portals\" but the model has no triangle of a "
+            "portal material");
+    }
+    NAVE_ASSIGN_OR_RETURN(sampler->own_portals_,
+                          SkyPortals::Build(*scene.source, std::move(triangles)));
+    sampler->portals_ = sampler->own_portals_.get();
+    return sampler;
+}
+
+std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index,
+                                                   const SurfaceHit& h, const Bsdf& bsdf,
+                                                   const Vec3f& wo, const RayRecord& r,
+                                                   const VertexRng& rng,
+                                                   const GuidedBsdf* continuation) const {
+    Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
+    Vec3f wi;
+    SampledSpectrum Li;
+    float t_max = kInfinity;
+    float light_pdf = 0;  // solid angle; 0 for delta lights
+    switch (light.kind) {
+        case Light::Kind::kSun: {
+            // Uniform over the solar disc's cone (radiance constant over the disc: no limb
+            // darkening).
+            wi = light.SampleSun(u);
+            light_pdf = light.SunPdf();
+            Li = light.spectrum.Sample(r.lambda) / light_pdf;
+            break;
+        }
+        case Light::Kind::kDirectional:
+            // The paper's eq. 3: L_r = F_r(w_s, w_o) L_s (n . w_s), with L_s the irradiance at
+            // normal incidence.
+            wi = light.to_light;
+            Li = light.spectrum.Sample(r.lambda);
+            break;
+        case Light::Kind::kPoint:
+        case Light::Kind::kSpot: {
+            Vec3f d = light.position - h.p;
+            float dist2 = Dot(d, d);
+            if (dist2 == 0) return std::nullopt;
+            float dist = std::sqrt(dist2);
+            wi = d / dist;
+            float falloff = 1;
+            if (light.kind == Light::Kind::kSpot) {
+                // Smoothstep between the cone and the start of the falloff (pbrt-v4 SpotLight::I).
+                float cos_a = Dot(-wi, light.spot_axis);
+                float x = std::clamp(
+                    (cos_a - light.cos_cone) / std::max(1e-6f, light.cos_falloff - light.cos_cone),
+                    0.f, 1.f);
+                falloff = x * x * (3 - 2 * x);
+            }
+            Li = light.spectrum.Sample(r.lambda) * (falloff / dist2);
+            t_max = dist * (1 - 1e-4f);
+            break;
+        }
+    }
+    if (Li.IsZero()) return std::nullopt;
+    SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
+    if (f.IsZero()) return std::nullopt;
+    float w = 1;
+    if (light_pdf > 0 && continuation != nullptr)
+        w = PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda));
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.dir = wi;
+    s.t_max = t_max;
+    s.beta = r.beta * f * Li * w;
+    return s;
+}
+
+std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf& bsdf,
+                                                 const Vec3f& wo, const RayRecord& r,
+                                                 const VertexRng& rng,
+                                                 const GuidedBsdf* continuation) const {
+    const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
+    Vec3f wi;
+    if (portals_ != nullptr && rng.Uniform(dim + 2) < kPortalSkyShare) {
+        const Vec3f q = portals_->SamplePoint(rng.Uniform(dim + 3),
+                                              Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+        const float d = Length(q - h.p);
+        if (!(d > 0)) return std::nullopt;
+        wi = (q - h.p) / d;
+    } else {
+        wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+    }
+    SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
+    if (f.IsZero()) return std::nullopt;
+    const float light_pdf = SkyPdf(h.p, wi);
+    if (!(light_pdf > 0)) return std::nullopt;
+    float w = continuation != nullptr
+                  ? PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda))
+                  : 1.f;
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.dir = wi;
+    s.t_max = kInfinity;
+    s.beta = r.beta * f * scene_.SkyRadiance(wi, r.lambda) * (w / light_pdf);
+    if (s.beta.IsZero()) return std::nullopt;
+    return s;
+}
+
+float LightSampler::SkyPdf(const Vec3f& p, const Vec3f& w) const {
+    if (portals_ == nullptr) return UniformSpherePdf();
+    double portal_pdf = 0;
+    portals_->ForEachCrossing(p, w, kInfinity, [&](const BrickHit& hit) {
+        const float cos_theta = std::abs(Dot(Normalize(hit.ng), w));
+        if (cos_theta > 1e-6f)
+            portal_pdf += double(hit.t) * hit.t / (double(cos_theta) * portals_->area());
+    });
+    return float((1 - kPortalSkyShare) * UniformSpherePdf() + kPortalSkyShare * portal_pdf);
+}
+
+}  // namespace nave::render

@@ -1,0 +1,299 @@
+#include "src/render/transport/path_guide.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <tuple>
+
+#include "src/core/byte_stream.h"
+#include "src/core/check.h"
+#include "src/core/sampling.h"
+
+namespace nave::render {
+namespace {
+
+// Of a guided cell's distribution, this share is uniform over the sphere: every bin keeps a
+// little probability, so that the guide never starves a direction that its cell has not yet
+// seen light from (the BSDF's share samples every direction too).
+constexpr double kUniformShare = 0.1;
+
+/// The solid-angle pdf of bin `bin` of a cell's CDF: its probability over its solid angle,
+/// 4π / kBins.
+float BinPdf(const float* cdf, int bin) {
+    return (cdf[bin] - (bin > 0 ? cdf[bin - 1] : 0.f)) * float(PathGuide::kBins) / (4 * kPi);
+}
+
+}  // namespace
+
+struct PathGuide::Cell {
+    uint64_t sum[kBins] = {};  // fixed-point credits per bin
+    float cdf[kBins] = {};     // after Update: the cumulative distribution over the bins
+    uint32_t credits = 0;
+    bool guiding = false;  // Update gave it a distribution
+};
+
+PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_t max_cells,
+                     double radiance_scale)
+    : bounds_(bounds), max_cells_(max_cells) {
+    NAVE_CHECK(!bounds.Empty());
+    NAVE_CHECK(coarse_cells_long_axis > 0 && coarse_cells_long_axis <= 64);
+    const Vec3f d = bounds.Diagonal();
+    const float extent[3] = {std::max(d.x, 1e-6f), std::max(d.y, 1e-6f), std::max(d.z, 1e-6f)};
+    const float coarse =
+        std::max({extent[0], extent[1], extent[2]}) / float(coarse_cells_long_axis);
+    for (int l = 0; l < kLevels; ++l) {
+        Level& level = levels_[l];
+        level.size = 1;
+        for (int a = 0; a < 3; ++a) {
+            level.res[a] = std::clamp(int(std::ceil(extent[a] / coarse)), 1, coarse_cells_long_axis)
+                           << l;
+            level.size *= uint32_t(level.res[a]);
+        }
+        level.size *= kSides;
+        level.slot = std::make_unique<uint32_t[]>(level.size);
+        std::fill_n(level.slot.get(), level.size, kNoCell);
+        level.count = std::make_unique<uint32_t[]>(level.size);  // zeroed
+    }
+    // CreditKey packs the finest slot index in 24 bits.
+    NAVE_CHECK(levels_[kLevels - 1].size <= (1u << 24));
+    const float per_metre = float(1 << (kLevels - 1)) / coarse;  // finest cells per unit length
+    inv_fine_cell_ = Vec3f(per_metre, per_metre, per_metre);
+    // A credit of the scene's radiance scale is 2^32 units: sums of millions of credits stay far
+    // from 2^64, and a credit a millionth of the scale still has 4000 units.
+    to_fixed_ = 0x1p32 / std::max(radiance_scale, 1e-30);
+    cells_.reserve(max_cells_);
+}
+
+PathGuide::~PathGuide() = default;
+
+uint64_t PathGuide::MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells) {
+    // At most the grid's index and count per cell of each level (the bounds' other axes as long as
+    // the longest at worst), and the histograms.
+    uint64_t grid = 0;
+    for (int l = 0; l < kLevels; ++l) {
+        const uint64_t res = uint64_t(coarse_cells_long_axis) << l;
+        grid += res * res * res * kSides * 2 * sizeof(uint32_t);
+    }
+    return grid + uint64_t(max_cells) * (sizeof(Cell) + sizeof(std::unique_ptr<Cell>));
+}
+
+bool PathGuide::FineCoords(const Vec3f& p, int xyz[3]) const {
+    if (!bounds_.Contains(p)) return false;
+    const Vec3f q = (p - bounds_.min);
+    const int* res = levels_[kLevels - 1].res;
+    xyz[0] = std::min(int(q.x * inv_fine_cell_.x), res[0] - 1);
+    xyz[1] = std::min(int(q.y * inv_fine_cell_.y), res[1] - 1);
+    xyz[2] = std::min(int(q.z * inv_fine_cell_.z), res[2] - 1);
+    return true;
+}
+
+uint32_t PathGuide::IndexAt(int level, const int xyz[3], int side) const {
+    const int shift = kLevels - 1 - level;
+    const int* res = levels_[level].res;
+    const uint32_t cell =
+        uint32_t(((xyz[2] >> shift) * res[1] + (xyz[1] >> shift)) * res[0] + (xyz[0] >> shift));
+    return cell * kSides + uint32_t(side);
+}
+
+int PathGuide::SideOf(const Vec3f& n) {
+    const float a[3] = {std::abs(n.x), std::abs(n.y), std::abs(n.z)};
+    const int axis = a[0] >= a[1] && a[0] >= a[2] ? 0 : (a[1] >= a[2] ? 1 : 2);
+    const float v = axis == 0 ? n.x : (axis == 1 ? n.y : n.z);
+    return 2 * axis + (v < 0);
+}
+
+int PathGuide::BinOf(const Vec3f& w) {
+    const int zi = std::clamp(int((w.z + 1.f) * 0.5f * kZBins), 0, kZBins - 1);
+    float phi = std::atan2(w.y, w.x);
+    if (phi < 0) phi += 2 * kPi;
+    const int pi = std::clamp(int(phi * (0.5f * kInvPi) * kPhiBins), 0, kPhiBins - 1);
+    return zi * kPhiBins + pi;
+}
+
+uint32_t PathGuide::CreditKey(const Vec3f& p, int side, const Vec3f& w) const {
+    static_assert(kBins == 256, "CreditKey packs the bin in 8 bits");
+    int xyz[3];
+    if (!FineCoords(p, xyz)) return kNoCredit;
+    return IndexAt(kLevels - 1, xyz, side) << 8 | uint32_t(BinOf(w));
+}
+
+void PathGuide::Credit(uint32_t key, double value) {
+    if (key == kNoCredit || !(value > 0)) return;
+    const Level& fine = levels_[kLevels - 1];
+    const int side = int((key >> 8) % kSides);
+    const uint32_t g = (key >> 8) / kSides;
+    const int xyz[3] = {int(g % uint32_t(fine.res[0])),
+                        int(g / uint32_t(fine.res[0]) % uint32_t(fine.res[1])),
+                        int(g / (uint32_t(fine.res[0]) * uint32_t(fine.res[1])))};
+    // Clamped so that no single credit can overflow a bin: a rare path with a tiny pdf would
+    // otherwise dominate its cell.
+    const uint64_t units = uint64_t(std::min(value * to_fixed_, 0x1p40));
+    for (int l = 0; l < kLevels; ++l) {
+        const uint32_t index = IndexAt(l, xyz, side);
+        const uint32_t slot = levels_[l].slot[index];
+        if (slot == kNoCell) {
+            std::atomic_ref<uint32_t>(levels_[l].count[index])
+                .fetch_add(1, std::memory_order_relaxed);
+            continue;
+        }
+        Cell& cell = *cells_[slot];
+        std::atomic_ref<uint64_t>(cell.sum[key & 0xff]).fetch_add(units, std::memory_order_relaxed);
+        std::atomic_ref<uint32_t>(cell.credits).fetch_add(1, std::memory_order_relaxed);
+    }
+}
+
+void PathGuide::Update(uint32_t min_credits) {
+    cells_guiding_ = 0;
+    for (const std::unique_ptr<Cell>& c : cells_) {
+        Cell& cell = *c;
+        double total = 0;
+        for (uint64_t s : cell.sum) total += double(s);
+        cell.guiding = cell.credits >= min_credits && total > 0;
+        if (!cell.guiding) continue;
+        ++cells_guiding_;
+        double running = 0;
+        for (int b = 0; b < kBins; ++b) {
+            running += (1 - kUniformShare) * double(cell.sum[b]) / total + kUniformShare / kBins;
+            cell.cdf[b] = float(running);
+        }
+        cell.cdf[kBins - 1] = 1.f;
+    }
+    // New histograms for the cells most credited so far, in an order that depends on the counts
+    // alone (ties: coarser level, then lower index).
+    struct Candidate {
+        uint32_t count;
+        int level;
+        uint32_t index;
+    };
+    std::vector<Candidate> candidates;
+    const uint32_t min_count = std::max(1u, min_credits / 4);
+    for (int l = 0; l < kLevels; ++l) {
+        for (uint32_t i = 0; i < levels_[l].size; ++i) {
+            if (levels_[l].slot[i] == kNoCell && levels_[l].count[i] >= min_count)
+                candidates.push_back({levels_[l].count[i], l, i});
+        }
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+        return std::tie(b.count, a.level, a.index) < std::tie(a.count, b.level, b.index);
+    });
+    for (const Candidate& c : candidates) {
+        if (cells_.size() >= max_cells_) break;
+        levels_[c.level].slot[c.index] = uint32_t(cells_.size());
+        cells_.push_back(std::make_unique<Cell>());
+    }
+}
+
+void PathGuide::SaveState(ByteWriter* out) const {
+    for (const Level& level : levels_) {
+        out->PutArray(level.slot.get(), level.size);
+        out->PutArray(level.count.get(), level.size);
+    }
+    out->Put(uint32_t(cells_.size()));
+    for (const std::unique_ptr<Cell>& cell : cells_) {
+        out->Put(cell->sum);
+        out->Put(cell->cdf);
+        out->Put(cell->credits);
+        out->Put(uint8_t(cell->guiding));
+    }
+    out->Put(cells_guiding_);
+}
+
+Status PathGuide::LoadState(ByteReader* in) {
+    for (Level& level : levels_) {
+        NAVE_RETURN_IF_ERROR(in->GetArray(level.slot.get(), level.size, "guide cell slots"));
+        NAVE_RETURN_IF_ERROR(in->GetArray(level.count.get(), level.size, "guide cell counts"));
+    }
+    uint32_t cells = 0;
+    NAVE_RETURN_IF_ERROR(in->Get(&cells, "guide cell count"));
+    if (cells > max_cells_) {
+        return DataLossError("{}: {} guide cells, at most {} expected", in->what(), cells,
+                             max_cells_);
+    }
+    for (const Level& level : levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) {
+            if (level.slot[i] != kNoCell && level.slot[i] >= cells) {
+                return DataLossError("{}: guide slot {} points at cell {} of {}", in->what(), i,
+                                     level.slot[i], cells);
+            }
+        }
+    }
+    cells_.clear();
+    for (uint32_t c = 0; c < cells; ++c) {
+        auto cell = std::make_unique<Cell>();
+        uint8_t guiding = 0;
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->sum, "guide cell sums"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distribution"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->credits, "guide cell credits"));
+        NAVE_RETURN_IF_ERROR(in->Get(&guiding, "guide cell flag"));
+        cell->guiding = guiding != 0;
+        cells_.push_back(std::move(cell));
+    }
+    NAVE_RETURN_IF_ERROR(in->Get(&cells_guiding_, "guiding cell count"));
+    return Status::Ok();
+}
+
+const float* PathGuide::Distribution(const Vec3f& p, int side) const {
+    int xyz[3];
+    if (!FineCoords(p, xyz)) return nullptr;
+    for (int l = kLevels - 1; l >= 0; --l) {
+        const uint32_t slot = levels_[l].slot[IndexAt(l, xyz, side)];
+        if (slot != kNoCell && cells_[slot]->guiding) return cells_[slot]->cdf;
+    }
+    return nullptr;
+}
+
+std::optional<GuideSample> PathGuide::Sample(const Vec3f& p, int side, float u_bin, float u0,
+                                             float u1) const {
+    const float* cdf = Distribution(p, side);
+    if (cdf == nullptr) return std::nullopt;
+    const int bin = int(std::upper_bound(cdf, cdf + kBins - 1, u_bin) - cdf);
+    // Uniform within the bin: cos θ and φ are uniform in it (equal-area cylindrical mapping,
+    // Archimedes' hat-box theorem).
+    const float z = std::clamp(-1.f + 2.f * (float(bin / kPhiBins) + u0) / kZBins, -1.f, 1.f);
+    const float phi = 2 * kPi * (float(bin % kPhiBins) + u1) / kPhiBins;
+    const float r = std::sqrt(std::max(0.f, 1 - z * z));
+    const Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
+    // The pdf of the bin the direction falls in as Pdf sees it (rounding at a bin's edge can move
+    // it to the neighbour): the sample's pdf and Pdf must agree for MIS.
+    return GuideSample{wi, BinPdf(cdf, BinOf(wi))};
+}
+
+float PathGuide::Pdf(const Vec3f& p, int side, const Vec3f& w) const {
+    const float* cdf = Distribution(p, side);
+    if (cdf == nullptr) return 0;
+    return BinPdf(cdf, BinOf(w));
+}
+
+float GuidedBsdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda) const {
+    const float bsdf_pdf = bsdf_.Pdf(wo, wi, lambda);
+    if (guide_ == nullptr) return bsdf_pdf;
+    return kGuideShare * guide_->Pdf(p_, side_, wi) + (1 - kGuideShare) * bsdf_pdf;
+}
+
+std::optional<BsdfSample> GuidedBsdf::Sample(const Vec3f& wo, float u_choice, float uc, Point2f u,
+                                             const std::array<float, 3>& ug,
+                                             const SampledWavelengths& lambda) const {
+    if (guide_ == nullptr) return bsdf_.Sample(wo, uc, u, lambda);
+    if (u_choice < kGuideShare) {
+        std::optional<GuideSample> g = guide_->Sample(p_, side_, ug[0], ug[1], ug[2]);
+        if (!g) return std::nullopt;
+        BsdfSample s;
+        s.wi = g->wi;
+        s.f = bsdf_.Eval(wo, s.wi, lambda);
+        if (s.f.IsZero()) return std::nullopt;  // below a reflecting surface, say
+        s.pdf = kGuideShare * g->pdf + (1 - kGuideShare) * bsdf_.Pdf(wo, s.wi, lambda);
+        if (!(s.pdf > 0)) return std::nullopt;
+        // The flags of a non-specular BSDF's lobes for this direction: reflection or transmission
+        // by the side of the shading frame, diffuse or glossy as the BSDF has them.
+        const bool reflect = Dot(wo, bsdf_.frame().z) * Dot(s.wi, bsdf_.frame().z) > 0;
+        s.flags = uint8_t((bsdf_.Flags() & (kBxdfDiffuse | kBxdfGlossy)) |
+                          (reflect ? kBxdfReflection : kBxdfTransmission));
+        return s;
+    }
+    std::optional<BsdfSample> s = bsdf_.Sample(wo, uc, u, lambda);
+    if (!s) return std::nullopt;
+    s->pdf = kGuideShare * guide_->Pdf(p_, side_, s->wi) + (1 - kGuideShare) * s->pdf;
+    return s;
+}
+
+}  // namespace nave::render

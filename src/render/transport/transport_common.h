@@ -1,0 +1,144 @@
+#pragma once
+// What path tracing, photon tracing, light sampling and photon emission share: the layout of a
+// vertex's random numbers, the MIS weight, one pass over the triangles of chosen materials, and the
+// walk of a path or photon through a brick.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+
+#include "src/core/status.h"
+#include "src/render/bricks/brick_walk.h"
+#include "src/render/scene/scene.h"
+#include "src/render/scene/surface_hit.h"
+#include "src/render/stream/ray.h"
+#include "src/render/stream/stream_scheduler.h"
+#include "src/render/transport/rng.h"
+
+namespace nave::render {
+
+inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+/// Dimensions of a vertex's random numbers (VertexRng::Uniform).
+enum RngDim : uint32_t {
+    // The camera stream only: pixel position, lens, wavelengths.
+    kDimPixelX = 0,
+    kDimPixelY,
+    kDimLens0,
+    kDimLens1,
+    kDimLambda,
+    // Every scattering vertex: BSDF lobe and direction, Russian roulette.
+    kDimBsdfChoice = 8,
+    kDimBsdf0,
+    kDimBsdf1,
+    kDimRoulette,
+    // Path guiding: the guide or the BSDF, then the guide's bin and the direction in it.
+    kDimGuideChoice,
+    kDimGuideBin,
+    kDimGuide0,
+    kDimGuide1,
+    kDimLight0 = 16,  // next-event estimation: two per light, then the sky's
+};
+
+/// The random streams of a ray (RngKey::stream).
+enum RngStream : uint32_t {
+    kStreamPath = 0,
+    kStreamPhoton = 1,
+    kStreamCamera = 2,
+    kStreamEmit = 3,
+    kStreamWavelengths = 4,  // photon mode: the iteration's shared wavelengths
+};
+
+/// The key of ray r's random numbers in `stream`: its path (or photon), its vertex and the SPPM
+/// iteration (0 in path mode) under the render's `seed`.
+inline RngKey RayKey(uint64_t seed, const RayRecord& r, uint32_t iteration, uint32_t stream) {
+    return RngKey{seed, r.pixel, r.sample, r.vertex, iteration, stream};
+}
+
+/// The MIS weight of a sample drawn with pdf `a` against a strategy with pdf `b`.
+inline float PowerHeuristic(float a, float b) {
+    // Veach 1997, eq. 9.13 with beta = 2.
+    if (std::isinf(a)) return 1;
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0;
+}
+
+/// A path or photon leaving solid absorbing glass through the hit `h` (its ray runs along the
+/// surface's outward, winding-given normal) crossed the glass from its last vertex: Beer-Lambert,
+/// exp(-α d) over that length d (Beer 1852), for closed, outward-wound objects not nested in
+/// another.
+inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, RayRecord* r) {
+    const DielectricMaterial* glass = m.absorbing_dielectric();
+    if (glass == nullptr || Dot(r->dir, h.ng) <= 0) return;
+    r->beta *= glass->Transmittance(r->since_vertex + Length(h.p - r->origin), r->lambda);
+}
+
+/// Moves path or photon `r` on through the pass-through surface at `h` (thin glass: not a bounce,
+/// so neither its depth nor its direction changes), toward `wi`. False if nothing is left of it.
+inline bool PassThrough(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
+    if (r.beta.IsZero()) return false;
+    r.since_vertex += Length(h.p - r.origin);
+    r.origin = OffsetOrigin(h.p, h.ng, wi);
+    r.t_max = kInfinity;
+    return true;
+}
+
+/// Bounces path or photon `r` at `h` into direction `wi`: its next vertex. False if nothing is
+/// left of it.
+inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
+    if (r.beta.IsZero()) return false;
+    r.origin = OffsetOrigin(h.p, h.ng, wi);
+    r.since_vertex = 0;
+    r.dir = wi;
+    r.t_max = kInfinity;
+    r.depth += 1;
+    return true;
+}
+
+/// One pass over the bricks (pinned through `scheduler`, so through the pager when paging) calling
+/// `visit(mesh, t, b)` for every triangle t of brick b whose material passes `want`. A triangle
+/// stored in several bricks (it crosses cells) is visited once: in the brick whose cell holds its
+/// centroid. Errors: a brick that cannot be pinned. Call from the render's thread, not during a
+/// Drain.
+Status ForEachOwnedTriangle(
+    const RenderScene& scene, StreamScheduler& scheduler,
+    const std::function<bool(const SurfaceMaterial&)>& want,
+    const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit);
+
+/// Traces a path or photon ray `r` inside brick `b` (pinned as `brick`) from its segment there. At
+/// each hit, `shade(r, hit)` scatters the ray in place and returns whether it goes on. A ray that
+/// goes on inside the cell is traced on at once, without queueing; one whose next segment lies in
+/// another brick is sent to `out`; one that leaves the model goes to `escape(r)`.
+template <typename Shade, typename Escape>
+void TraceInBrick(RayRecord& r, uint32_t b, const ResidentBrick& brick,
+                  const StreamScheduler& scheduler, RayOutbox& out, Shade&& shade,
+                  Escape&& escape) {
+    for (;;) {
+        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        ++out.counts.segments_traced;
+        BrickHit hit;
+        if (!brick.Intersect(r.origin, r.dir, r.t_enter, t1, &hit)) {
+            const uint32_t next = scheduler.Route(r, r.t_exit, b);
+            if (next == store::kNoBrick) {
+                escape(r);
+            } else {
+                out.Send(next, b, r);
+            }
+            return;
+        }
+        if (!shade(r, hit)) return;
+        ++out.counts.rays;
+        const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);
+        if (next == store::kNoBrick) {
+            escape(r);
+            return;
+        }
+        if (next == b) continue;  // still in this brick: keep tracing without queueing
+        out.Send(next, b, r);
+        return;
+    }
+}
+
+}  // namespace nave::render
