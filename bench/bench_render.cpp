@@ -83,18 +83,18 @@ std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
 void BM_PathRays(benchmark::State& state) {
     ProgressBar::SetEnabled(false);
     auto f = MakeFixture(int(state.range(0)), "path");
-    uint64_t rays = 0, moves = 0, segments = 0;
+    uint64_t rays = 0, brick_moves = 0, segments = 0;
     for (auto _ : state) {
         Film film(f->config.camera.width, f->config.camera.height, f->config.output);
         RenderStats stats;
         if (!RenderStreams(f->scene, &film, &stats).ok()) state.SkipWithError("render failed");
         rays += stats.rays;
         segments += stats.segments_traced + stats.shadow_segments;
-        moves += stats.brick_moves;
+        brick_moves += stats.brick_moves;
     }
     state.counters["bricks"] = double(f->source->brick_count());
     state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
-    state.counters["moves/ray"] = double(moves) / double(std::max<uint64_t>(1, rays));
+    state.counters["brick_moves/ray"] = double(brick_moves) / double(std::max<uint64_t>(1, rays));
     state.counters["segments/ray"] = double(segments) / double(std::max<uint64_t>(1, rays));
 }
 BENCHMARK(BM_PathRays)

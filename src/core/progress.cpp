@@ -31,6 +31,31 @@ double ProgressBar::ElapsedSeconds() const {
 
 void ProgressBar::SetTotal(uint64_t total) { total_.store(total); }
 
+void ProgressBar::SetDeadline(double seconds) { deadline_s_.store(std::max(0.0, seconds)); }
+
+double ProgressBar::Fraction() const {
+    const uint64_t total = total_.load();
+    double fraction = total > 0 ? std::min(1.0, double(done_.load()) / double(total)) : 0.0;
+    const double deadline = deadline_s_.load();
+    if (deadline > 0) fraction = std::max(fraction, std::min(1.0, ElapsedSeconds() / deadline));
+    return fraction;
+}
+
+double ProgressBar::SecondsLeft() const { return SecondsLeftAt(ElapsedSeconds(), nullptr); }
+
+double ProgressBar::SecondsLeftAt(double elapsed, bool* by_deadline) const {
+    const uint64_t done = done_.load(), total = total_.load();
+    double left = -1;
+    if (total > 0 && done > 0 && elapsed > 0) {
+        left = double(total - std::min(done, total)) / (double(done) / elapsed);
+    }
+    const double deadline = deadline_s_.load();
+    const double to_deadline = std::max(0.0, deadline - elapsed);
+    const bool deadline_first = deadline > 0 && (left < 0 || to_deadline < left);
+    if (by_deadline != nullptr) *by_deadline = deadline_first;
+    return deadline_first ? to_deadline : left;
+}
+
 void ProgressBar::Add(uint64_t n) {
     done_.fetch_add(n, std::memory_order_relaxed);
     if (!g_enabled.load(std::memory_order_relaxed)) return;
@@ -65,18 +90,21 @@ void ProgressBar::Draw(bool final_draw) {
     const uint64_t total = total_.load();
     const double elapsed = ElapsedSeconds();
     const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
-    std::string tail = fmt::format("{} {} | {}/s | {}", FormatCount(double(done)), unit_,
-                                   FormatCount(rate), FormatDuration(elapsed));
-    double fraction = total > 0 ? std::min(1.0, double(done) / double(total)) : 0.0;
-    if (total > 0 && !final_draw && rate > 0) {
-        tail +=
-            fmt::format(" | ETA {}", FormatDuration(double(total - std::min(done, total)) / rate));
+    std::string tail = fmt::format("{} {} | {} | {}", FormatCount(double(done)), unit_,
+                                   FormatRate(rate), FormatDuration(elapsed));
+    const double deadline = deadline_s_.load();
+    // A render stopped by its time limit ends full: the limit, not the units, was its measure.
+    const double fraction = final_draw && deadline > 0 && elapsed >= deadline ? 1.0 : Fraction();
+    bool by_deadline = false;
+    const double left = SecondsLeftAt(elapsed, &by_deadline);
+    if (!final_draw && left >= 0) {
+        tail += fmt::format(" | {} {}", by_deadline ? "time left" : "ETA", FormatDuration(left));
     }
     if (!note_.empty()) tail += " | " + note_;
     if (tty_) {
         constexpr int kWidth = 30;
         std::string bar;
-        if (total > 0) {
+        if (total > 0 || deadline > 0) {
             const int filled = std::clamp(int(fraction * kWidth), 0, kWidth);
             bar = fmt::format("[{:#<{}}{:-<{}}] {:5.1f}% ", "", filled, "", kWidth - filled,
                               100.0 * fraction);
@@ -86,10 +114,11 @@ void ProgressBar::Draw(bool final_draw) {
         std::fflush(stderr);
     } else {
         // Not a terminal (CI logs, pipes): one line per 10 % and a final one.
-        int decile = total > 0 ? int(fraction * 10) : -1;
+        const bool measured = total > 0 || deadline > 0;
+        int decile = measured ? int(fraction * 10) : -1;
         if (final_draw || (decile > last_logged_decile_ && decile < 10)) {
             last_logged_decile_ = decile;
-            if (total > 0)
+            if (measured)
                 log::Info("{} {:5.1f}% {}", label_, 100.0 * fraction, tail);
             else if (final_draw)
                 log::Info("{} {}", label_, tail);
@@ -102,6 +131,13 @@ std::string FormatDuration(double seconds) {
     auto s = static_cast<long long>(seconds + 0.5);
     if (s < 3600) return fmt::format("{} min {:02} s", s / 60, s % 60);
     return fmt::format("{} h {:02} min", s / 3600, (s % 3600) / 60);
+}
+
+std::string FormatRate(double per_second) {
+    if (per_second >= 1e4) return FormatCount(per_second) + "/s";
+    if (per_second >= 10) return fmt::format("{:.1f}/s", per_second);
+    if (per_second >= 1) return fmt::format("{:.2f}/s", per_second);
+    return fmt::format("{:.3f}/s", per_second);
 }
 
 std::string FormatCount(double count) {

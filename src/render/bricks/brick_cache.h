@@ -18,7 +18,7 @@
 
 namespace nave::render {
 
-/// What a brick mesh cache did during one render.
+/// What the brick cache did during one render.
 struct BrickCacheStats {
     uint64_t bricks_written = 0;
     uint64_t reads = 0;       ///< loads served from the cache

@@ -15,7 +15,8 @@ namespace nave::render {
 
 class StoppingRule {
   public:
-    /// The rule of `settings`; `progress` (may be null) shows the noise estimate as it goes.
+    /// The rule of `settings`; `progress` (may be null) shows the noise estimate as it goes and,
+    /// under a time limit, fills with the time and shows the time left.
     /// `elapsed_before_s`: seconds the render spent in earlier runs (resumed from a checkpoint),
     /// which count toward the time limit.
     StoppingRule(const RenderSettings& settings, ProgressBar* progress,
