@@ -129,7 +129,7 @@ StatusOr<uint64_t> ConvertMaterialTextures(const PreprocessOptions& options,
     return reserve;
 }
 
-/// Phase 2: cuts the root bin into leaf bins of at most 5/4 of the brick size.
+/// Phase 2: cuts the root bin into leaf bins of at most LeafMaxTriangles (5/4 of the brick size).
 Status SplitIntoLeaves(const GridPlan& grid, Partitioner& partitioner, PreprocessStats* stats) {
     const auto start = Clock::now();
     {

@@ -45,8 +45,9 @@ StatusOr<PreprocessPlan> PlanPreprocess(const PreprocessOptions& options,
     plan.memory_budget =
         options.memory_bytes > 0 ? options.memory_bytes : machine.physical_memory_bytes / 4;
 
-    // The budget must hold one brick's work (the largest a leaf may be: 5/4 of the target). Without
-    // --brick-triangles, bricks get the default size, or the largest whose work fits the budget.
+    // The budget must hold one brick's work (the largest a leaf may be: LeafMaxTriangles, 5/4 of
+    // the target, hence 4/5 of what fits). Without --brick-triangles, bricks get the default size,
+    // or the largest whose work fits the budget.
     const uint64_t fit = plan.memory_budget > kFixedBytes
                              ? (plan.memory_budget - kFixedBytes) / kEncodeBytesPerTriangle * 4 / 5
                              : 0;
@@ -56,7 +57,7 @@ StatusOr<PreprocessPlan> PlanPreprocess(const PreprocessOptions& options,
             std::clamp<uint64_t>(fit, kMinBrickTriangles, kDefaultBrickTriangles);
         plan.brick_triangles_fitted = plan.brick_triangles < kDefaultBrickTriangles;
     }
-    plan.leaf_max_triangles = plan.brick_triangles + plan.brick_triangles / 4;
+    plan.leaf_max_triangles = LeafMaxTriangles(plan.brick_triangles);
     plan.brick_work_bytes = plan.leaf_max_triangles * kEncodeBytesPerTriangle;
     if (plan.memory_budget < kFixedBytes + plan.brick_work_bytes) {
         return ResourceExhaustedError(

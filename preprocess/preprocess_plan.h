@@ -42,7 +42,7 @@ struct PreprocessPlan {
     /// cannot hold the default's work (then `brick_triangles_fitted`).
     uint64_t brick_triangles = 0;
     bool brick_triangles_fitted = false;
-    uint64_t leaf_max_triangles = 0;  ///< the largest a leaf may be: 5/4 of brick_triangles
+    uint64_t leaf_max_triangles = 0;  ///< the largest a leaf may be (LeafMaxTriangles)
     uint64_t brick_work_bytes = 0;    ///< encoding work of such a leaf
     /// Producer threads of a generator: each buffers about 10 MiB of triangles, so small budgets
     /// get one.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace nave::preprocess::abbey {
 
@@ -65,7 +66,7 @@ void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& 
     // Rounded arrises: from the wall face at the stone's edge up to the face border, n segments
     // along each side and m = n / 2 across (a quarter round; m = 1 is a plain chamfer).
     const int m = std::max(1, n / 2);
-    const double kHalfPi = 1.5707963267948966;
+    const double kHalfPi = std::numbers::pi / 2;
     // Point on the arris of side (du, dv) at position `along` in [0, 1] and `across` in [0, 1].
     auto arris = [&](int side, double along, double across) {
         double inset = c * (1 - std::cos(across * kHalfPi)),
@@ -146,7 +147,7 @@ std::vector<EdgeEndNormals> SmoothProfileNormals(const std::vector<Vec2>& edge_n
 
 void Revolve(Emitter& em, const Vec3d& base, const std::vector<Vec2>& profile, int segments,
              uint32_t m, int sides, double phase) {
-    const double kTwoPi = 6.283185307179586;
+    const double kTwoPi = 2 * std::numbers::pi;
     auto dir = [&](int i) {
         double a = phase + kTwoPi * i / segments;
         if (sides > 0) {
@@ -282,7 +283,7 @@ void ParamGrid(Emitter& em, const std::function<Vec3d(double, double)>& p, int n
 std::vector<Vec2> CircleProfile(double radius, int n, double center_n) {
     std::vector<Vec2> out;
     for (int i = 0; i < n; ++i) {
-        double a = 6.283185307179586 * i / n;
+        double a = 2 * std::numbers::pi * i / n;
         out.push_back({radius * std::cos(a), center_n + radius * std::sin(a)});
     }
     return out;

@@ -4,6 +4,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "preprocess/import/file_source.h"
 #include "preprocess/import/mtl_parser.h"
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
@@ -17,9 +18,9 @@ struct Corner {
     int64_t v = -1, vt = -1, vn = -1;  // 0-based, -1 when absent
 };
 
-class ObjSource final : public TriangleSource {
+class ObjSource final : public FileSourceWithVertices {
   public:
-    explicit ObjSource(StreamReader reader) : reader_(std::move(reader)) {}
+    explicit ObjSource(StreamReader reader) : FileSourceWithVertices(std::move(reader)) {}
 
     StatusOr<bool> Next(std::vector<Triangle>& batch, size_t max_triangles) override {
         batch.clear();
@@ -46,16 +47,6 @@ class ObjSource final : public TriangleSource {
         }
         return !batch.empty();
     }
-
-    const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
-    std::string name() const override { return reader_.path().filename().string(); }
-    uint64_t progress_done() const override { return reader_.offset(); }
-    uint64_t progress_total() const override { return reader_.file_size(); }
-    uint64_t memory_bytes() const override {
-        return positions_.capacity() * sizeof(Vec3f) + normals_.capacity() * sizeof(Vec3f) +
-               uvs_.capacity() * sizeof(uvs_[0]);
-    }
-    const ImportWarnings& warnings() const override { return warnings_; }
 
   private:
     Status ParseVec(std::string_view rest, float* out, int count, std::string_view keyword) {
@@ -215,20 +206,15 @@ class ObjSource final : public TriangleSource {
         return Status::Ok();
     }
 
-    StreamReader reader_;
-    std::vector<Vec3f> positions_, normals_;
-    std::vector<std::array<float, 2>> uvs_;
     std::vector<Corner> corners_;
     std::vector<Vec3f> polygon_;
     std::vector<std::array<uint32_t, 3>> fan_;
-    std::vector<store::MaterialRecord> materials_;
     std::unordered_map<std::string, int64_t> material_index_;
     std::unordered_map<std::string, store::MaterialRecord> library_;
     int64_t current_material_ = -1;
     uint64_t triangles_ = 0;
     bool finished_ = false;
     bool empty_reported_ = false;
-    ImportWarnings warnings_;
 };
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "preprocess/import/file_source.h"
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
@@ -79,10 +80,12 @@ int VertexSlot(const std::string& name) {
     return -1;
 }
 
-class PlySource final : public TriangleSource {
+class PlySource final : public FileSourceWithVertices {
   public:
     PlySource(StreamReader reader, Format format, std::vector<Element> elements)
-        : reader_(std::move(reader)), format_(format), elements_(std::move(elements)) {
+        : FileSourceWithVertices(std::move(reader)),
+          format_(format),
+          elements_(std::move(elements)) {
         store::MaterialRecord m;
         m.name = "default";
         materials_.push_back(m);
@@ -129,16 +132,6 @@ class PlySource final : public TriangleSource {
         }
         return !batch.empty();
     }
-
-    const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
-    std::string name() const override { return reader_.path().filename().string(); }
-    uint64_t progress_done() const override { return reader_.offset(); }
-    uint64_t progress_total() const override { return reader_.file_size(); }
-    uint64_t memory_bytes() const override {
-        return positions_.capacity() * sizeof(Vec3f) + normals_.capacity() * sizeof(Vec3f) +
-               uvs_.capacity() * sizeof(uvs_[0]);
-    }
-    const ImportWarnings& warnings() const override { return warnings_; }
 
   private:
     std::string Where() const {
@@ -399,7 +392,6 @@ class PlySource final : public TriangleSource {
         return Status::Ok();
     }
 
-    StreamReader reader_;
     Format format_;
     std::vector<Element> elements_;
     size_t element_ = 0;
@@ -408,13 +400,9 @@ class PlySource final : public TriangleSource {
     bool vertices_read_ = false;
     bool finished_ = false;
     uint64_t triangles_ = 0;
-    std::vector<Vec3f> positions_, normals_;
-    std::vector<std::array<float, 2>> uvs_;
     std::vector<int64_t> indices_;
     std::vector<Vec3f> polygon_;
     std::vector<std::array<uint32_t, 3>> fan_;
-    std::vector<store::MaterialRecord> materials_;
-    ImportWarnings warnings_;
 };
 
 }  // namespace

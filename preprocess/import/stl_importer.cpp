@@ -4,6 +4,7 @@
 #include <cstring>
 #include <string>
 
+#include "preprocess/import/file_source.h"
 #include "preprocess/import/stream_reader.h"
 #include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangle_check.h"
@@ -11,10 +12,10 @@
 namespace nave::preprocess {
 namespace {
 
-class StlSource final : public TriangleSource {
+class StlSource final : public FileSource {
   public:
     StlSource(StreamReader reader, bool binary, uint64_t binary_count)
-        : reader_(std::move(reader)), binary_(binary), binary_count_(binary_count) {
+        : FileSource(std::move(reader)), binary_(binary), binary_count_(binary_count) {
         store::MaterialRecord m;
         m.name = "default";
         materials_.push_back(m);
@@ -36,12 +37,6 @@ class StlSource final : public TriangleSource {
         }
         return !batch.empty();
     }
-
-    const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
-    std::string name() const override { return reader_.path().filename().string(); }
-    uint64_t progress_done() const override { return reader_.offset(); }
-    uint64_t progress_total() const override { return reader_.file_size(); }
-    const ImportWarnings& warnings() const override { return warnings_; }
 
   private:
     void Emit(Triangle& t, std::vector<Triangle>& batch, const std::string& where) {
@@ -123,7 +118,6 @@ class StlSource final : public TriangleSource {
         return Status::Ok();
     }
 
-    StreamReader reader_;
     bool binary_;
     uint64_t binary_count_;
     uint64_t facets_ = 0, triangles_ = 0;
@@ -131,8 +125,6 @@ class StlSource final : public TriangleSource {
     Triangle current_;
     int corner_ = 0;
     std::string facet_where_;
-    std::vector<store::MaterialRecord> materials_;
-    ImportWarnings warnings_;
 };
 
 }  // namespace

@@ -260,7 +260,7 @@ Status Partitioner::Split(const Bounds3f& root, double margin, ProgressBar& prog
 
 Status Partitioner::SplitTask(Task task, std::vector<Task>& children) {
     NAVE_RETURN_IF_ERROR(CheckCancelled(config_.interrupt));
-    const uint64_t leaf_max = config_.brick_triangles + config_.brick_triangles / 4;
+    const uint64_t leaf_max = LeafMaxTriangles(config_.brick_triangles);
     if (task.triangles <= leaf_max || task.depth + 2 >= int(store::BrickTree::kMaxDepth)) {
         std::lock_guard<std::mutex> lock(mutex_);
         leaves_.push_back(

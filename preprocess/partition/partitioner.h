@@ -31,7 +31,8 @@
 namespace nave::preprocess {
 
 struct PartitionConfig {
-    uint64_t brick_triangles = 1'000'000;  ///< target per brick; a leaf may hold up to 5/4 of it
+    /// Target triangles per brick; a leaf may hold up to LeafMaxTriangles(brick_triangles).
+    uint64_t brick_triangles = 1'000'000;
     size_t block_bytes =
         256 << 10;    ///< the root bin's block size (uncompressed), and the most for others
     int threads = 1;  ///< threads of each bin's split pass
@@ -46,6 +47,12 @@ struct PartitionConfig {
     /// Set by the caller (its signal handler) to a signal number to stop the work: Cancelled.
     const std::atomic<int>* interrupt = nullptr;
 };
+
+/// The most triangles a leaf of a `brick_triangles` target may hold before it is split again: 5/4
+/// of the target (rounded down). Also the largest brick the encoder's memory must be planned for.
+constexpr uint64_t LeafMaxTriangles(uint64_t brick_triangles) {
+    return brick_triangles + brick_triangles / 4;
+}
 
 /// The most leaves one split pass may cut a bin into (PartitionConfig::max_fanout): each is an open
 /// file with two block buffers of 16 KiB or more, within `split_buffer_bytes` and `open_files`

@@ -1,38 +1,18 @@
 // `nave preprocess`: model files (or the procedural abbey) -> a brick store, in bounded memory.
 // The library plans and runs; what touches the whole process is done here: the handlers of SIGINT
-// and SIGTERM and the open-file limit.
-#include <signal.h>
+// and SIGTERM (src/cli/interrupt.h) and the open-file limit.
 #include <sys/resource.h>
-#include <unistd.h>
 
-#include <atomic>
 #include <cstdio>
 
 #include "preprocess/preprocess.h"
 #include "src/cli/commands.h"
+#include "src/cli/interrupt.h"
 #include "src/core/log.h"
 #include "src/core/memory.h"
 
 namespace nave::cli {
 namespace {
-
-// The signal that asked the run to stop, 0 until one does (PreprocessOptions::interrupt).
-std::atomic<int> g_preprocess_interrupt{0};
-static_assert(std::atomic<int>::is_always_lock_free, "set from a signal handler");
-
-void OnPreprocessSignal(int sig) {
-    // The first signal asks the run to unwind (removing its files); a second stops it now, with
-    // the conventional exit code.
-    if (g_preprocess_interrupt.exchange(sig) != 0) _exit(128 + sig);
-}
-
-void InstallPreprocessInterruptHandlers() {
-    struct sigaction sa {};
-    sa.sa_handler = OnPreprocessSignal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
-}
 
 // Each leaf of a split pass is an open file: the soft limit (often 1024) would cap the pass's
 // fan-out (preprocess::MaxSplitFanout) where the hard limit does not.
@@ -111,8 +91,8 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             o.verify_every = opt->verify_every;
             o.convert_textures = !opt->no_textures;
             o.tool_version = std::string("nave ") + NAVE_VERSION;
-            o.interrupt = &g_preprocess_interrupt;
-            InstallPreprocessInterruptHandlers();
+            // The first signal asks the run to unwind (removing its files); a second stops it now.
+            o.interrupt = InstallInterruptHandlers();
             RaiseOpenFileLimit();
             NAVE_ASSIGN_OR_RETURN(auto stats, preprocess::RunPreprocess(o));
             log::Info("wrote {}\n{}", o.output.string(), preprocess::FormatSummary(stats));

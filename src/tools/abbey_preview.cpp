@@ -13,6 +13,7 @@
 
 #include "preprocess/abbey/abbey_plan.h"
 #include "preprocess/abbey/abbey_source.h"
+#include "src/core/sampling.h"
 
 using namespace nave;
 
@@ -73,7 +74,7 @@ int main(int argc, char** argv) {
         Vec3f fwd = Normalize(v.target - v.eye);
         Vec3f right = Normalize(Cross(fwd, Vec3f(0, 0, 1)));
         Vec3f up = Cross(right, fwd);
-        float scale = std::tan(v.fov_deg * 3.14159265f / 360);
+        float scale = std::tan(v.fov_deg * kPi / 360);
         for (int y = 0; y < h; ++y) {
             for (int x = 0; x < w; ++x) {
                 float sx = (2 * (x + 0.5f) / w - 1) * scale,
