@@ -1,10 +1,13 @@
 // `nave compare A.exr B.exr`: how far apart two renders are, in the terms docs/render.md uses to
 // judge noise: each image's mean luminance, their ratio, and the relative mean squared error of one
 // render estimated from a pair that differs only in the seed (or, with --reference, of A against
-// B).
+// B), on luminance, on RGB and on RGB after a box blur (which removes pixel noise and keeps error
+// that spans many pixels: photon discs, blotches), and the mean of each region of a 3 x 3 grid, so
+// that a bias in part of the image shows.
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -58,8 +61,14 @@ Status CompareIdentical(const CompareOptions& o) {
         a.channels[first % nc], a.pixels[first], b.pixels[first]);
 }
 
-/// The luminance of an image's R, G, B channels, per pixel.
-StatusOr<std::vector<float>> ReadLuminance(const std::string& path, int* width, int* height) {
+/// An image's R, G and B channels and their luminance, per pixel.
+struct RgbImage {
+    int width = 0, height = 0;
+    std::array<std::vector<float>, 3> rgb;
+    std::vector<float> luminance;
+};
+
+StatusOr<RgbImage> ReadRgb(const std::string& path) {
     NAVE_ASSIGN_OR_RETURN(imaging::FloatImage image, imaging::ReadImage(path));
     int channel[3] = {-1, -1, -1};
     for (size_t c = 0; c < image.channels.size(); ++c) {
@@ -70,45 +79,96 @@ StatusOr<std::vector<float>> ReadLuminance(const std::string& path, int* width, 
     if (channel[0] < 0 || channel[1] < 0 || channel[2] < 0)
         return InvalidArgumentError("{}: expected channels R, G and B", path);
     const size_t nc = image.channels.size();
-    std::vector<float> y(size_t(image.width) * image.height);
-    for (size_t p = 0; p < y.size(); ++p) {
+    const size_t pixels = size_t(image.width) * size_t(image.height);
+    RgbImage out;
+    out.width = image.width;
+    out.height = image.height;
+    for (auto& plane : out.rgb) plane.resize(pixels);
+    out.luminance.resize(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
         const float* px = &image.pixels[p * nc];
-        y[p] = float(LuminanceOfLinearSrgb(px[channel[0]], px[channel[1]], px[channel[2]]));
+        for (int k = 0; k < 3; ++k) out.rgb[size_t(k)][p] = px[channel[k]];
+        out.luminance[p] =
+            float(LuminanceOfLinearSrgb(px[channel[0]], px[channel[1]], px[channel[2]]));
     }
-    *width = image.width;
-    *height = image.height;
-    return y;
+    return out;
+}
+
+/// The box blur a comparison on RGB reports beside the plain one when --blur does not choose:
+/// 4 pixels, a 9 x 9 square, over which pixel noise falls some 80-fold.
+constexpr int kDefaultRgbBlur = 4;
+/// The regions whose mean luminance is compared: a grid of this many a side.
+constexpr int kRegionsPerSide = 3;
+
+/// The relMSE of `a` (of one render of a pair, or against the reference `b`) over R, G and B: the
+/// mean of the three channels' relMSE, each box-blurred over `blur` pixels first.
+double RgbRelMse(const RgbImage& a, const RgbImage& b, bool reference, int blur) {
+    double sum = 0;
+    for (size_t k = 0; k < 3; ++k) {
+        const std::vector<float> ca = BoxBlur(a.rgb[k], a.width, a.height, blur);
+        const std::vector<float> cb = BoxBlur(b.rgb[k], b.width, b.height, blur);
+        sum += reference ? RelMseAgainst(ca, cb) : PairRelMse(ca, cb);
+    }
+    return sum / 3;
 }
 
 Status RunCompare(const CompareOptions& o) {
     if (o.identical) return CompareIdentical(o);
-    int wa = 0, ha = 0, wb = 0, hb = 0;
-    NAVE_ASSIGN_OR_RETURN(std::vector<float> a, ReadLuminance(o.a, &wa, &ha));
-    NAVE_ASSIGN_OR_RETURN(std::vector<float> b, ReadLuminance(o.b, &wb, &hb));
-    if (wa != wb || ha != hb)
+    NAVE_ASSIGN_OR_RETURN(RgbImage image_a, ReadRgb(o.a));
+    NAVE_ASSIGN_OR_RETURN(RgbImage image_b, ReadRgb(o.b));
+    if (image_a.width != image_b.width || image_a.height != image_b.height)
         return InvalidArgumentError("{} is {}x{} but {} is {}x{}: compare images of one size", o.a,
-                                    wa, ha, o.b, wb, hb);
-    a = BoxBlur(a, wa, ha, o.blur_radius);
-    b = BoxBlur(b, wb, hb, o.blur_radius);
+                                    image_a.width, image_a.height, o.b, image_b.width,
+                                    image_b.height);
+    const int w = image_a.width, h = image_a.height;
+    const std::vector<float> a = BoxBlur(image_a.luminance, w, h, o.blur_radius);
+    const std::vector<float> b = BoxBlur(image_b.luminance, w, h, o.blur_radius);
     const double mean_a = FiniteMean(a), mean_b = FiniteMean(b);
     const double ratio = mean_a > 0 ? mean_b / mean_a : 0.0;
     const double rel_mse = o.reference ? RelMseAgainst(a, b) : PairRelMse(a, b);
+    const int rgb_blur = o.blur_radius > 0 ? o.blur_radius : kDefaultRgbBlur;
+    const double rgb = RgbRelMse(image_a, image_b, o.reference, 0);
+    const double rgb_blurred = RgbRelMse(image_a, image_b, o.reference, rgb_blur);
+    const std::vector<double> regions_a =
+        RegionMeans(image_a.luminance, w, h, kRegionsPerSide, kRegionsPerSide);
+    const std::vector<double> regions_b =
+        RegionMeans(image_b.luminance, w, h, kRegionsPerSide, kRegionsPerSide);
     const char* what = o.reference ? "relmse_against_reference" : "relmse_of_one";
     if (o.json) {
+        std::string regions;
+        for (size_t r = 0; r < regions_a.size(); ++r) {
+            regions +=
+                fmt::format("{}[{:.9g}, {:.9g}]", r > 0 ? ", " : "", regions_a[r], regions_b[r]);
+        }
         std::printf(
             "{\"mean_luminance_a\": %.9g, \"mean_luminance_b\": %.9g, \"ratio_b_to_a\": %.6f, "
-            "\"blur_radius\": %d, \"%s\": %.6g}\n",
-            mean_a, mean_b, ratio, o.blur_radius, what, rel_mse);
+            "\"blur_radius\": %d, \"%s\": %.6g, \"%s_rgb\": %.6g, \"rgb_blur_radius\": %d, "
+            "\"%s_rgb_blurred\": %.6g, \"region_grid\": %d, \"region_mean_luminance\": [%s]}\n",
+            mean_a, mean_b, ratio, o.blur_radius, what, rel_mse, what, rgb, rgb_blur, what,
+            rgb_blurred, kRegionsPerSide, regions.c_str());
         return Status::Ok();
     }
     std::printf("%s: mean luminance %.6g\n%s: mean luminance %.6g (%.4f of the first)\n",
                 o.a.c_str(), mean_a, o.b.c_str(), mean_b, ratio);
-    if (o.blur_radius > 0)
-        std::printf("both blurred over %d pixels around each pixel\n", o.blur_radius);
+    const std::string luminance_blur =
+        o.blur_radius > 0 ? fmt::format(" (box-blurred over {} pixels)", o.blur_radius) : "";
     if (o.reference) {
-        std::printf("relMSE of %s against %s: %.4g\n", o.a.c_str(), o.b.c_str(), rel_mse);
+        std::printf("relMSE of %s against %s:\n", o.a.c_str(), o.b.c_str());
     } else {
-        std::printf("relMSE of one render (a pair that differs only in the seed): %.4g\n", rel_mse);
+        std::printf("relMSE of one render (a pair that differs only in the seed):\n");
+    }
+    std::printf("  luminance%s %.4g\n  RGB %.4g\n  RGB box-blurred over %d pixels %.4g\n",
+                luminance_blur.c_str(), rel_mse, rgb, rgb_blur, rgb_blurred);
+    std::printf("mean luminance by region (%d x %d, top row first), second / first:\n",
+                kRegionsPerSide, kRegionsPerSide);
+    for (int row = 0; row < kRegionsPerSide; ++row) {
+        std::string line = " ";
+        for (int col = 0; col < kRegionsPerSide; ++col) {
+            const size_t r = size_t(row * kRegionsPerSide + col);
+            line += regions_a[r] > 0 ? fmt::format(" {:8.4f}", regions_b[r] / regions_a[r])
+                                     : std::string("        -");
+        }
+        std::printf("%s\n", line.c_str());
     }
     return Status::Ok();
 }
@@ -119,9 +179,9 @@ void RegisterCompareCommand(CLI::App& app, CommandRun& run) {
     auto o = std::make_shared<CompareOptions>();
     CLI::App* cmd = app.add_subcommand(
         "compare",
-        "How far apart two renders are: mean luminance of each and the relative mean squared error "
-        "of one "
-        "render estimated from two that differ only in the seed (docs/render.md, \"Noise\")");
+        "How far apart two renders are: mean luminance of each (and of each region of a 3 x 3 "
+        "grid), and the relative mean squared error of one render estimated from two that differ "
+        "only in the seed, on luminance, RGB and blurred RGB (docs/render.md, \"Noise\")");
     cmd->add_option("A", o->a, "First image (EXR, linear RGB)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -131,7 +191,8 @@ void RegisterCompareCommand(CLI::App& app, CommandRun& run) {
         "B is a converged reference: report A's relMSE against it instead of the pair estimate");
     cmd->add_option(
            "--blur", o->blur_radius,
-           "Box-blur both images over this many pixels around each pixel first (default 0)")
+           "Box-blur both images' luminance over this many pixels around each pixel first, and "
+           "the RGB comparison's blurred figure over as many (default 0; blurred RGB: 4)")
         ->check(CLI::Range(0, 1000));
     cmd->add_flag("--json", o->json, "Print JSON");
     cmd->add_flag(

@@ -96,4 +96,25 @@ double RelMseAgainst(std::span<const float> image, std::span<const float> refere
     return n > 0 ? sum / double(n) : 0.0;
 }
 
+std::vector<double> RegionMeans(std::span<const float> values, int width, int height, int columns,
+                                int rows) {
+    NAVE_CHECK_EQ(values.size(), size_t(width) * size_t(height));
+    NAVE_CHECK(columns > 0 && rows > 0);
+    std::vector<double> sum(size_t(columns) * size_t(rows), 0.0);
+    std::vector<size_t> count(sum.size(), 0);
+    for (int y = 0; y < height; ++y) {
+        const size_t row = size_t(y) * size_t(rows) / size_t(height);
+        for (int x = 0; x < width; ++x) {
+            const float v = values[size_t(y) * size_t(width) + size_t(x)];
+            if (!std::isfinite(v)) continue;
+            const size_t region =
+                row * size_t(columns) + size_t(x) * size_t(columns) / size_t(width);
+            sum[region] += v;
+            ++count[region];
+        }
+    }
+    for (size_t r = 0; r < sum.size(); ++r) sum[r] = count[r] > 0 ? sum[r] / double(count[r]) : 0;
+    return sum;
+}
+
 }  // namespace nave

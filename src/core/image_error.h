@@ -47,4 +47,11 @@ std::vector<float> BoxBlur(std::span<const float> values, int width, int height,
 /// The mean of the finite values of `values` (0 if there are none).
 double FiniteMean(std::span<const float> values);
 
+/// The means of `values` (width x height, row-major) over a grid of `columns` x `rows` regions of
+/// near-equal size, top row first: a bias that covers part of an image (too dark a vault, too
+/// bright a floor) shows in its regions even where the whole image's mean hides it. Non-finite
+/// values are skipped; a region without a finite value has mean 0.
+std::vector<double> RegionMeans(std::span<const float> values, int width, int height, int columns,
+                                int rows);
+
 }  // namespace nave

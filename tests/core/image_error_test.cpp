@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -62,6 +63,23 @@ TEST(ImageErrorTest, PairEstimatePredictsTheErrorAgainstTheTruth) {
     // Within 10 %: the pair's denominator uses the noisy m, the truth's the exact value.
     EXPECT_NEAR(PairRelMse(a, b) / actual_one, 1.0, 0.1);
     EXPECT_NEAR(HalvesRelMse(a, b) / actual_mean, 1.0, 0.1);
+}
+
+TEST(RegionMeansTest, EachRegionAveragesItsOwnPixels) {
+    // 5 x 4 pixels in 2 x 2 regions of near-equal size: columns 0-2 and 3-4, rows 0-1 and 2-3.
+    std::vector<float> v(20);
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 5; ++x) v[size_t(y) * 5 + size_t(x)] = float(10 * (y >= 2) + (x >= 3));
+    }
+    v[0] = std::numeric_limits<float>::quiet_NaN();  // skipped, not a zero
+    const std::vector<double> m = RegionMeans(v, 5, 4, 2, 2);
+    ASSERT_EQ(m.size(), 4u);
+    EXPECT_EQ(m[0], 0.0);   // top left (its NaN skipped)
+    EXPECT_EQ(m[1], 1.0);   // top right
+    EXPECT_EQ(m[2], 10.0);  // bottom left
+    EXPECT_EQ(m[3], 11.0);  // bottom right
+    // One region: the image's mean.
+    EXPECT_DOUBLE_EQ(RegionMeans(v, 5, 4, 1, 1)[0], FiniteMean(v));
 }
 
 }  // namespace
