@@ -12,6 +12,7 @@
 #include "pager_test_scene.h"
 #include "render_test_util.h"
 #include "src/core/memory.h"
+#include "src/render/stream/memory_plan.h"
 
 namespace nave::render {
 namespace {

@@ -19,6 +19,7 @@
 #include "src/core/progress.h"
 #include "src/render/bricks/procedural_meshes.h"
 #include "src/render/bricks/store_brick_source.h"
+#include "src/render/stream/memory_plan.h"
 #include "src/render/stream/ray.h"
 #include "store/store_reader.h"
 
