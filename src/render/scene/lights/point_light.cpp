@@ -31,7 +31,7 @@ PhotonSample PointLight::SamplePhoton(const PhotonRandoms& u,
 }
 
 double PointLight::Power(const PhotonTarget&) const {
-    // Φ = 4 pi I.
+    // Φ = 4 pi I (for a spot, which sends less outside its cone, an upper bound).
     float w = MeanVisible(intensity_);
     w *= 4 * kPi;
     return w;
