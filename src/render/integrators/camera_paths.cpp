@@ -96,7 +96,7 @@ void CameraPaths::Escape(const RayRecord& r) {
             w = PowerHeuristic(r.prev_pdf,
                                lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.dir));
         }
-        const SampledSpectrum sky = scene_.SkyRadiance(r.dir, r.lambda);
+        const SampledSpectrum sky = scene_.sky->Radiance(r.dir, r.lambda);
         L += sky * w;
         // The sky seen through a window from the last vertex: the guide learns where windows are
         // open to it, which next-event estimation, aiming at all windows alike, does not know.
@@ -107,16 +107,16 @@ void CameraPaths::Escape(const RayRecord& r) {
         }
     }
     if (scene_.sun >= 0) {
-        const Light& sun = scene_.lights[size_t(scene_.sun)];
-        if (sun.SeesSun(r.dir)) {
+        const SunLight& sun = scene_.sun_light();
+        if (sun.Sees(r.dir)) {
             // A BSDF-sampled direction that found the sun: weighted against next-event estimation
             // of the sun (power heuristic). Camera rays and specular bounces cannot be
             // light-sampled: weight 1.
             float w = 1;
             if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
-                w = PowerHeuristic(r.prev_pdf, sun.SunPdf());
+                w = PowerHeuristic(r.prev_pdf, sun.Pdf());
             }
-            L += sun.spectrum.Sample(r.lambda) * w;
+            L += sun.radiance().Sample(r.lambda) * w;
         }
     }
     if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda, Half(r));
@@ -202,7 +202,7 @@ void CameraPaths::EstimateDirect(const RayRecord& r, uint32_t b, const ResidentB
     };
     for (size_t i = 0; i < scene_.lights.size(); ++i) {
         spawn_shadow(
-            lights_.SampleLight(scene_.lights[i], int(i), h, bsdf, wo, r, rng, mis_against));
+            lights_.SampleLight(*scene_.lights[i], int(i), h, bsdf, wo, r, rng, mis_against));
     }
     if (sky) spawn_shadow(lights_.SampleSky(h, bsdf, wo, r, rng, mis_against));
 }

@@ -38,14 +38,14 @@ double PathIntegrator::GuideRadianceScale(const RenderScene& scene) {
     const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
     double scale = 0;
     if (scene.sun >= 0) {
-        const Light& sun = scene.lights[size_t(scene.sun)];
-        const double solid_angle = sun.SunSolidAngle();
-        scale = double(sun.spectrum.Sample(green).Average()) * solid_angle * kInvPi;
+        const SunLight& sun = scene.sun_light();
+        const double solid_angle = sun.SolidAngle();
+        scale = double(sun.radiance().Sample(green).Average()) * solid_angle * kInvPi;
     }
     if (scene.sky) {
         for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
                                Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
-            scale = std::max(scale, double(scene.SkyRadiance(w, green).Average()));
+            scale = std::max(scale, double(scene.sky->Radiance(w, green).Average()));
     }
     return scale > 0 ? scale : 1.0;
 }
@@ -156,7 +156,7 @@ bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& br
                 owned_guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir);
             credit_scale = 1 / (beta * r.prev_pdf);
         }
-        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky, credit,
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky != nullptr, credit,
                        credit_scale, out);
     }
     return Continue(r, h, continuation, rng, side, last);

@@ -38,7 +38,7 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
     const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
     const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
     if (flags & kBxdfGlossy) {
-        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky,
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);
     }
     return Continue(r, h, continuation, rng, side, last);

@@ -5,6 +5,9 @@
 
 #include "src/core/log.h"
 #include "src/core/rgb_to_spectrum.h"
+#include "src/render/scene/lights/directional_light.h"
+#include "src/render/scene/lights/point_light.h"
+#include "src/render/scene/lights/spot_light.h"
 #include "src/render/scene/materials/ior.h"
 #include "src/render/scene/sun/sun.h"
 
@@ -25,32 +28,34 @@ float SurfaceMaterial::AlbedoForAov() const {
 
 Spectrum HorizontalIrradiance(const RenderScene& scene) {
     std::vector<double> e(Spectrum::kNumSamples, 0.0);
-    if (scene.preetham) {
-        // ∫ L cos θ dω = ∫∫ L(μ, φ) μ dμ dφ over μ in (0, 1].
-        constexpr int kMu = 64, kPhi = 128;
-        const double cell = (1.0 / kMu) * (2 * std::numbers::pi / kPhi) * scene.sky_scale;
-        for (int i = 0; i < kMu; ++i) {
-            const double mu = (i + 0.5) / kMu, r = std::sqrt(1 - mu * mu);
-            for (int j = 0; j < kPhi; ++j) {
-                const double phi = (j + 0.5) * 2 * std::numbers::pi / kPhi;
-                const Spectrum l = scene.preetham->RadianceSpectrum(
-                    Vec3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(mu)));
-                for (int k = 0; k < Spectrum::kNumSamples; ++k)
-                    e[size_t(k)] += double(l.sample(k)) * mu * cell;
-            }
-        }
-    } else if (scene.sky) {
-        for (int k = 0; k < Spectrum::kNumSamples; ++k)
-            e[size_t(k)] = std::numbers::pi * scene.sky_radiance.sample(k);
-    }
+    if (scene.sky) scene.sky->AddHorizontalIrradiance(&e);
     if (scene.sun >= 0) {
-        const Light& sun = scene.lights[size_t(scene.sun)];
-        const double sun_e = sun.SunSolidAngle() * std::max(0.0, double(sun.to_light.z));
+        const SunLight& sun = scene.sun_light();
+        const double sun_e = sun.SolidAngle() * std::max(0.0, double(sun.to_light().z));
         for (int k = 0; k < Spectrum::kNumSamples; ++k)
-            e[size_t(k)] += sun_e * sun.spectrum.sample(k);
+            e[size_t(k)] += sun_e * sun.radiance().sample(k);
     }
     return Spectrum::FromFunction(
         [&](double lambda) { return e[size_t(int(lambda - kLambdaMinNm))]; });
+}
+
+std::unique_ptr<Light> MakeLight(const LightConfig& lc) {
+    switch (lc.kind) {
+        case LightKind::kDirectional:
+            return std::make_unique<DirectionalLight>(lc.direction, ToSpectrum(lc.spectrum));
+        case LightKind::kPoint:
+            return std::make_unique<PointLight>(lc.position, ToSpectrum(lc.spectrum));
+        case LightKind::kSpot:
+            return std::make_unique<SpotLight>(
+                lc.position, lc.direction, std::cos(lc.cone_deg * kPi / 180.f),
+                std::cos(lc.falloff_start_deg * kPi / 180.f), ToSpectrum(lc.spectrum));
+        case LightKind::kSun:
+        case LightKind::kSky:
+        case LightKind::kTriangle:
+            break;  // the sun and the sky have tables of their own; triangles come from the model
+    }
+    NAVE_CHECK(false) << "[[lights]] has no light of kind " << int(lc.kind);
+    return nullptr;
 }
 
 namespace {
@@ -250,52 +255,26 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         NAVE_ASSIGN_OR_RETURN(SunState sun, ResolveSun(config.sun, file));
         if (!sun.above_horizon)
             log::Warning("{}: the sun is below the horizon at that date and place", file);
-        Light l;
-        l.kind = Light::Kind::kSun;
-        l.to_light = sun.to_sun;
-        l.sun_radius_rad = sun.angular_radius_rad;
-        l.spectrum = sun.radiance;
         scene.sun = int(scene.lights.size());
-        scene.lights.push_back(std::move(l));
+        scene.lights.push_back(
+            std::make_unique<SunLight>(sun.to_sun, sun.angular_radius_rad, sun.radiance));
         scene.sun_description = fmt::format("azimuth {:.2f} deg, elevation {:.2f} deg",
                                             sun.azimuth_deg, 90.0 - sun.zenith_deg);
     }
-    for (const LightConfig& lc : config.lights) {
-        Light l;
-        l.spectrum = ToSpectrum(lc.spectrum);
-        switch (lc.kind) {
-            case LightConfig::Kind::kDirectional:
-                l.kind = Light::Kind::kDirectional;
-                l.to_light = -lc.direction;
-                break;
-            case LightConfig::Kind::kPoint:
-                l.kind = Light::Kind::kPoint;
-                l.position = lc.position;
-                break;
-            case LightConfig::Kind::kSpot:
-                l.kind = Light::Kind::kSpot;
-                l.position = lc.position;
-                l.spot_axis = lc.direction;
-                l.cos_cone = std::cos(lc.cone_deg * kPi / 180.f);
-                l.cos_falloff = std::cos(lc.falloff_start_deg * kPi / 180.f);
-                break;
-        }
-        scene.lights.push_back(std::move(l));
-    }
+    for (const LightConfig& lc : config.lights) scene.lights.push_back(MakeLight(lc));
     if (config.sky.kind == SkyConfig::Kind::kUniform) {
-        scene.sky = true;
-        scene.sky_radiance = ToSpectrum(config.sky.radiance);
+        scene.sky = std::make_unique<SkyLight>(ToSpectrum(config.sky.radiance));
     } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {
-        scene.sky = true;
         double turbidity =
             std::clamp(config.sky.turbidity.value_or(config.sun.turbidity), 1.7, 10.0);
-        const Light& sun = scene.lights[size_t(scene.sun)];
-        scene.preetham = std::make_shared<PreethamSky>(sun.to_light, float(turbidity));
-        scene.sky_scale = config.sky.scale;
+        scene.sky = std::make_unique<SkyLight>(
+            std::make_shared<PreethamSky>(scene.sun_light().to_light(), float(turbidity)),
+            config.sky.scale);
         if (config.sky.ground_albedo) {
             // Lambertian: L = ρ E / π (the parser checked ρ is within [0, 1]).
-            scene.ground_radiance = ToSpectrum(*config.sky.ground_albedo) *
-                                    HorizontalIrradiance(scene) * float(1 / std::numbers::pi);
+            scene.sky->set_ground_radiance(ToSpectrum(*config.sky.ground_albedo) *
+                                           HorizontalIrradiance(scene) *
+                                           float(1 / std::numbers::pi));
         }
     }
     if (scene.output.white_balance == "scene") {

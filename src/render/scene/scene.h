@@ -16,6 +16,9 @@
 #include "src/core/vecmath.h"
 #include "src/render/bricks/brick_source.h"
 #include "src/render/scene/camera.h"
+#include "src/render/scene/lights/light.h"
+#include "src/render/scene/lights/sky_light.h"
+#include "src/render/scene/lights/sun_light.h"
 #include "src/render/scene/materials/bxdf.h"
 #include "src/render/scene/materials/frame.h"
 #include "src/render/scene/materials/materials.h"
@@ -98,58 +101,17 @@ struct SurfaceMaterial {
     float AlbedoForAov() const;
 };
 
-/// A light that next-event estimation samples.
-struct Light {
-    enum class Kind { kSun, kDirectional, kPoint, kSpot };
-    Kind kind = Kind::kSun;
-    Vec3f to_light{0, 0, 1};              ///< sun and directional: unit direction toward the light
-    Vec3f position;                       ///< point and spot
-    Vec3f spot_axis{0, 0, -1};            ///< spot: direction light travels
-    float cos_cone = 1, cos_falloff = 1;  ///< spot
-    double sun_radius_rad = 0;            ///< sun: the disc's angular radius
-    Spectrum spectrum;  ///< sun: radiance; directional: irradiance (normal incidence); point/spot:
-                        ///< intensity
-    /// Sun: the disc's solid angle (sr) and the pdf of SampleSun, in double where it matters (the
-    /// disc spans 1 - cos θ ≈ 1.1e-5).
-    double SunSolidAngle() const { return ConeSolidAngle(sun_radius_rad); }
-    float SunPdf() const { return float(1 / SunSolidAngle()); }
-    /// Sun: a direction uniform over the disc.
-    Vec3f SampleSun(Point2f u) const {
-        return Normalize(
-            Frame::FromZ(to_light).FromLocal(SampleUniformNarrowCone(u, sun_radius_rad)));
-    }
-    /// Sun: whether direction `w` (unit) is within the disc.
-    bool SeesSun(const Vec3f& w) const { return InNarrowCone(w, to_light, sun_radius_rad); }
-};
-
 struct RenderScene {
     BrickSource* source = nullptr;
     std::unique_ptr<Camera> camera;
     std::vector<SurfaceMaterial> materials;  ///< indexed by the store's material id
-    std::vector<Light> lights;
+    /// The lights next-event estimation samples, in this order: the sun, then the config's
+    /// [[lights]] (MakeLight). A light's index keys its random dimensions.
+    std::vector<std::unique_ptr<Light>> lights;
     int sun = -1;  ///< index of the sun in `lights`, or -1
-    bool sky = false;
-    Spectrum sky_radiance;  ///< uniform sky
-    std::shared_ptr<const PreethamSky>
-        preetham;  ///< physical sky (physics: render/scene/sun/sky.h), or null
-    float sky_scale = 1;
-    /// With a physical sky and [sky] ground_albedo: the radiance of the ground below the horizon
-    /// (albedo / π times HorizontalIrradiance); otherwise zero there.
-    Spectrum ground_radiance;
-    /// Radiance of the sky seen in direction `w` (world), at the path's wavelengths: below the
-    /// horizon of a physical sky, the ground's.
-    SampledSpectrum SkyRadiance(const Vec3f& w, const SampledWavelengths& lambda) const {
-        if (preetham) {
-            return w.z > 0 ? preetham->Radiance(w, lambda) * sky_scale
-                           : ground_radiance.Sample(lambda);
-        }
-        return sky_radiance.Sample(lambda);
-    }
-    /// The same as a full spectrum (for tools and the photon emitters' power).
-    Spectrum SkySpectrum(const Vec3f& w) const {
-        if (preetham) return w.z > 0 ? preetham->RadianceSpectrum(w) * sky_scale : ground_radiance;
-        return sky_radiance;
-    }
+    /// The sun; only when `sun` >= 0.
+    const SunLight& sun_light() const { return static_cast<const SunLight&>(*lights[size_t(sun)]); }
+    std::unique_ptr<SkyLight> sky;  ///< uniform or physical, or null
     RenderSettings settings;
     OutputConfig output;
     std::string sun_description;  ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary
@@ -169,6 +131,9 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
 
 /// The tabulated form of a config spectrum.
 Spectrum ToSpectrum(const SpectrumSpec& spec);
+
+/// The light of a [[lights]] table of the config: the factory of the lights the config lists.
+std::unique_ptr<Light> MakeLight(const LightConfig& config);
 
 /// The sun's position and spectrum for a place and time: the physics sun model (NREL SPA, clear-sky
 /// transmittance, render/scene/sun/sun.h), or the config's fixed direction and spectrum.

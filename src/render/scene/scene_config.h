@@ -16,6 +16,7 @@
 #include "src/core/color.h"
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
+#include "src/render/scene/lights/light.h"
 
 namespace nave::render {
 
@@ -81,7 +82,7 @@ struct SkyConfig {
 };
 
 struct LightConfig {
-    enum class Kind { kDirectional, kPoint, kSpot };
+    using Kind = LightKind;  ///< kDirectional, kPoint or kSpot
     Kind kind = Kind::kDirectional;
     Vec3f direction{0, 0, -1};  ///< directional and spot: the direction light travels
     Vec3f position{0, 0, 0};    ///< point and spot

@@ -87,58 +87,20 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
                                                    const VertexRng& rng,
                                                    const GuidedBsdf* continuation) const {
     Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
-    Vec3f wi;
-    SampledSpectrum Li;
-    float t_max = kInfinity;
-    float light_pdf = 0;  // solid angle; 0 for delta lights
-    switch (light.kind) {
-        case Light::Kind::kSun: {
-            // Uniform over the solar disc's cone (radiance constant over the disc: no limb
-            // darkening).
-            wi = light.SampleSun(u);
-            light_pdf = light.SunPdf();
-            Li = light.spectrum.Sample(r.lambda) / light_pdf;
-            break;
-        }
-        case Light::Kind::kDirectional:
-            // The paper's eq. 3: L_r = F_r(w_s, w_o) L_s (n . w_s), with L_s the irradiance at
-            // normal incidence.
-            wi = light.to_light;
-            Li = light.spectrum.Sample(r.lambda);
-            break;
-        case Light::Kind::kPoint:
-        case Light::Kind::kSpot: {
-            Vec3f d = light.position - h.p;
-            float dist2 = Dot(d, d);
-            if (dist2 == 0) return std::nullopt;
-            float dist = std::sqrt(dist2);
-            wi = d / dist;
-            float falloff = 1;
-            if (light.kind == Light::Kind::kSpot) {
-                // Smoothstep between the cone and the start of the falloff (pbrt-v4 SpotLight::I).
-                float cos_a = Dot(-wi, light.spot_axis);
-                float x = std::clamp(
-                    (cos_a - light.cos_cone) / std::max(1e-6f, light.cos_falloff - light.cos_cone),
-                    0.f, 1.f);
-                falloff = x * x * (3 - 2 * x);
-            }
-            Li = light.spectrum.Sample(r.lambda) * (falloff / dist2);
-            t_max = dist * (1 - 1e-4f);
-            break;
-        }
-    }
-    if (Li.IsZero()) return std::nullopt;
+    const std::optional<LightSample> ls = light.SampleLi(h.p, u, r.lambda);
+    if (!ls || ls->Li.IsZero()) return std::nullopt;
+    const Vec3f& wi = ls->wi;
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
     float w = 1;
-    if (light_pdf > 0 && continuation != nullptr)
-        w = PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda));
+    if (ls->pdf > 0 && continuation != nullptr)
+        w = PowerHeuristic(ls->pdf, continuation->Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
-    s.t_max = t_max;
-    s.beta = r.beta * f * Li * w;
+    s.t_max = ls->t_max;
+    s.beta = r.beta * f * ls->Li * w;
     return s;
 }
 
@@ -155,7 +117,7 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
         if (!(d > 0)) return std::nullopt;
         wi = (q - h.p) / d;
     } else {
-        wi = SampleUniformSphere(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+        wi = SkyLight::SampleUniform(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
     }
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
@@ -169,20 +131,20 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = kInfinity;
-    s.beta = r.beta * f * scene_.SkyRadiance(wi, r.lambda) * (w / light_pdf);
+    s.beta = r.beta * f * scene_.sky->Radiance(wi, r.lambda) * (w / light_pdf);
     if (s.beta.IsZero()) return std::nullopt;
     return s;
 }
 
 float LightSampler::SkyPdf(const Vec3f& p, const Vec3f& w) const {
-    if (portals_ == nullptr) return UniformSpherePdf();
+    if (portals_ == nullptr) return SkyLight::UniformPdf();
     double portal_pdf = 0;
     portals_->ForEachCrossing(p, w, kInfinity, [&](const BrickHit& hit) {
         const float cos_theta = std::abs(Dot(Normalize(hit.ng), w));
         if (cos_theta > 1e-6f)
             portal_pdf += double(hit.t) * hit.t / (double(cos_theta) * portals_->area());
     });
-    return float((1 - kPortalSkyShare) * UniformSpherePdf() + kPortalSkyShare * portal_pdf);
+    return float((1 - kPortalSkyShare) * SkyLight::UniformPdf() + kPortalSkyShare * portal_pdf);
 }
 
 }  // namespace nave::render

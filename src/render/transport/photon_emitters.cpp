@@ -14,32 +14,6 @@
 #include "src/render/transport/visible_points.h"
 
 namespace nave::render {
-namespace {
-
-/// A rough power of a spectrum for choosing emitters: its mean over 400-700 nm.
-float MeanVisible(const Spectrum& s) {
-    double sum = 0;
-    for (int l = 400; l <= 700; l += 10) sum += s.Evaluate(float(l));
-    return float(sum / 31);
-}
-
-/// The rough power of an emissive material for choosing emitters: MeanVisible of its spectrum, or
-/// for an emission texture the mean of its mean radiance over a few wavelength sets (any positive
-/// weight keeps the estimate unbiased; a good one only lowers noise).
-float EmissionPower(const SurfaceMaterial& m) {
-    if (!(m.textures && m.textures->emission)) return MeanVisible(m.emission);
-    double sum = 0;
-    for (int i = 0; i < 8; ++i) {
-        SampledWavelengths lambda = SampledWavelengths::SampleVisible((i + 0.5f) / 8);
-        SampledSpectrum s = m.textures->MeanEmission(lambda);
-        for (int k = 0; k < kNumWavelengths; ++k) sum += s[k];
-    }
-    // A black texture would give 0 and never be chosen; keep a floor so its triangles can still
-    // emit.
-    return std::max(float(sum / (8 * kNumWavelengths)), 1e-6f);
-}
-
-}  // namespace
 
 StatusOr<std::unique_ptr<PhotonEmitters>> PhotonEmitters::Build(const RenderScene& scene,
                                                                 StreamScheduler& scheduler) {
@@ -68,14 +42,15 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
             "render.photon_target = \"portals\" but no material has portal = true");
     }
     std::vector<double> weights;
-    std::vector<Emitter> triangles;
+    std::vector<TriangleLight> triangles;
     std::vector<double> triangle_weights;
     std::vector<std::array<Vec3f, 3>> portal_triangles;
     if (any_emissive || (want_portals && any_portal)) {
         // Per material, not per triangle: an emission texture's mean takes texture lookups.
         std::vector<float> power(scene_.materials.size(), 0.f);
         for (size_t i = 0; i < power.size(); ++i) {
-            if (scene_.materials[i].emissive) power[i] = EmissionPower(scene_.materials[i]);
+            if (scene_.materials[i].emissive)
+                power[i] = TriangleLight::MaterialPower(scene_.materials[i]);
         }
         NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
             scene_, scheduler,
@@ -85,56 +60,38 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
                 const std::array<Vec3f, 3> v = m.TrianglePositions(t);
                 if (want_portals && sm.portal) portal_triangles.push_back(v);
                 if (!sm.emissive) return;
-                Emitter e;
-                e.kind = Emitter::Kind::kTriangle;
-                e.v0 = v[0];
-                e.v1 = v[1];
-                e.v2 = v[2];
-                Vec3f c = Cross(v[1] - v[0], v[2] - v[0]);
-                e.area = 0.5f * Length(c);
-                if (e.area <= 0) return;
-                e.n = Normalize(c);
-                e.material = &sm;
+                std::array<std::array<float, 2>, 3> uv{};
                 if (m.HasUvs()) {
-                    for (int k = 0; k < 3; ++k) e.uv[k] = m.uvs[m.indices[3 * t + k]];
-                    e.has_uv = true;
+                    for (int k = 0; k < 3; ++k) uv[k] = m.uvs[m.indices[3 * t + k]];
                 }
-                triangles.push_back(e);
-                // Two-sided Lambertian emitter: power = L pi A per side.
-                triangle_weights.push_back(power[m.material_ids[t]] * 2 * kPi * e.area);
+                std::optional<TriangleLight> light = TriangleLight::Make(
+                    v, sm, m.HasUvs() ? &uv : nullptr, power[m.material_ids[t]]);
+                if (!light) return;
+                triangles.push_back(std::move(*light));
+                triangle_weights.push_back(triangles.back().Power(PhotonTarget()));
             }));
     }
-    for (const Light& l : scene_.lights) {
+    for (const std::unique_ptr<Light>& l : scene_.lights) {
         Emitter e;
-        e.light = &l;
-        float w = MeanVisible(l.spectrum);
+        e.light = l.get();
+        e.distant = l->distant();
         float target_area = disk_area;
-        if (want_portals && (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional)) {
-            PortalProjection projection(portal_triangles, l.to_light);
+        if (want_portals && e.distant != nullptr) {
+            PortalProjection projection(portal_triangles, e.distant->to_light());
             if (!projection.empty()) {
                 e.portal = int(portals_.size());
                 target_area = float(projection.total_area());
                 portals_.push_back(std::move(projection));
             }
         }
-        switch (l.kind) {
-            case Light::Kind::kSun:
-                w *= l.SunSolidAngle() * target_area;
-                break;
-            case Light::Kind::kDirectional:
-                w *= target_area;
-                break;
-            case Light::Kind::kPoint:
-            case Light::Kind::kSpot:
-                w *= 4 * kPi;
-                break;
-        }
-        if (l.kind == Light::Kind::kSun || l.kind == Light::Kind::kDirectional) {
+        if (e.distant != nullptr) {
             e.guide = int(guides_.size());
             guides_.emplace_back(kGuideCells, scene_radius_);
         }
         emitters_.push_back(e);
-        weights.push_back(w);
+        PhotonTarget target;
+        target.area = target_area;
+        weights.push_back(l->Power(target));
     }
     if (!guides_.empty()) {
         photon_cells_.assign(
@@ -146,29 +103,22 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
     }
     if (scene_.sky) {
         Emitter e;
-        e.kind = Emitter::Kind::kSky;
+        e.light = scene_.sky.get();
+        e.flags = kFromSky;
         emitters_.push_back(e);
-        // Mean radiance over the sphere of directions (a fixed 256-direction Fibonacci set for a
-        // sky model).
-        double mean = 0;
-        if (scene_.preetham) {
-            const int n = 256;
-            for (int i = 0; i < n; ++i) {
-                float z = 1 - 2 * (float(i) + 0.5f) / float(n), phi = 2.39996323f * float(i);
-                float rxy = std::sqrt(std::max(0.f, 1 - z * z));
-                mean += MeanVisible(
-                    scene_.SkySpectrum(Vec3f(rxy * std::cos(phi), rxy * std::sin(phi), z)));
-            }
-            mean = mean / n;  // with the ground below the horizon
-        } else {
-            mean = MeanVisible(scene_.sky_radiance);
-        }
         // Through portals: lines cross them with measure 2 pi A_portals (both sides), through the
         // bounds 4 pi A_disc.
-        weights.push_back(mean *
-                          (sky_portals_ ? 2 * kPi * sky_portals_->area() : 4 * kPi * disk_area));
+        PhotonTarget target;
+        target.line_measure = sky_portals_ ? 2 * kPi * sky_portals_->area() : 4 * kPi * disk_area;
+        weights.push_back(scene_.sky->Power(target));
     }
-    emitters_.insert(emitters_.end(), triangles.begin(), triangles.end());
+    triangle_lights_ = std::move(triangles);
+    for (const TriangleLight& t : triangle_lights_) {
+        Emitter e;
+        e.light = &t;
+        e.flags = kFromAreaLight;
+        emitters_.push_back(e);
+    }
     weights.insert(weights.end(), triangle_weights.begin(), triangle_weights.end());
     double total = 0;
     for (double w : weights) total += w;
@@ -185,9 +135,9 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
 
 float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, const VertexRng& rng,
                                          RayRecord* r) {
-    const Light& l = *e.light;
-    const Frame frame = Frame::FromZ(l.to_light);
-    const Vec3f plane_centre = scene_center_ + l.to_light * (2 * scene_radius_);
+    const Vec3f& to_light = e.distant->to_light();
+    const Frame frame = Frame::FromZ(to_light);
+    const Vec3f plane_centre = scene_center_ + to_light * (2 * scene_radius_);
     const float disk_area = kPi * scene_radius_ * scene_radius_;
     const PortalProjection* portals = e.portal >= 0 ? &portals_[size_t(e.portal)] : nullptr;
     PhotonGuide& guide = guides_[size_t(e.guide)];
@@ -208,7 +158,7 @@ float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, cons
     }
     // Where the photon's line (through on_line along -to) crosses the plane facing the light: the
     // coordinates every strategy's density is measured in.
-    const float t = Dot(plane_centre - on_line, l.to_light) / Dot(to, l.to_light);
+    const float t = Dot(plane_centre - on_line, to_light) / Dot(to, to_light);
     r->origin = on_line + to * t;
     const float x = Dot(r->origin - scene_center_, frame.x),
                 y = Dot(r->origin - scene_center_, frame.y);
@@ -298,39 +248,12 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 return scene_center_ + toward * (2 * scene_radius_) + f.x * (d.x * scene_radius_) +
                        f.y * (d.y * scene_radius_);
             };
-            if (e.kind == Emitter::Kind::kLight) {
-                const Light& l = *e.light;
-                switch (l.kind) {
-                    case Light::Kind::kSun:
-                    case Light::Kind::kDirectional: {
-                        const bool sun = l.kind == Light::Kind::kSun;
-                        Vec3f to = sun ? l.SampleSun(u2) : l.to_light;
-                        const float area = StartDistantPhoton(e, to, rng, &r);
-                        r.dir = -to;
-                        // Sun: L cos / (p_area p_dir) with p_dir = 1/Omega; directional: E /
-                        // p_area.
-                        r.beta = sun ? l.spectrum.Sample(lambda) *
-                                           (Dot(to, l.to_light) * area * float(l.SunSolidAngle()))
-                                     : l.spectrum.Sample(lambda) * area;
-                        break;
-                    }
-                    case Light::Kind::kPoint:
-                    case Light::Kind::kSpot: {
-                        r.origin = l.position;
-                        r.dir = SampleUniformSphere(u2);
-                        float falloff = 1;
-                        if (l.kind == Light::Kind::kSpot) {
-                            float cos_a = Dot(r.dir, l.spot_axis);
-                            float x = std::clamp(
-                                (cos_a - l.cos_cone) / std::max(1e-6f, l.cos_falloff - l.cos_cone),
-                                0.f, 1.f);
-                            falloff = x * x * (3 - 2 * x);
-                        }
-                        r.beta = l.spectrum.Sample(lambda) * (falloff * 4 * kPi);
-                        break;
-                    }
-                }
-            } else if (e.kind == Emitter::Kind::kSky) {
+            if (e.distant != nullptr) {
+                const Vec3f to = e.distant->SamplePhotonDirection(u2);
+                const float area = StartDistantPhoton(e, to, rng, &r);
+                r.dir = -to;
+                r.beta = e.distant->PhotonPower(to, area, lambda);
+            } else if (e.light == scene_.sky.get()) {
                 Vec3f d;
                 if (sky_portals_ && rng.Uniform(8) < kSkyPortalPhotonShare) {
                     // A point uniform on the portals' area, a cosine-weighted direction on a random
@@ -344,7 +267,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                     r.origin = p - d * (2 * scene_radius_);
                 } else {
                     // A uniform direction, a point uniform on the disc facing it.
-                    const Vec3f to = SampleUniformSphere(u2);
+                    const Vec3f to = SkyLight::SampleUniform(u2);
                     r.origin = disc_origin(to);
                     d = -to;
                 }
@@ -361,23 +284,15 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                                   float(2 * kPi * sky_portals_->area()) +
                               (1 - kSkyPortalPhotonShare) * density;
                 }
-                r.beta = scene_.SkyRadiance(-d, lambda) / density;
-                r.flags = kFromSky;
+                r.beta = scene_.sky->Radiance(-d, lambda) / density;
             } else {
-                // Uniform point on the triangle (Turk 1990 square-root parameterisation),
-                // cosine-weighted direction on a side chosen with probability 1/2.
-                const std::array<float, 3> w = SampleUniformTriangle(u1);
-                Vec3f p = e.v0 * w[0] + e.v1 * w[1] + e.v2 * w[2];
-                Vec3f n = rng.Uniform(5) < 0.5f ? e.n : -e.n;
-                r.dir = Frame::FromZ(n).FromLocal(SampleCosineHemisphere(u2));
-                r.origin = OffsetOrigin(p, n, r.dir);
-                // L cos / (1/A * cos/pi * 1/2).
-                std::array<float, 2> uv;
-                for (int k = 0; k < 2; ++k)
-                    uv[k] = e.uv[0][k] * w[0] + e.uv[1][k] * w[1] + e.uv[2][k] * w[2];
-                r.beta = e.material->Emitted(e.has_uv ? &uv : nullptr, lambda) * (2 * kPi * e.area);
-                r.flags = kFromAreaLight;
+                // A photon of a light at a place: point, spot, emissive triangle.
+                const PhotonSample s = e.light->SamplePhoton({u1, u2, rng.Uniform(5)}, lambda);
+                r.origin = s.origin;
+                r.dir = s.dir;
+                r.beta = s.power;
             }
+            r.flags = e.flags;
             r.beta /= p_choice;
             if (r.beta.IsZero()) continue;
 

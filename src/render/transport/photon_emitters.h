@@ -15,6 +15,7 @@
 #include "src/core/spectrum.h"
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
+#include "src/render/scene/lights/triangle_light.h"
 #include "src/render/scene/scene.h"
 #include "src/render/transport/light_sampling.h"
 #include "src/render/transport/photon_guide.h"
@@ -64,16 +65,11 @@ class PhotonEmitters {
 
   private:
     struct Emitter {
-        enum class Kind { kLight, kSky, kTriangle };
-        Kind kind = Kind::kLight;
-        const Light* light = nullptr;
-        Vec3f v0, v1, v2, n;  // kTriangle
-        float area = 0;
-        const SurfaceMaterial* material = nullptr;  // kTriangle: what it emits
-        std::array<std::array<float, 2>, 3> uv{};   // kTriangle: texture coordinates of v0, v1, v2
-        bool has_uv = false;
-        int portal = -1;  // kLight (sun, directional): index in portals_ when aiming at windows
-        int guide = -1;   // kLight (sun, directional): index in guides_
+        const Light* light = nullptr;           // the scene's light or sky, or a triangle's
+        const DistantLight* distant = nullptr;  // light->distant(): photons start facing it
+        uint8_t flags = 0;                      // RayFlags of its photons
+        int portal = -1;                        // distant: index in portals_ when aiming at windows
+        int guide = -1;                         // distant: index in guides_
     };
     explicit PhotonEmitters(const RenderScene& scene) : scene_(scene) {}
 
@@ -104,6 +100,7 @@ class PhotonEmitters {
     Status Gather(StreamScheduler& scheduler);
 
     const RenderScene& scene_;
+    std::vector<TriangleLight> triangle_lights_;  // the emissive triangles
     std::vector<Emitter> emitters_;
     std::vector<double> emitter_cdf_;  // normalised, emitters_.size() + 1 entries
     std::vector<PortalProjection> portals_;
