@@ -64,7 +64,8 @@ TEST(PathGuide, SamplesFollowThePdfThatIntegratesToOne) {
     // So the pdf over the sphere, constant in each bin, integrates to one.
     double integral = 0;
     for (int b = 0; b < PathGuide::kBins; ++b) {
-        const float z = -1 + 2 * (float(b / PathGuide::kPhiBins) + 0.5f) / PathGuide::kZBins;
+        const int z_bin = b / PathGuide::kPhiBins;
+        const float z = -1 + 2 * (float(z_bin) + 0.5f) / PathGuide::kZBins;
         const float phi = 2 * kPi * (float(b % PathGuide::kPhiBins) + 0.5f) / PathGuide::kPhiBins;
         const Vec3f w(std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi),
                       z);
@@ -112,6 +113,7 @@ TEST(PathGuide, SidesAreTheNormalsLargestAxisAndItsSign) {
 TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
     std::mt19937 rng(3);
     std::vector<std::pair<Vec3f, double>> credits;
+    credits.reserve(5000);
     for (int i = 0; i < 5000; ++i)
         credits.push_back(
             {UniformDirection(rng), std::exp(std::uniform_real_distribution<double>(-8, 3)(rng))});

@@ -16,6 +16,7 @@ struct Record {
 
 std::vector<uint64_t> Ids(const std::vector<Record>& v) {
     std::vector<uint64_t> ids;
+    ids.reserve(v.size());
     for (const Record& r : v) ids.push_back(r.id);
     return ids;
 }

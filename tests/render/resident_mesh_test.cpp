@@ -12,7 +12,8 @@ namespace {
 store::BrickMesh Strip(size_t triangles, bool normals, bool uvs) {
     store::BrickMesh m;
     for (size_t v = 0; v < triangles + 2; ++v) {
-        m.positions.push_back(Vec3f(float(v / 2), float(v % 2), 0.25f * float(v)));
+        const size_t column = v / 2;
+        m.positions.push_back(Vec3f(float(column), float(v % 2), 0.25f * float(v)));
         if (normals) m.normals.push_back(Vec3f(0, 0, 1));
         if (uvs) m.uvs.push_back({float(v) * 0.5f, float(v % 2)});
     }

@@ -104,8 +104,9 @@ TEST_F(TextureTest, CacheStaysWithinItsCapOnMoreDataThanTheCap) {
             for (int x = 0; x < kSize; ++x) {
                 float* p = &pixels[(size_t(y) * kSize + x) * 4];
                 p[0] = float(k);
-                p[1] = float(x / kTile);
-                p[2] = float(y / kTile);
+                const int tile_x = x / kTile, tile_y = y / kTile;
+                p[1] = float(tile_x);
+                p[2] = float(tile_y);
                 p[3] = 1.f;
             }
         paths.push_back(dir_ / ("big" + std::to_string(k) + ".tif"));
@@ -121,8 +122,9 @@ TEST_F(TextureTest, CacheStaysWithinItsCapOnMoreDataThanTheCap) {
         for (int ty = 0; ty < kSize / kTile; ++ty)
             for (int tx = 0; tx < kSize / kTile; ++tx) {
                 float v[4];
-                float s = (tx * kTile + kTile / 2 + 0.5f) / kSize;
-                float t = (ty * kTile + kTile / 2 + 0.5f) / kSize;
+                const int centre_x = tx * kTile + kTile / 2, centre_y = ty * kTile + kTile / 2;
+                float s = (float(centre_x) + 0.5f) / kSize;
+                float t = (float(centre_y) + 0.5f) / kSize;
                 ASSERT_TRUE((*cache)->Lookup(*tex, s, t, {}, 0, 4, v).ok());
                 ASSERT_EQ(v[0], float(k));
                 ASSERT_EQ(v[1], float(tx));

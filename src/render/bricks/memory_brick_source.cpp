@@ -12,7 +12,8 @@ Bounds3f MeshesBounds(const std::vector<store::BrickMesh>& meshes) {
 }
 }  // namespace
 
-MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device,
+                                     const store::BrickTree& tree,
                                      std::vector<store::BrickMesh> meshes,
                                      std::vector<store::MaterialRecord> materials)
     : BrickSource(std::move(device), tree, tree.BrickCells(uint32_t(meshes.size())),

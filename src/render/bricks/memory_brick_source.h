@@ -15,7 +15,7 @@ namespace nave::render {
 /// Bricks held in memory from the start (tests, benchmarks). "Loading" copies the mesh.
 class MemoryBrickSource final : public BrickSource {
   public:
-    MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
+    MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, const store::BrickTree& tree,
                       std::vector<store::BrickMesh> meshes,
                       std::vector<store::MaterialRecord> materials);
     uint64_t EstimatedResidentBytes(uint32_t id) const override;

@@ -45,8 +45,10 @@ void CameraPaths::GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sa
             r.pixel = uint32_t(p);
             r.sample = sample;
             VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamCamera));
-            float x = float(p % uint64_t(camera.width())) + rng.Uniform(kDimPixelX);
-            float y = float(p / uint64_t(camera.width())) + rng.Uniform(kDimPixelY);
+            const uint64_t column = p % uint64_t(camera.width()),
+                           row = p / uint64_t(camera.width());
+            float x = float(column) + rng.Uniform(kDimPixelX);
+            float y = float(row) + rng.Uniform(kDimPixelY);
             camera.GenerateRay(x, y, rng.Uniform(kDimLens0), rng.Uniform(kDimLens1), &r.origin,
                                &r.dir);
             r.lambda = SampledWavelengths::SampleVisible(rng.Uniform(kDimLambda));

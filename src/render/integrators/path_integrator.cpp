@@ -70,7 +70,8 @@ void PathIntegrator::Save(Checkpoint* checkpoint) const {
     checkpoint->sections["path_guide"] = out.Take();
 }
 
-StatusOr<int> PathIntegrator::RenderRounds(int s, bool boundaries) {
+StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
+    const int s = passes;
     const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
     const int spp = scene_.settings.spp;
     const uint64_t wave = scene_.settings.wave_paths;

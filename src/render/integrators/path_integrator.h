@@ -26,10 +26,11 @@ class PathIntegrator final : public Integrator, public CameraPaths {
     ProgressUnits progress_units() const override;
     void set_progress(ProgressBar* progress) override { set_path_progress(progress); }
     Status Restore(const RenderSession& session) override;
-    StatusOr<int> RenderRounds(int done, bool boundaries) override;
-    double NoiseEstimate(int done) const override;
+    /// The passes after the first `passes`: one, or with small images several in one wave.
+    StatusOr<int> RenderRounds(int passes, bool boundaries) override;
+    double NoiseEstimate(int passes) const override;
     void Save(Checkpoint* checkpoint) const override;
-    Status Finish(int done, RenderStats* stats) override;
+    Status Finish(int passes, RenderStats* stats) override;
 
   private:
     PathIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,

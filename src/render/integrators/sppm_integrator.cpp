@@ -121,7 +121,9 @@ double SppmIntegrator::NoiseEstimate(int iterations) const {
     // Each half: the film's direct light and specular chains of its iterations (even or odd) plus
     // the photon estimate of the same iterations. Pixel by pixel: no image is held.
     const double photons = double(scene_.settings.photons_per_iteration);
-    const double emitted[2] = {photons * ((iterations + 1) / 2), photons * (iterations / 2)};
+    const int even = (iterations + 1) / 2,
+              odd = iterations / 2;  // iterations 0, 2, 4... and 1, 3...
+    const double emitted[2] = {photons * even, photons * odd};
     return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
         std::array<double, 2> half;
         for (int h = 0; h < 2; ++h) {

@@ -37,8 +37,8 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     /// From the two halves of the film's samples and of the photons (visible_points.h).
     double NoiseEstimate(int iterations) const override;
     void Save(Checkpoint* checkpoint) const override;
-    /// Adds the photon estimate of `iterations` iterations to the film.
-    Status Finish(int iterations, RenderStats* stats) override;
+    /// Adds the photon estimate of the `done` iterations to the film.
+    Status Finish(int done, RenderStats* stats) override;
 
     void ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                       std::span<const RayRecord> rays, RayOutbox& out) override;

@@ -30,8 +30,8 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     size_t pos = 0;
     while (pos <= text.size() && !text.empty()) {
         size_t comma = text.find(',', pos);
-        std::string_view item =
-            text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos);
+        std::string_view item = text.substr(
+            pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
         pos = comma == std::string_view::npos ? text.size() + 1 : comma + 1;
         if (item.empty()) continue;
         size_t eq = item.find('=');

@@ -43,16 +43,16 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
     return scheduler;
 }
 
-Status StreamScheduler::StartPaging(const PagerOptions& options) {
-    NAVE_RETURN_IF_ERROR(source_.SetBvhSettings(options.bvh));
-    source_.SetTrace(options.trace);
+Status StreamScheduler::StartPaging(const PagerOptions& paging) {
+    NAVE_RETURN_IF_ERROR(source_.SetBvhSettings(paging.bvh));
+    source_.SetTrace(paging.trace);
     // Under a budget one decode runs at a time: its scratch memory is reserved once (the memory
     // plan counts LoadScratchBytes), and with the brick cache only first loads decode.
-    if (!options.in_core()) source_.SetDecodeLimit(1);
-    if (!options.in_core() && options.brick_cache) {
+    if (!paging.in_core()) source_.SetDecodeLimit(1);
+    if (!paging.in_core() && paging.brick_cache) {
         NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::SpillFile> file,
-                              store::SpillFile::Create(options.spill_dir, "the brick cache"));
-        uint64_t limit = options.brick_cache_limit_bytes;
+                              store::SpillFile::Create(paging.spill_dir, "the brick cache"));
+        uint64_t limit = paging.brick_cache_limit_bytes;
         if (limit == 0) {
             std::error_code ec;
             const std::filesystem::space_info space = std::filesystem::space(file->dir(), ec);
@@ -61,17 +61,17 @@ Status StreamScheduler::StartPaging(const PagerOptions& options) {
         brick_cache_ = std::make_unique<BrickCache>(std::move(file), source_.brick_count(), limit);
         source_.SetBrickCache(brick_cache_.get());
     }
-    const uint64_t queue_memory = QueueMemoryBytes(options);
-    if (!options.in_core() && queue_memory > 0) {
+    const uint64_t queue_memory = QueueMemoryBytes(paging);
+    if (!paging.in_core() && queue_memory > 0) {
         NAVE_ASSIGN_OR_RETURN(queue_spill_,
-                              store::SpillFile::Create(options.spill_dir, "the ray queues"));
+                              store::SpillFile::Create(paging.spill_dir, "the ray queues"));
         queue_memory_ = queue_memory;
         max_batch_ = MaxBatchRays(queue_memory_);
     }
-    trace_ = options.trace;
+    trace_ = paging.trace;
     if (trace_ != nullptr) trace_->NameThread("scheduler");
     NAVE_ASSIGN_OR_RETURN(
-        pager_, Pager::Create(source_, options, [this](uint32_t b) { return queues_.Waiting(b); }));
+        pager_, Pager::Create(source_, paging, [this](uint32_t b) { return queues_.Waiting(b); }));
     return Status::Ok();
 }
 

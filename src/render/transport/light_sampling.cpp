@@ -26,8 +26,8 @@ StatusOr<std::unique_ptr<SkyPortals>> SkyPortals::Build(
     }
     for (double& c : portals->area_cdf_) c /= portals->area_;
     portals->triangles_ = std::move(triangles);
-    NAVE_ASSIGN_OR_RETURN(portals->scene_, ResidentBrick::Build(source.device(), 0, source.bounds(),
-                                                                std::move(mesh)));
+    NAVE_ASSIGN_OR_RETURN(portals->scene_,
+                          ResidentBrick::Build(source.device(), 0, source.bounds(), mesh));
     return portals;
 }
 
@@ -88,7 +88,7 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
                                                    const GuidedBsdf* continuation) const {
     Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
     const std::optional<LightSample> ls = light.SampleLi(h.p, u, r.lambda);
-    if (!ls || ls->Li.IsZero()) return std::nullopt;
+    if (!ls || ls->weight.IsZero()) return std::nullopt;
     const Vec3f& wi = ls->wi;
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
@@ -100,7 +100,7 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = ls->t_max;
-    s.beta = r.beta * f * ls->Li * w;
+    s.beta = r.beta * f * ls->weight * w;
     return s;
 }
 

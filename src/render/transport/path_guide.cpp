@@ -249,7 +249,8 @@ std::optional<GuideSample> PathGuide::Sample(const Vec3f& p, int side, float u_b
     const int bin = int(std::upper_bound(cdf, cdf + kBins - 1, u_bin) - cdf);
     // Uniform within the bin: cos θ and φ are uniform in it (equal-area cylindrical mapping,
     // Archimedes' hat-box theorem).
-    const float z = std::clamp(-1.f + 2.f * (float(bin / kPhiBins) + u0) / kZBins, -1.f, 1.f);
+    const int z_bin = bin / kPhiBins;
+    const float z = std::clamp(-1.f + 2.f * (float(z_bin) + u0) / kZBins, -1.f, 1.f);
     const float phi = 2 * kPi * (float(bin % kPhiBins) + u1) / kPhiBins;
     const float r = std::sqrt(std::max(0.f, 1 - z * z));
     const Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);

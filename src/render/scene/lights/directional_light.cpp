@@ -8,7 +8,7 @@ std::optional<LightSample> DirectionalLight::SampleLi(const Vec3f&, Point2f,
     // incidence.
     LightSample s;
     s.wi = to_light();
-    s.Li = irradiance_.Sample(lambda);
+    s.weight = irradiance_.Sample(lambda);
     return s;
 }
 

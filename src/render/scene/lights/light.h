@@ -42,7 +42,7 @@ struct LightSample {
     /// The light's factor of the estimate, to multiply by f |cos θ|: radiance / pdf for a light
     /// sampled in solid angle; irradiance at normal incidence (directional) or intensity / d²
     /// (point, spot) for a delta light.
-    SampledSpectrum Li;
+    SampledSpectrum weight;
     float pdf = 0;  ///< solid angle (sr^-1); 0 for a delta light
     /// Length of the shadow ray: short of a light at a place.
     float t_max = std::numeric_limits<float>::infinity();

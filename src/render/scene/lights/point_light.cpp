@@ -14,7 +14,7 @@ std::optional<LightSample> PointLight::SampleLi(const Vec3f& p, Point2f,
     s.wi = d / dist;
     const float falloff = Falloff(-s.wi);
     // Intensity over the squared distance.
-    s.Li = intensity_.Sample(lambda) * (falloff / dist2);
+    s.weight = intensity_.Sample(lambda) * (falloff / dist2);
     s.t_max = dist * (1 - 1e-4f);
     return s;
 }

@@ -8,7 +8,7 @@ std::optional<LightSample> SunLight::SampleLi(const Vec3f&, Point2f u,
     LightSample s;
     s.wi = Sample(u);
     s.pdf = Pdf();
-    s.Li = radiance_.Sample(lambda) / s.pdf;
+    s.weight = radiance_.Sample(lambda) / s.pdf;
     return s;
 }
 

@@ -121,8 +121,9 @@ std::string FormatIso8601(const CivilTime& t) {
                        t.hour, t.minute, t.second, zone);
 }
 
-double EstimateDeltaT(double y) {
-    // Espenak & Meeus (2006) §2.6, one polynomial per period.
+double EstimateDeltaT(double decimal_year) {
+    // Espenak & Meeus (2006) §2.6, one polynomial per period, in their y.
+    const double y = decimal_year;
     auto long_term = [](double year) {
         double u = (year - 1820.0) / 100.0;
         return -20.0 + 32.0 * u * u;
