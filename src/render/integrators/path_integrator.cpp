@@ -94,12 +94,13 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     const int next_update = owned_guide_ ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
     const bool update = owned_guide_ && s_end >= next_update;
     if (update) s_end = next_update;
-    for (uint64_t first = 0; first < pixels; first += wave) {
-        const uint64_t last = std::min(pixels, first + wave);
-        for (int k = s; k < s_end; ++k)
-            NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k)));
-        NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this, scheduler_.WaveOverlap()));
-    }
+    NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
+        *this, pixels, wave, StreamScheduler::LastWave::kTailInFlight,
+        [&](uint64_t first, uint64_t last) {
+            for (int k = s; k < s_end; ++k)
+                NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k)));
+            return Status::Ok();
+        }));
     if (update || boundaries) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
     if (update) {
         owned_guide_->Update();

@@ -77,19 +77,19 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
     // Visible points must all be in place before photons arrive: waves overlap within each pass
     // only. So the queues hold camera paths and their shadow rays, then photons, never both,
     // and each pass is drained by its own processor.
-    for (uint64_t first = 0; first < pixels; first += wave) {
-        NAVE_RETURN_IF_ERROR(
-            camera_pass_.GenerateCameraRays(first, std::min(pixels, first + wave), 0));
-        NAVE_RETURN_IF_ERROR(
-            scheduler_.Drain(camera_pass_, first + wave < pixels ? scheduler_.WaveOverlap() : 0));
-    }
+    NAVE_RETURN_IF_ERROR(
+        scheduler_.DrainInWaves(camera_pass_, pixels, wave, StreamScheduler::LastWave::kDrained,
+                                [&](uint64_t first, uint64_t last) {
+                                    return camera_pass_.GenerateCameraRays(first, last, 0);
+                                }));
     visible_->BuildBrickGrids(scheduler_.tree());
     deposited_.assign(emitters_->learned_photons(), 0.f);
-    for (uint64_t first = 0; first < photons; first += wave) {
-        emitters_->EmitPhotons(first, std::min(photons, first + wave), iteration_, scheduler_);
-        NAVE_RETURN_IF_ERROR(
-            scheduler_.Drain(*this, first + wave < photons ? scheduler_.WaveOverlap() : 0));
-    }
+    NAVE_RETURN_IF_ERROR(
+        scheduler_.DrainInWaves(*this, photons, wave, StreamScheduler::LastWave::kDrained,
+                                [&](uint64_t first, uint64_t last) {
+                                    emitters_->EmitPhotons(first, last, iteration_, scheduler_);
+                                    return Status::Ok();
+                                }));
     emitters_->Learn(deposited_);
     visible_->EndIteration(Film::SampleHalf(iteration_));
     if (progress_ != nullptr) progress_->Add(1);

@@ -150,6 +150,17 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
     return Status::Ok();
 }
 
+Status StreamScheduler::DrainInWaves(
+    RayProcessor& processor, uint64_t count, uint64_t wave_paths, LastWave last,
+    const std::function<Status(uint64_t first, uint64_t last)>& generate) {
+    for (uint64_t first = 0; first < count; first += wave_paths) {
+        NAVE_RETURN_IF_ERROR(generate(first, std::min(count, first + wave_paths)));
+        const bool drained = last == LastWave::kDrained && first + wave_paths >= count;
+        NAVE_RETURN_IF_ERROR(Drain(processor, drained ? 0 : WaveOverlap()));
+    }
+    return Status::Ok();
+}
+
 Status StreamScheduler::SpillIfOverCap() {
     if (!queue_spill_ || queues_.MemoryBytes() <= queue_memory_) return Status::Ok();
     std::vector<size_t> waiting(queues_.brick_count());

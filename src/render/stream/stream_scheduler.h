@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <utility>
@@ -97,6 +98,15 @@ class StreamScheduler {
     /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty), tracing
     /// every batch with `processor`. Errors: a brick that cannot be pinned.
     Status Drain(RayProcessor& processor, size_t stop_below = 0);
+    /// How the last wave of DrainInWaves ends: with its tail still in flight (the next pass's first
+    /// wave joins it), or drained to the last ray.
+    enum class LastWave { kTailInFlight, kDrained };
+    /// `count` paths (or photons) in waves of `wave_paths`: `generate(first, last)` queues the rays
+    /// of paths [first, last), and each wave is drained by `processor` until WaveOverlap rays
+    /// wait, so that the next wave joins its tail; the last wave as `last` says. Errors: those of
+    /// `generate` and Drain.
+    Status DrainInWaves(RayProcessor& processor, uint64_t count, uint64_t wave_paths, LastWave last,
+                        const std::function<Status(uint64_t first, uint64_t last)>& generate);
     /// Spills queues to disk if they hold more than the queue memory cap (a no-op in-core).
     /// For the integrators between chunks of a wave's new rays, so that a wave larger than the cap
     /// is spilled as it is generated rather than queued whole first. Not concurrent with Drain or
