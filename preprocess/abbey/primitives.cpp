@@ -30,37 +30,38 @@ void Box(Emitter& em, const Vec3d& lo, const Vec3d& hi, uint32_t m) {
     OrientedBox(em, c, Vec3d(h.x, 0, 0), Vec3d(0, h.y, 0), Vec3d(0, 0, h.z), m);
 }
 
-void OrientedBox(Emitter& em, const Vec3d& o, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-                 uint32_t m) {
+void OrientedBox(Emitter& em, const Vec3d& center, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                 uint32_t material) {
     const Vec3d* axes[3] = {&a, &b, &c};
     for (int k = 0; k < 3; ++k) {
         const Vec3d& n = *axes[k];
         const Vec3d& p = *axes[(k + 1) % 3];
         const Vec3d& q = *axes[(k + 2) % 3];
         for (double s : {-1.0, 1.0}) {
-            Vec3d f = o + n * s;
-            em.Quad(f - p - q, f + p - q, f + p + q, f - p + q, n * s, m);
+            Vec3d f = center + n * s;
+            em.Quad(f - p - q, f + p - q, f + p + q, f - p + q, n * s, material);
         }
     }
 }
 
-void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& s, uint64_t seed,
-           uint32_t m_) {
-    double j = s.joint, c = std::min({s.chamfer, lu * 0.25, lv * 0.25});
+void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& style,
+           uint64_t seed, uint32_t material) {
+    double j = style.joint, c = std::min({style.chamfer, lu * 0.25, lv * 0.25});
     double u0 = j, u1 = lu - j, v0 = j, v1 = lv - j;
     if (u1 - u0 <= 2 * c || v1 - v0 <= 2 * c) return;
-    int n = std::max(1, s.subdivisions);
+    int n = std::max(1, style.subdivisions);
     // Front face grid, tooled inside (the border stays flat so the chamfers meet it exactly).
     auto front = [&](int i, int k) {
         double x = u0 + c + (u1 - u0 - 2 * c) * i / n;
         double y = v0 + c + (v1 - v0 - 2 * c) * k / n;
-        double z = s.relief;
-        if (i > 0 && i < n && k > 0 && k < n) z += s.tooling * (2 * Hash01(seed, i, k) - 1);
+        double z = style.relief;
+        if (i > 0 && i < n && k > 0 && k < n) z += style.tooling * (2 * Hash01(seed, i, k) - 1);
         return f.At(x, y, z);
     };
     for (int k = 0; k < n; ++k) {
         for (int i = 0; i < n; ++i) {
-            em.Quad(front(i, k), front(i + 1, k), front(i + 1, k + 1), front(i, k + 1), f.w, m_);
+            em.Quad(front(i, k), front(i + 1, k), front(i + 1, k + 1), front(i, k + 1), f.w,
+                    material);
         }
     }
     // Rounded arrises: from the wall face at the stone's edge up to the face border, n segments
@@ -70,8 +71,8 @@ void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& 
     // Point on the arris of side (du, dv) at position `along` in [0, 1] and `across` in [0, 1].
     auto arris = [&](int side, double along, double across) {
         double inset = c * (1 - std::cos(across * kHalfPi)),
-               z = s.relief * std::sin(across * kHalfPi);
-        if (m == 1) inset = c * across, z = s.relief * across;
+               z = style.relief * std::sin(across * kHalfPi);
+        if (m == 1) inset = c * across, z = style.relief * across;
         double x0 = u0 + inset, x1 = u1 - inset, y0 = v0 + inset, y1 = v1 - inset;
         switch (side) {
             case 0:
@@ -93,7 +94,7 @@ void Stone(Emitter& em, const Frame& f, double lu, double lv, const StoneStyle& 
                 // The last row meets the tooled face's border vertices exactly (same formula at
                 // across = 1).
                 em.Quad(arris(side, a, p), arris(side, b, p), arris(side, b, q), arris(side, a, q),
-                        outs[side], m_);
+                        outs[side], material);
             }
         }
     }

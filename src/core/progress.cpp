@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "src/core/log.h"
@@ -128,7 +129,7 @@ void ProgressBar::Draw(bool final_draw) {
 
 std::string FormatDuration(double seconds) {
     if (seconds < 60) return fmt::format("{:.1f} s", seconds);
-    auto s = static_cast<long long>(seconds + 0.5);
+    const long long s = std::llround(seconds);
     if (s < 3600) return fmt::format("{} min {:02} s", s / 60, s % 60);
     return fmt::format("{} h {:02} min", s / 3600, (s % 3600) / 60);
 }

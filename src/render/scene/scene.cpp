@@ -39,22 +39,23 @@ Spectrum HorizontalIrradiance(const RenderScene& scene) {
         [&](double lambda) { return e[size_t(int(lambda - kLambdaMinNm))]; });
 }
 
-std::unique_ptr<Light> MakeLight(const LightConfig& lc) {
-    switch (lc.kind) {
+std::unique_ptr<Light> MakeLight(const LightConfig& config) {
+    switch (config.kind) {
         case LightKind::kDirectional:
-            return std::make_unique<DirectionalLight>(lc.direction, ToSpectrum(lc.spectrum));
+            return std::make_unique<DirectionalLight>(config.direction,
+                                                      ToSpectrum(config.spectrum));
         case LightKind::kPoint:
-            return std::make_unique<PointLight>(lc.position, ToSpectrum(lc.spectrum));
+            return std::make_unique<PointLight>(config.position, ToSpectrum(config.spectrum));
         case LightKind::kSpot:
             return std::make_unique<SpotLight>(
-                lc.position, lc.direction, std::cos(lc.cone_deg * kPi / 180.f),
-                std::cos(lc.falloff_start_deg * kPi / 180.f), ToSpectrum(lc.spectrum));
+                config.position, config.direction, std::cos(config.cone_deg * kPi / 180.f),
+                std::cos(config.falloff_start_deg * kPi / 180.f), ToSpectrum(config.spectrum));
         case LightKind::kSun:
         case LightKind::kSky:
         case LightKind::kTriangle:
             break;  // the sun and the sky have tables of their own; triangles come from the model
     }
-    NAVE_CHECK(false) << "[[lights]] has no light of kind " << int(lc.kind);
+    NAVE_CHECK(false) << "[[lights]] has no light of kind " << int(config.kind);
     return nullptr;
 }
 

@@ -11,7 +11,7 @@ class DirectionalLight final : public DistantLight {
     /// Light travelling along unit direction `direction` with `irradiance` at normal incidence
     /// (W m^-2 nm^-1).
     DirectionalLight(const Vec3f& direction, Spectrum irradiance)
-        : DistantLight(LightKind::kDirectional, -direction), irradiance_(std::move(irradiance)) {}
+        : DistantLight(LightKind::kDirectional, -direction), irradiance_(irradiance) {}
 
     const Spectrum& irradiance() const { return irradiance_; }
 

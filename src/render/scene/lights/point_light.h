@@ -11,7 +11,7 @@ class PointLight : public Light {
   public:
     /// A light at `position` of `intensity` (W sr^-1 nm^-1) in every direction.
     PointLight(const Vec3f& position, Spectrum intensity)
-        : PointLight(LightKind::kPoint, position, std::move(intensity)) {}
+        : PointLight(LightKind::kPoint, position, intensity) {}
 
     const Vec3f& position() const { return position_; }
     const Spectrum& intensity() const { return intensity_; }
@@ -24,7 +24,7 @@ class PointLight : public Light {
 
   protected:
     PointLight(LightKind kind, const Vec3f& position, Spectrum intensity)
-        : Light(kind), position_(position), intensity_(std::move(intensity)) {}
+        : Light(kind), position_(position), intensity_(intensity) {}
     /// The share of the intensity sent along unit direction `w` (the way light travels): 1 here.
     virtual float Falloff(const Vec3f& w) const { return 1; }
 

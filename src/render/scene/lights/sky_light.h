@@ -17,7 +17,7 @@ namespace nave::render {
 class SkyLight final : public Light {
   public:
     /// A uniform sky of `radiance` (W m^-2 sr^-1 nm^-1) in every direction, above and below.
-    explicit SkyLight(Spectrum radiance) : Light(LightKind::kSky), radiance_(std::move(radiance)) {}
+    explicit SkyLight(Spectrum radiance) : Light(LightKind::kSky), radiance_(radiance) {}
     /// A physical sky, its radiance times `scale`; black below the horizon until
     /// set_ground_radiance.
     SkyLight(std::shared_ptr<const PreethamSky> preetham, float scale)
@@ -45,7 +45,7 @@ class SkyLight final : public Light {
     /// uniform sky, a 64 x 128 midpoint quadrature in cos θ and φ for a physical one.
     void AddHorizontalIrradiance(std::vector<double>* e) const;
     /// With a physical sky: the radiance of the ground below the horizon.
-    void set_ground_radiance(Spectrum radiance) { ground_radiance_ = std::move(radiance); }
+    void set_ground_radiance(Spectrum radiance) { ground_radiance_ = radiance; }
     /// The mean radiance over the sphere of directions times the measure of the lines its photons
     /// cross (target.line_measure).
     double Power(const PhotonTarget& target) const override;

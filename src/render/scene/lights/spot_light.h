@@ -12,7 +12,7 @@ class SpotLight final : public PointLight {
     /// `cos_falloff` (the cosine of the falloff's start angle), falling to zero at `cos_cone`.
     SpotLight(const Vec3f& position, const Vec3f& axis, float cos_cone, float cos_falloff,
               Spectrum intensity)
-        : PointLight(LightKind::kSpot, position, std::move(intensity)),
+        : PointLight(LightKind::kSpot, position, intensity),
           axis_(axis),
           cos_cone_(cos_cone),
           cos_falloff_(cos_falloff) {}

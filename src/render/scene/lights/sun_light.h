@@ -14,9 +14,7 @@ class SunLight final : public DistantLight {
     /// The sun toward unit direction `to_sun`, its disc of angular radius `radius_rad`, of
     /// `radiance` (W m^-2 sr^-1 nm^-1).
     SunLight(const Vec3f& to_sun, double radius_rad, Spectrum radiance)
-        : DistantLight(LightKind::kSun, to_sun),
-          radius_rad_(radius_rad),
-          radiance_(std::move(radiance)) {}
+        : DistantLight(LightKind::kSun, to_sun), radius_rad_(radius_rad), radiance_(radiance) {}
 
     const Spectrum& radiance() const { return radiance_; }
     /// The disc's solid angle (sr) and the pdf of Sample, in double where it matters (the disc
