@@ -23,7 +23,9 @@
 
 namespace nave::render {
 
-/// Renders `scene` into `film` in the mode of scene.settings. `film` must match the camera's
+/// Renders `scene` into `film` in the mode of scene.settings: Integrator::Create makes the mode's
+/// integrator and this driver renders its rounds the same way for every mode (resume, progress,
+/// the stopping rule, checkpoints), then fills `stats`. `film` must match the camera's
 /// resolution. Thread count: scene.settings.threads (0: all cores). `picker` empty: the pager's
 /// choice (the fullest resident brick first). `paging` null: in-core with the default tunables
 /// (bricks stay once loaded, and are loaded in the background while the workers trace); else bricks
