@@ -94,8 +94,9 @@ void ProgressBar::Draw(bool final_draw) {
     std::string tail = fmt::format("{} {} | {} | {}", FormatCount(double(done)), unit_,
                                    FormatRate(rate), FormatDuration(elapsed));
     const double deadline = deadline_s_.load();
-    // A render stopped by its time limit ends full: the limit, not the units, was its measure.
-    const double fraction = final_draw && deadline > 0 && elapsed >= deadline ? 1.0 : Fraction();
+    // Past a deadline (a render stopped by its time limit) the bar is full: the limit, not the
+    // units, was its measure.
+    const double fraction = Fraction();
     bool by_deadline = false;
     const double left = SecondsLeftAt(elapsed, &by_deadline);
     if (!final_draw && left >= 0) {

@@ -52,7 +52,7 @@ double PathIntegrator::GuideRadianceScale(const RenderScene& scene) {
 
 ProgressUnits PathIntegrator::progress_units() const {
     // Advanced by every path as it ends, on the workers: a wave can be the whole image.
-    return {"render", "paths", uint64_t(scene_.camera->width()) * scene_.camera->height()};
+    return {"render", "paths", film_->pixel_count()};
 }
 
 Status PathIntegrator::Restore(const RenderSession& session) {
@@ -72,7 +72,7 @@ void PathIntegrator::Save(Checkpoint* checkpoint) const {
 
 StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     const int s = passes;
-    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const uint64_t pixels = film_->pixel_count();
     const int spp = scene_.settings.spp;
     const uint64_t wave = scene_.settings.wave_paths;
     // Small images put several passes in one wave, so that the streams stay long enough to keep
@@ -120,8 +120,7 @@ Status PathIntegrator::Finish(int passes, RenderStats* stats) {
         stats->guide_cells = owned_guide_->cells_used();
         stats->guide_cells_guiding = owned_guide_->cells_guiding();
     }
-    stats->camera_paths =
-        uint64_t(scene_.camera->width()) * scene_.camera->height() * uint64_t(passes);
+    stats->camera_paths = uint64_t(film_->pixel_count()) * uint64_t(passes);
     film_->SetSamplesPerPixel(passes);
     return Status::Ok();
 }

@@ -1,7 +1,6 @@
 #include "src/render/integrators/sppm_integrator.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <optional>
 
@@ -43,9 +42,9 @@ SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamSched
       scheduler_(scheduler),
       emitters_(std::move(emitters)),
       lights_(std::move(lights)),
-      visible_(std::make_unique<VisiblePoints>(
-          uint64_t(scene.camera->width()) * scene.camera->height(), scene.source->brick_count(),
-          InitialRadius(scene, *emitters_), scene.settings.alpha)),
+      visible_(std::make_unique<VisiblePoints>(film->pixel_count(), scene.source->brick_count(),
+                                               InitialRadius(scene, *emitters_),
+                                               scene.settings.alpha)),
       camera_pass_(scene, film, scheduler, *lights_, visible_.get()),
       sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
 
@@ -68,7 +67,7 @@ void SppmIntegrator::Save(Checkpoint* checkpoint) const {
 
 StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
     // Every iteration ends with its photons drained: a checkpoint needs no extra drain.
-    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const uint64_t pixels = film_->pixel_count();
     const uint64_t photons = scene_.settings.photons_per_iteration;
     const uint64_t wave = scene_.settings.wave_paths;
     iteration_ = uint32_t(done);
@@ -97,7 +96,7 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
 }
 
 Status SppmIntegrator::Finish(int done, RenderStats* stats) {
-    const uint64_t pixels = uint64_t(scene_.camera->width()) * scene_.camera->height();
+    const uint64_t pixels = film_->pixel_count();
     const uint64_t photons = scene_.settings.photons_per_iteration;
     // Direct light and specular chains were summed by the film over `done` iterations; the photon
     // estimate is added as `done` times the per-iteration mean so the film's division by its sample

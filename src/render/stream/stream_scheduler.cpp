@@ -4,7 +4,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 
 #include "src/core/check.h"
 #include "src/core/trace.h"
