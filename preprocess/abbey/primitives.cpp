@@ -203,7 +203,6 @@ void Sweep(Emitter& em, const std::vector<Vec3d>& raw_path, const Vec3d& side,
     size_t np = path.size(), nq = profile.size();
     if (np < 2 || nq < 3) return;
     std::vector<Vec3d> ring_prev(nq), ring(nq);
-    Vec3d center_prev;
     auto make_ring = [&](size_t i, std::vector<Vec3d>& out) {
         Vec3d t = path[std::min(i + 1, np - 1)] - path[i > 0 ? i - 1 : 0];
         Vec3d n = Normalize(Cross(side, t));
