@@ -59,11 +59,16 @@ std::unique_ptr<BrickSource> BallGridSource() {
     return testing::GridSource(BallGrid(), testing::NamedMaterials(kNames), {4, 4, 2});
 }
 
-/// The ball grid's config in `mode` (path or photon).
+/// The ball grid's config in `mode` (path, photon, or "photon_gather": photon with final
+/// gathering and its guide).
 SceneConfig BallGridConfig(const std::string& mode) {
-    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), mode), "balls.toml");
+    const bool gather = mode == "photon_gather";
+    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), gather ? "photon" : mode),
+                                   "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
-    return config.ok() ? *config : SceneConfig();
+    if (!config.ok()) return SceneConfig();
+    config->render.final_gather = gather;
+    return *config;
 }
 
 /// The ball grid rendered on a fresh source; the render's Status is kept, not expected. Null if
@@ -159,6 +164,10 @@ TEST_F(PagerTest, AWaveLargerThanTheQueueMemorySpillsAsItIsGenerated) {
 TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-4); }
+
+TEST_F(PagerTest, PagedRenderEqualsInCorePhotonWithFinalGather) {
+    ExpectPagedEqualsInCore("photon_gather", 1e-4);
+}
 
 TEST_F(PagerTest, InCoreBudgetLoadsEveryBrickOnceAndEvictsNothing) {
     const auto in_core = RenderBallGrid("path", nullptr);

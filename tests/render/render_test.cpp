@@ -105,8 +105,9 @@ spp = 4
 
 // A diffuse plane under a uniform sky of radiance L: E = pi L from the open hemisphere, so the
 // reflected radiance is R L (Lambert). Both modes (next-event estimation of the sky, weighted
-// against BSDF sampling), and photon mode with the sky's direct light from its photons
-// (render.sky_direct = "photons").
+// against BSDF sampling), photon mode with the sky's direct light from its photons
+// (render.sky_direct = "photons"), and photon mode with final gathering (the gather's escape
+// weighed against next-event estimation of the sky).
 TEST_F(RenderTest, UniformSkyOnDiffusePlane) {
     store::BrickMesh m;
     AppendQuad(&m, {0, 0, 0}, {50, 0, 0}, {0, 50, 0}, 4, 0);
@@ -114,9 +115,11 @@ TEST_F(RenderTest, UniformSkyOnDiffusePlane) {
         const char* mode;
         const char* sky_direct;
         int photons;
+        bool final_gather = false;
     };
-    for (const Case& c : {Case{"path", "sampled", 1000}, Case{"photon", "sampled", 1000},
-                          Case{"photon", "photons", 100000}}) {
+    for (const Case& c :
+         {Case{"path", "sampled", 1000}, Case{"photon", "sampled", 1000},
+          Case{"photon", "photons", 100000}, Case{"photon", "sampled", 1000, true}}) {
         std::string config = fmt::format(R"(
 [camera]
 position = [0, 0, 5]
@@ -130,17 +133,18 @@ reflectance = 0.6
 [render]
 mode = "{}"
 sky_direct = "{}"
+final_gather = {}
 spp = 64
 iterations = 64
 photons_per_iteration = {}
 )",
-                                         c.mode, c.sky_direct, c.photons);
+                                         c.mode, c.sky_direct, c.final_gather, c.photons);
         auto t = Render(m, {"plane"}, config, 1);
         ASSERT_TRUE(t);
         // The 50 m plane seen from 5 m hides a little sky near the horizon from nothing: exact up
         // to noise.
         EXPECT_NEAR(MeanY(*t->film), 0.6 * 2.0, 0.02 * 1.2)
-            << c.mode << ", sky_direct " << c.sky_direct;
+            << c.mode << ", sky_direct " << c.sky_direct << ", final_gather " << c.final_gather;
     }
 }
 

@@ -52,6 +52,19 @@ class ResumeTest : public ::testing::Test {
         scene_ = std::move(*scene);
     }
 
+    /// Loads `mesh` (materials named `names`, cut into 2 x 2 x 2 bricks) with config `text`.
+    void LoadMesh(const store::BrickMesh& mesh, const std::vector<std::string>& names,
+                  const std::string& text) {
+        auto config = ParseSceneConfig(text, "mesh.toml");
+        ASSERT_TRUE(config.ok()) << config.status().ToString();
+        config->render.threads = 1;
+        auto scene = testing::BuildTestScene(
+            testing::GridSource(mesh, testing::NamedMaterials(names), {2, 2, 2}),
+            std::move(*config));
+        ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+        scene_ = std::move(*scene);
+    }
+
     /// One run with `options`, into a fresh film.
     RenderResult Render(const SessionOptions& options) {
         // The fullest brick first, whether resident or not: the order of the batches, and so of the
@@ -143,6 +156,37 @@ TEST_F(ResumeTest, PhotonModeWithRadiiDensitiesAndPhotonGuides) {
         c->render.photons_per_iteration = 20000;
     });
     ExpectResumedEqualsUninterrupted({2, 1}, 6);
+}
+
+TEST_F(ResumeTest, PhotonModeWithFinalGatherItsGuideAndTheLearnedWindows) {
+    // The room lit by the sky through a window in its roof: what the gather guide and the sky's
+    // windows learn from the photons carries over a stop.
+    LoadMesh(testing::RoomWithRoofWindow(), {"floor", "wall", "window"}, R"(
+[camera]
+position = [0.0, -1.8, 1.5]
+look_at = [0.0, 0.0, 0.0]
+fov_deg = 70
+resolution = [24, 24]
+[sky]
+radiance = 1.0
+[materials.floor]
+reflectance = 0.5
+[materials.wall]
+reflectance = 0.5
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+portal = true
+[render]
+mode = "photon"
+final_gather = true
+photon_target = "portals"
+sky_sampling = "portals"
+iterations = 5
+photons_per_iteration = 20000
+max_depth = 4
+)");
+    ExpectResumedEqualsUninterrupted({2, 1}, 5);
 }
 
 TEST_F(ResumeTest, ACheckpointOfAnotherSizeIsRefused) {

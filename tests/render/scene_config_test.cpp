@@ -108,6 +108,25 @@ TEST(SceneConfig, PhotonsPerIterationFitIn32Bits) {
         << over.status().message();
 }
 
+TEST(SceneConfig, FinalGatherAndTheSkysDirectLightFromPhotonsExcludeEachOther) {
+    auto c = ParseSceneConfig(
+        "[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0]\n[render]\nmode = \"photon\"\n"
+        "final_gather = true\nsky_direct = \"photons\"\n",
+        "gather.toml");
+    ASSERT_FALSE(c.ok());
+    EXPECT_NE(c.status().message().find("gather.toml"), std::string::npos) << c.status().ToString();
+    EXPECT_NE(c.status().message().find("render.final_gather"), std::string::npos)
+        << c.status().ToString();
+    EXPECT_NE(c.status().message().find("render.sky_direct"), std::string::npos)
+        << c.status().ToString();
+    auto ok = ParseSceneConfig(
+        "[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0]\n[render]\nmode = \"photon\"\n"
+        "final_gather = true\n",
+        "gather.toml");
+    ASSERT_TRUE(ok.ok()) << ok.status().ToString();
+    EXPECT_TRUE(ok->render.final_gather);
+}
+
 TEST(SceneConfig, WrongTypeSaysExpectedAndFound) {
     auto c = ParseSceneConfig(
         "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\nfov_deg = \"wide\"\n", "s.toml");

@@ -57,6 +57,31 @@ TEST(SkyPortals, SameImageInExpectationWithLessNoise) {
     EXPECT_LT(portals.noise, 0.5 * uniform.noise);
 }
 
+// Photon mode with final gathering, its sky next-event estimation choosing the window the sky's
+// photons taught each region (SkyWindows), and its gather guided by the bounced photons: the same
+// room, now with indirect light (max_depth 4), agrees with path tracing through the portals.
+TEST(SkyPortals, FinalGatherWithLearnedWindowsAgreesWithPathTracing) {
+    const std::string deeper = [] {
+        std::string c = kConfig;
+        c.replace(c.find("max_depth = 1"), std::string("max_depth = 1").size(), "max_depth = 4");
+        return c + "sky_sampling = \"portals\"\n";
+    }();
+    const testing::SeedPair path =
+        testing::RenderSeedPair(testing::RoomWithRoofWindow(), kMaterials, deeper, 2);
+    const testing::SeedPair photon = testing::RenderSeedPair(
+        testing::RoomWithRoofWindow(), kMaterials,
+        deeper +
+            "mode = \"photon\"\nfinal_gather = true\nphoton_target = \"portals\"\n"
+            "iterations = 24\nphotons_per_iteration = 20000\ninitial_radius_m = 0.2\n",
+        2);
+    ASSERT_GT(path.mean, 0);
+    // Within the two renders' noise and the photon estimate's blur (a few percent at this radius).
+    const double tolerance = 0.04 * path.mean + 4 * std::hypot(path.noise, photon.noise) /
+                                                    std::sqrt(2.0 * double(path.pixels));
+    EXPECT_NEAR(photon.mean, path.mean, tolerance)
+        << "path noise " << path.noise << ", photon noise " << photon.noise;
+}
+
 TEST(SkyPortals, PortalSamplingWithoutPortalsIsAnError) {
     std::string config = kConfig;
     config.replace(config.find("portal = true"), std::string("portal = true").size(), "");

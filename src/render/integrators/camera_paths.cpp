@@ -95,8 +95,8 @@ void CameraPaths::Escape(const RayRecord& r) {
         // vertex the direction was sampled from.
         float w = 1;
         if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
-            w = PowerHeuristic(r.prev_pdf,
-                               lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.dir));
+            w = PowerHeuristic(
+                r.prev_pdf, lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir));
         }
         const SampledSpectrum sky = scene_.sky->Radiance(r.dir, r.lambda);
         L += sky * w;
@@ -221,7 +221,7 @@ bool CameraPaths::Continue(RayRecord& r, const SurfaceHit& h, const GuidedBsdf& 
     r.vertex += 1;
     if (IsPassThrough(*h.material, *bs)) return PassThrough(r, h, bs->wi);
     if (last) return false;
-    r.flags = bs->IsSpecular() ? kSpecularBounce : 0;
+    r.flags = uint8_t((r.flags & ~kSpecularBounce) | (bs->IsSpecular() ? kSpecularBounce : 0));
     r.guide_side = uint8_t(side);
     r.prev_pdf = bs->pdf;
     if (r.depth >= 2) {

@@ -4,6 +4,7 @@
 #include "src/render/integrators/render_session.h"
 #include "src/render/transport/path_guide.h"
 #include "src/render/transport/photon_emitters.h"
+#include "src/render/transport/sky_windows.h"
 #include "src/render/transport/visible_points.h"
 
 namespace nave::render {
@@ -17,6 +18,13 @@ RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, in
         // The visible points and what the photon emitters learn from.
         state.transport = VisiblePoints::MemoryBytes(pixels) +
                           PhotonEmitters::LearningBytes(settings.photons_per_iteration);
+        // The windows the sky's photons teach its next-event estimation.
+        if (settings.sky_sampling == RenderSettings::SkySampling::kPortals &&
+            settings.photon_target == RenderSettings::PhotonTarget::kPortals)
+            state.transport += SkyWindows::kMemoryReserveBytes;
+        // Final gathering's guide, learned from the photons.
+        if (settings.final_gather)
+            state.transport += PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
     } else if (settings.path_guiding) {
         state.transport = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
     }

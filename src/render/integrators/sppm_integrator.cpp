@@ -6,6 +6,7 @@
 
 #include "src/core/byte_stream.h"
 #include "src/core/image_error.h"
+#include "src/core/log.h"
 #include "src/core/progress.h"
 #include "src/render/scene/surface_hit.h"
 #include "src/render/transport/rng.h"
@@ -19,9 +20,17 @@ StatusOr<std::unique_ptr<SppmIntegrator>> SppmIntegrator::Create(const RenderSce
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<PhotonEmitters> emitters,
                           PhotonEmitters::Build(scene, scheduler));
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<LightSampler> lights,
-                          LightSampler::Create(scene, scheduler, emitters->sky_portals()));
-    return std::unique_ptr<SppmIntegrator>(
-        new SppmIntegrator(scene, film, scheduler, std::move(emitters), std::move(lights)));
+                          LightSampler::Create(scene, scheduler, emitters->sky_portals(),
+                                               emitters->typical_photon_power()));
+    std::unique_ptr<PathGuide> gather_guide;
+    if (scene.settings.final_gather && !scene.source->bounds().Empty()) {
+        // Credited with photon powers, not radiances: its fixed point is scaled to a photon's.
+        gather_guide =
+            std::make_unique<PathGuide>(scene.source->bounds(), kGuideCoarseCellsLongAxis,
+                                        kGuideMaxCells, emitters->typical_photon_power());
+    }
+    return std::unique_ptr<SppmIntegrator>(new SppmIntegrator(
+        scene, film, scheduler, std::move(emitters), std::move(lights), std::move(gather_guide)));
 }
 
 namespace {
@@ -36,7 +45,8 @@ float InitialRadius(const RenderScene& scene, const PhotonEmitters& emitters) {
 
 SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
                                std::unique_ptr<PhotonEmitters> emitters,
-                               std::unique_ptr<LightSampler> lights)
+                               std::unique_ptr<LightSampler> lights,
+                               std::unique_ptr<PathGuide> gather_guide)
     : scene_(scene),
       film_(film),
       scheduler_(scheduler),
@@ -45,8 +55,10 @@ SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamSched
       visible_(std::make_unique<VisiblePoints>(film->pixel_count(), scene.source->brick_count(),
                                                InitialRadius(scene, *emitters_),
                                                scene.settings.alpha)),
-      camera_pass_(scene, film, scheduler, *lights_, visible_.get()),
-      sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
+      gather_guide_(std::move(gather_guide)),
+      camera_pass_(scene, film, scheduler, *lights_, visible_.get(), gather_guide_.get()),
+      sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons),
+      final_gather_(scene.settings.final_gather) {}
 
 Status SppmIntegrator::Restore(const RenderSession& session) {
     NAVE_ASSIGN_OR_RETURN(std::string_view points, session.Section("visible_points"));
@@ -54,7 +66,19 @@ Status SppmIntegrator::Restore(const RenderSession& session) {
     NAVE_RETURN_IF_ERROR(visible_->LoadState(&points_in));
     NAVE_ASSIGN_OR_RETURN(std::string_view learned, session.Section("photon_emitters"));
     ByteReader learned_in(learned, session.resume_name() + " section photon_emitters");
-    return emitters_->LoadState(&learned_in);
+    NAVE_RETURN_IF_ERROR(emitters_->LoadState(&learned_in));
+    if (gather_guide_) {
+        NAVE_ASSIGN_OR_RETURN(std::string_view guide, session.Section("gather_guide"));
+        ByteReader guide_in(guide, session.resume_name() + " section gather_guide");
+        NAVE_RETURN_IF_ERROR(gather_guide_->LoadState(&guide_in));
+    }
+    if (SkyWindows* windows = lights_->sky_windows()) {
+        NAVE_ASSIGN_OR_RETURN(std::string_view sums, session.Section("sky_windows"));
+        ByteReader sums_in(sums, session.resume_name() + " section sky_windows");
+        NAVE_RETURN_IF_ERROR(windows->LoadState(&sums_in));
+        return sums_in.ExpectEnd();
+    }
+    return Status::Ok();
 }
 
 void SppmIntegrator::Save(Checkpoint* checkpoint) const {
@@ -63,6 +87,16 @@ void SppmIntegrator::Save(Checkpoint* checkpoint) const {
     emitters_->SaveState(&learned);
     checkpoint->sections["visible_points"] = points.Take();
     checkpoint->sections["photon_emitters"] = learned.Take();
+    if (gather_guide_) {
+        ByteWriter guide;
+        gather_guide_->SaveState(&guide);
+        checkpoint->sections["gather_guide"] = guide.Take();
+    }
+    if (const SkyWindows* windows = lights_->sky_windows()) {
+        ByteWriter sums;
+        windows->SaveState(&sums);
+        checkpoint->sections["sky_windows"] = sums.Take();
+    }
 }
 
 StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
@@ -90,6 +124,12 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
                                     return Status::Ok();
                                 }));
     emitters_->Learn(deposited_);
+    if (SkyWindows* windows = lights_->sky_windows()) windows->Update();
+    if (gather_guide_) {
+        gather_guide_->Update();
+        log::Debug("gather guide after {} iterations: {} cells learning, {} guiding",
+                   iteration_ + 1, gather_guide_->cells_used(), gather_guide_->cells_guiding());
+    }
     visible_->EndIteration(Film::SampleHalf(iteration_));
     if (progress_ != nullptr) progress_->Add(1);
     return done + 1;
@@ -145,6 +185,18 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
     }
 }
 
+void SppmIntegrator::LearnWindow(const RayRecord& r, const SurfaceHit& h) {
+    SkyWindows* windows = lights_->sky_windows();
+    if (windows == nullptr) return;
+    // The window the photon came in through: the first portal back along its path (panes let it
+    // through without bending it).
+    const Vec3f wo = -r.dir;
+    const std::optional<BrickHit> window = emitters_->sky_portals()->FirstCrossing(h.p, wo);
+    if (!window) return;  // outside, or in through an opening that is not a portal
+    windows->Record(h.p, PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns), window->triangle,
+                    double(r.beta.Average()));
+}
+
 bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick,
                                  const BrickHit& hit) {
     SurfaceHit h = MakeSurfaceHit(scene_, brick, hit, r.dir);
@@ -156,8 +208,9 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     if (flags == kBxdfUnset) return false;
     // Direct light from the sun and the other delta or disc lights is next-event estimated at the
     // visible points: deposit only photons that bounced, or that come from emitters no estimator
-    // samples (emissive surfaces; the sky with render.sky_direct = "photons").
-    if ((r.depth > 0 || (r.flags & kFromAreaLight) ||
+    // samples (emissive surfaces; the sky with render.sky_direct = "photons"). With final
+    // gathering the visible points are one bounce past that estimate: every photon counts.
+    if ((final_gather_ || r.depth > 0 || (r.flags & kFromAreaLight) ||
          ((r.flags & kFromSky) && sky_direct_photons_)) &&
         (flags & kBxdfDiffuse)) {
         const float added = visible_->Deposit(
@@ -165,6 +218,15 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
             VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)));
         // One writer per photon: a photon is traced by one thread at a time.
         if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
+    }
+    if ((r.flags & kFromSky) && r.depth == 0 && (flags & kBxdfDiffuse)) LearnWindow(r, h);
+    if (gather_guide_ && r.depth > 0 && (flags & kBxdfDiffuse)) {
+        // Light that bounced before arriving here: what a gather from here should look for (its
+        // direct light is next-event estimated). Jensen 1995, "Importance driven path tracing
+        // using the photon map", guides the bounce by the photons around the vertex likewise.
+        const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+        gather_guide_->Credit(gather_guide_->CreditKey(h.p, side, wo),
+                              std::max(0.0, double(r.beta.Average())));
     }
     // As for paths, a photon at its last bounce still passes through thin glass.
     const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);

@@ -45,9 +45,13 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
 
   private:
     SppmIntegrator(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
-                   std::unique_ptr<PhotonEmitters> emitters, std::unique_ptr<LightSampler> lights);
+                   std::unique_ptr<PhotonEmitters> emitters, std::unique_ptr<LightSampler> lights,
+                   std::unique_ptr<PathGuide> gather_guide);
     /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
     bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
+    /// A sky photon at its first diffuse hit `h`: teaches the sky's next-event estimation which
+    /// window lights that region (SkyWindows).
+    void LearnWindow(const RayRecord& r, const SurfaceHit& h);
 
     const RenderScene& scene_;
     Film* film_;
@@ -55,12 +59,16 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     std::unique_ptr<PhotonEmitters> emitters_;
     std::unique_ptr<LightSampler> lights_;  // shares the emitters' portals
     std::unique_ptr<VisiblePoints> visible_;
+    // With final gathering: where the indirect light at a first diffuse vertex comes from,
+    // learned from the photons that bounced before arriving (null otherwise).
+    std::unique_ptr<PathGuide> gather_guide_;
     VisiblePointPass camera_pass_;
     // Per photon of the pass (the first PhotonEmitters::learned_photons()), the luminance it
     // brought to the visible points, for the emitters to learn from.
     std::vector<float> deposited_;
     uint32_t iteration_ = 0;
     const bool sky_direct_photons_;  // render.sky_direct = "photons"
+    const bool final_gather_;        // render.final_gather
     ProgressBar* progress_ = nullptr;
 };
 

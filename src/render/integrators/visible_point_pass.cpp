@@ -5,10 +5,13 @@
 namespace nave::render {
 
 VisiblePointPass::VisiblePointPass(const RenderScene& scene, Film* film, StreamScheduler& scheduler,
-                                   const LightSampler& lights, VisiblePoints* visible_points)
+                                   const LightSampler& lights, VisiblePoints* visible_points,
+                                   const PathGuide* gather_guide)
     : CameraPaths(scene, film, scheduler, lights, nullptr),
       visible_points_(visible_points),
-      sky_from_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons) {}
+      sky_from_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons),
+      final_gather_(scene.settings.final_gather),
+      gather_guide_(gather_guide) {}
 
 bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& brick,
                                  const SurfaceHit& h, bool last, RayOutbox& out) {
@@ -26,6 +29,27 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
+    if ((flags & kBxdfDiffuse) && final_gather_) {
+        if (r.flags & kGathering) {
+            // The gather bounce landed: every photon arriving here is light leaving toward the
+            // first diffuse vertex, its direct light included, so no next-event estimation.
+            visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr,
+                                 h.footprint, r.beta, r.lambda);
+            return false;
+        }
+        // Final gathering (Jensen 1996, "Global illumination using photon maps", 3.3): direct
+        // light at the first diffuse vertex from next-event estimation weighed against the bounce
+        // (power heuristic, as in path mode), which goes on to the vertex whose photons it reads.
+        // A photon's power then reaches pixels scattered across the image instead of a disc of
+        // the gather radius around it.
+        const GuidedBsdf gather(bsdf, gather_guide_, h.p, side);
+        EstimateDirect(r, b, brick, h, bsdf, wo, rng, &gather, scene_.sky != nullptr,
+                       PathGuide::kNoCredit, 0, out);
+        r.flags |= kGathering;
+        return Continue(r, h, gather, rng, side, last);
+    }
     if (flags & kBxdfDiffuse) {
         // With render.sky_direct = "photons", the sky's photons bring its direct light here.
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, nullptr, scene_.sky && !sky_from_photons_,
@@ -35,8 +59,6 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
                              r.beta, r.lambda);
         return false;
     }
-    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
-    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
     if (flags & kBxdfGlossy) {
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);

@@ -582,6 +582,14 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
                                   {{"sampled", RenderSettings::SkyDirect::kSampled},
                                    {"photons", RenderSettings::SkyDirect::kPhotons}},
                                   &s->sky_direct));
+    NAVE_RETURN_IF_ERROR(r.Bool("final_gather", &s->final_gather));
+    if (s->final_gather && s->sky_direct == RenderSettings::SkyDirect::kPhotons) {
+        return InvalidArgumentError(
+            "{}: render.final_gather = true and render.sky_direct = \"photons\" exclude each "
+            "other: with final gathering the sky's direct light is next-event estimated "
+            "(sky_direct = \"sampled\") and its photons are read one bounce away",
+            r.WhereTable());
+    }
     NAVE_RETURN_IF_ERROR(r.Bool("path_guiding", &s->path_guiding));
     return r.Finish();
 }

@@ -156,6 +156,11 @@ struct RenderSettings {
     /// light).
     enum class SkyDirect { kSampled, kPhotons };
     SkyDirect sky_direct = SkyDirect::kSampled;
+    /// Photon mode: camera paths go one diffuse bounce past their first diffuse vertex (direct
+    /// light there next-event estimated, with MIS) and read the photons where that bounce lands
+    /// (final gathering, Jensen 1996), so no single photon is seen directly. Excludes sky_direct =
+    /// "photons".
+    bool final_gather = false;
     /// Path mode: paths learn where the light reflected toward each part of the model comes from
     /// and draw half of their continuations from it (PathGuide).
     bool path_guiding = false;

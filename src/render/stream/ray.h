@@ -21,7 +21,9 @@ enum RayFlags : uint8_t {
         1 << 0,  ///< the last scattering was specular (no light sampling possible there)
     kFromAreaLight =
         1 << 1,  ///< photon emitted by a surface (its direct light is not next-event estimated)
-    kFromSky = 1 << 2,  ///< photon from the sky
+    kFromSky = 1 << 2,    ///< photon from the sky
+    kGathering = 1 << 3,  ///< photon mode's camera path past its first diffuse vertex, looking for
+                          ///< the vertex whose photons it reads (render.final_gather)
 };
 
 struct RayRecord {

@@ -43,7 +43,8 @@ Vec3f SkyPortals::SamplePoint(double u_triangle, Point2f u, size_t* triangle) co
 
 StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& scene,
                                                              StreamScheduler& scheduler,
-                                                             const SkyPortals* photon_portals) {
+                                                             const SkyPortals* photon_portals,
+                                                             double photon_power) {
     std::unique_ptr<LightSampler> sampler(new LightSampler(scene));
     if (!scene.sky || scene.settings.sky_sampling != RenderSettings::SkySampling::kPortals) {
         return sampler;
@@ -57,6 +58,14 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
                 "\"portals\"; the sky is sampled uniformly");
         }
         sampler->portals_ = photon_portals;
+        if (photon_portals != nullptr) {
+            sampler->windows_ =
+                std::make_unique<SkyWindows>(*photon_portals, scene.source->bounds(), photon_power);
+            log::Info(
+                "sky through {} windows ({} portal triangles): the sky's photons teach "
+                "each region its own",
+                sampler->windows_->window_count(), photon_portals->triangle_count());
+        }
         return sampler;
     }
     std::vector<std::array<Vec3f, 3>> triangles;
@@ -109,8 +118,22 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                                                  const VertexRng& rng,
                                                  const GuidedBsdf* continuation) const {
     const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
+    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const SkyWindows::Region* region = windows_ ? windows_->Find(h.p, side) : nullptr;
+    // With a learned region, kLearnedSkyShare of the samples from it and the rest split as
+    // without: u_strategy below kLearnedSkyShare picks a learned window, above it is rescaled.
+    float u_strategy = rng.Uniform(dim + 2);
     Vec3f wi;
-    if (portals_ != nullptr && rng.Uniform(dim + 2) < kPortalSkyShare) {
+    if (region != nullptr && u_strategy < kLearnedSkyShare) {
+        const Vec3f q = windows_->SamplePoint(*region, rng.Uniform(dim + 3),
+                                              Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+        const float d = Length(q - h.p);
+        if (!(d > 0)) return std::nullopt;
+        wi = (q - h.p) / d;
+    } else if (portals_ != nullptr &&
+               (region == nullptr
+                    ? u_strategy
+                    : (u_strategy - kLearnedSkyShare) / (1 - kLearnedSkyShare)) < kPortalSkyShare) {
         const Vec3f q = portals_->SamplePoint(rng.Uniform(dim + 3),
                                               Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
         const float d = Length(q - h.p);
@@ -121,7 +144,7 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
     }
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
-    const float light_pdf = SkyPdf(h.p, wi);
+    const float light_pdf = SkyPdf(h.p, side, wi);
     if (!(light_pdf > 0)) return std::nullopt;
     float w = continuation != nullptr
                   ? PowerHeuristic(light_pdf, continuation->Pdf(wo, wi, r.lambda))
@@ -136,15 +159,24 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
     return s;
 }
 
-float LightSampler::SkyPdf(const Vec3f& p, const Vec3f& w) const {
+float LightSampler::SkyPdf(const Vec3f& p, int side, const Vec3f& w) const {
     if (portals_ == nullptr) return SkyLight::UniformPdf();
-    double portal_pdf = 0;
+    const SkyWindows::Region* region = windows_ ? windows_->Find(p, side) : nullptr;
+    double portal_pdf = 0, learned_pdf = 0;
     portals_->ForEachCrossing(p, w, kInfinity, [&](const BrickHit& hit) {
         const float cos_theta = std::abs(Dot(Normalize(hit.ng), w));
-        if (cos_theta > 1e-6f)
-            portal_pdf += double(hit.t) * hit.t / (double(cos_theta) * portals_->area());
+        if (cos_theta > 1e-6f) {
+            // Area to solid angle: d² / |cos θ| (Veach 1997 §9.2).
+            const double to_solid_angle = double(hit.t) * hit.t / double(cos_theta);
+            portal_pdf += to_solid_angle / portals_->area();
+            if (region != nullptr)
+                learned_pdf += to_solid_angle * windows_->AreaDensity(*region, hit.triangle);
+        }
     });
-    return float((1 - kPortalSkyShare) * SkyLight::UniformPdf() + kPortalSkyShare * portal_pdf);
+    const double unlearned =
+        (1 - kPortalSkyShare) * SkyLight::UniformPdf() + kPortalSkyShare * portal_pdf;
+    if (region == nullptr) return float(unlearned);
+    return float(kLearnedSkyShare * learned_pdf + (1 - kLearnedSkyShare) * unlearned);
 }
 
 }  // namespace nave::render

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "src/render/stream/ray.h"
 #include "src/render/transport/path_guide.h"
 #include "src/render/transport/rng.h"
+#include "src/render/transport/sky_windows.h"
 
 namespace nave::render {
 
@@ -49,8 +51,18 @@ class SkyPortals {
     }
     /// Total area of the portal triangles (m^2).
     double area() const { return area_; }
-    /// Portal triangle `i` (the index SamplePoint gives).
+    /// Portal triangle `i` (the index SamplePoint gives, and BrickHit::triangle of a crossing).
     const std::array<Vec3f, 3>& triangle(size_t i) const { return triangles_[i]; }
+    size_t triangle_count() const { return triangles_.size(); }
+    /// The area of portal triangle `i` (m^2).
+    double TriangleArea(size_t i) const { return (area_cdf_[i + 1] - area_cdf_[i]) * area_; }
+    /// The first portal triangle the ray o + t d crosses (t > 0), or nothing.
+    std::optional<BrickHit> FirstCrossing(const Vec3f& o, const Vec3f& d) const {
+        BrickHit hit;
+        if (!scene_->Intersect(o, d, 0, std::numeric_limits<float>::infinity(), &hit))
+            return std::nullopt;
+        return hit;
+    }
 
   private:
     SkyPortals() = default;
@@ -68,10 +80,12 @@ class LightSampler {
     /// bricks through `scheduler`; an error if no material is a portal or the model has no portal
     /// triangle); in photon mode the sampler shares `photon_portals`, the photon emitters' portals
     /// (PhotonEmitters::sky_portals, which must outlive the sampler), and samples the sky uniformly
-    /// with a warning when there are none.
+    /// with a warning when there are none, and learns the windows from the sky's photons of
+    /// luminance about `photon_power` (sky_windows()).
     static StatusOr<std::unique_ptr<LightSampler>> Create(const RenderScene& scene,
                                                           StreamScheduler& scheduler,
-                                                          const SkyPortals* photon_portals);
+                                                          const SkyPortals* photon_portals,
+                                                          double photon_power = 0);
 
     /// Next-event estimation of `light` (index `index` in scene.lights) at hit `h` with BSDF
     /// `bsdf`, seen from `wo`, for the path of `r`: the shadow ray toward the light carrying its
@@ -84,17 +98,24 @@ class LightSampler {
                                          const VertexRng& rng,
                                          const GuidedBsdf* continuation) const;
     /// Next-event estimation of the sky: a uniform direction on the sphere, or with
-    /// render.sky_sampling = "portals" mostly a direction toward a point on a window (SkyPdf),
-    /// weighted against `continuation` as SampleLight does. Returns the shadow ray as SampleLight
-    /// does.
+    /// render.sky_sampling = "portals" mostly a direction toward a point on a window (SkyPdf):
+    /// where the sky's photons taught the vertex's region its windows (SkyWindows), mostly one
+    /// of those. Weighted against `continuation` as SampleLight does. Returns the shadow ray as
+    /// SampleLight does.
     std::optional<RayRecord> SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
                                        const RayRecord& r, const VertexRng& rng,
                                        const GuidedBsdf* continuation) const;
-    /// The solid-angle pdf with which SampleSky picks direction `w` at point `p`: the mixture of
-    /// uniform directions and portal sampling, whose pdf sums d² / (|cos θ| A_portals) over every
+    /// The solid-angle pdf with which SampleSky picks direction `w` at point `p` on a surface of
+    /// side `side` (PathGuide::SideOf, turned toward the path): the mixture of uniform
+    /// directions, portal sampling by area, whose pdf sums d² / (|cos θ| A_portals) over every
     /// portal triangle the ray from p crosses (each crossing could have been the sampled point;
-    /// Veach 1997 §9.2 area-to-solid-angle conversion).
-    float SkyPdf(const Vec3f& p, const Vec3f& w) const;
+    /// Veach 1997 §9.2 area-to-solid-angle conversion), and the region's learned windows, which
+    /// sums d² / |cos θ| times the crossed triangle's SkyWindows::AreaDensity.
+    float SkyPdf(const Vec3f& p, int side, const Vec3f& w) const;
+    /// Photon mode with portals: the windows the sky's photons teach (null otherwise). Record
+    /// into it while photons are traced; SkyWindows::Update between passes, never while the
+    /// sampler samples.
+    SkyWindows* sky_windows() const { return windows_.get(); }
 
   private:
     explicit LightSampler(const RenderScene& scene) : scene_(scene) {}
@@ -102,7 +123,11 @@ class LightSampler {
     // Sky next-event estimation toward the portals: this share of the samples, the rest uniform
     // (which keeps light that enters elsewhere, and vertices outside, sampled).
     static constexpr float kPortalSkyShare = 0.75f;
+    // Where a region learned its windows: this share from them, and of the rest kPortalSkyShare
+    // by area, the remainder uniform.
+    static constexpr float kLearnedSkyShare = 0.7f;
     const RenderScene& scene_;
+    std::unique_ptr<SkyWindows> windows_;
     std::unique_ptr<SkyPortals> own_portals_;  // path mode
     const SkyPortals* portals_ = nullptr;      // null: the sky is sampled uniformly
 };

@@ -127,6 +127,7 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
             "photon mode needs a light: the scene has no sun, light, sky or emissive "
             "material with power");
     }
+    total_power_ = total;
     emitter_cdf_.assign(1, 0.0);
     for (double w : weights) emitter_cdf_.push_back(emitter_cdf_.back() + w / total);
     emitter_cdf_.back() = 1.0;

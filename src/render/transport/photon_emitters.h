@@ -62,6 +62,9 @@ class PhotonEmitters {
     /// The model's bounding sphere, on which photons from distant sources start.
     const Vec3f& scene_center() const { return scene_center_; }
     float scene_radius() const { return scene_radius_; }
+    /// The power of a typical photon (the emitters' total selection weight: photons are emitted in
+    /// proportion to power, so each carries about this much, in the units of Light::Power).
+    double typical_photon_power() const { return total_power_; }
 
   private:
     struct Emitter {
@@ -115,6 +118,7 @@ class PhotonEmitters {
     std::unique_ptr<SkyPortals> sky_portals_;
     Vec3f scene_center_;
     float scene_radius_ = 1;
+    double total_power_ = 0;
 };
 
 }  // namespace nave::render
