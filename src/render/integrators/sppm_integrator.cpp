@@ -219,7 +219,11 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
         // One writer per photon: a photon is traced by one thread at a time.
         if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
     }
-    if ((r.flags & kFromSky) && r.depth == 0 && (flags & kBxdfDiffuse)) LearnWindow(r, h);
+    // One sky photon in kLearnWindowEvery teaches the windows: enough to learn them in an
+    // iteration of the abbey, for a quarter of the cost (a ray through the portals' scene each).
+    if ((r.flags & kFromSky) && r.depth == 0 && (flags & kBxdfDiffuse) &&
+        r.pixel % kLearnWindowEvery == 0)
+        LearnWindow(r, h);
     if (gather_guide_ && r.depth > 0 && (flags & kBxdfDiffuse)) {
         // Light that bounced before arriving here: what a gather from here should look for (its
         // direct light is next-event estimated). Jensen 1995, "Importance driven path tracing

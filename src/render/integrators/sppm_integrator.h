@@ -52,6 +52,7 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     /// A sky photon at its first diffuse hit `h`: teaches the sky's next-event estimation which
     /// window lights that region (SkyWindows).
     void LearnWindow(const RayRecord& r, const SurfaceHit& h);
+    static constexpr uint32_t kLearnWindowEvery = 4;
 
     const RenderScene& scene_;
     Film* film_;
