@@ -100,8 +100,9 @@ TEST(SkyWindows, TooFewPhotonsTeachNothing) {
 }
 
 TEST(SkyWindows, TheOrderOfRecordsAndACheckpointChangeNothing) {
-    std::vector<std::array<double, 2>> records;  // (triangle, power)
-    for (int i = 0; i < 200; ++i) records.push_back({double(i % 4), 0.1 + 0.37 * (i % 11)});
+    std::vector<std::array<double, 2>> records(200);  // (triangle, power)
+    for (size_t i = 0; i < records.size(); ++i)
+        records[i] = {double(i % 4), 0.1 + 0.37 * double(i % 11)};
     auto learned = [&](bool reversed) {
         TwoWindows w;
         for (size_t k = 0; k < records.size(); ++k) {
