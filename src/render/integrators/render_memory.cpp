@@ -24,7 +24,8 @@ RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, in
             state.transport += SkyWindows::kMemoryReserveBytes;
         // Final gathering's guide, learned from the photons.
         if (settings.final_gather)
-            state.transport += PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
+            state.transport +=
+                PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGatherGuideMaxCells);
     } else if (settings.path_guiding) {
         state.transport = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
     }

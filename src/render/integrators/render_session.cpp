@@ -3,6 +3,7 @@
 #include "src/core/byte_stream.h"
 #include "src/core/log.h"
 #include "src/render/transport/path_guide.h"
+#include "src/render/transport/sky_windows.h"
 
 namespace nave::render {
 
@@ -13,8 +14,14 @@ uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int he
         if (settings.path_guiding)
             state = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
     } else {
-        // Four doubles per pixel, and a few photon guides of 128 x 128 doubles.
+        // Four doubles per pixel, and a few photon guides of 128 x 128 doubles; the gather guide
+        // and the sky windows' sums (key, sum, count) when they learn.
         state = pixels * 4 * sizeof(double) + (uint64_t(1) << 20);
+        if (settings.final_gather)
+            state += PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGatherGuideMaxCells);
+        if (settings.sky_sampling == RenderSettings::SkySampling::kPortals &&
+            settings.photon_target == RenderSettings::PhotonTarget::kPortals)
+            state += SkyWindows::kMaxPairs * 20;
     }
     return Film::StateBytes(width, height, aov) + state;
 }

@@ -27,7 +27,7 @@ StatusOr<std::unique_ptr<SppmIntegrator>> SppmIntegrator::Create(const RenderSce
         // Credited with photon powers, not radiances: its fixed point is scaled to a photon's.
         gather_guide =
             std::make_unique<PathGuide>(scene.source->bounds(), kGuideCoarseCellsLongAxis,
-                                        kGuideMaxCells, emitters->typical_photon_power());
+                                        kGatherGuideMaxCells, emitters->typical_photon_power());
     }
     return std::unique_ptr<SppmIntegrator>(new SppmIntegrator(
         scene, film, scheduler, std::move(emitters), std::move(lights), std::move(gather_guide)));

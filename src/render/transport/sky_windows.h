@@ -43,10 +43,10 @@ class SkyWindows {
     static constexpr uint32_t kMinPhotons = 16;
     /// At most this many (region, window) sums are kept: beyond it, Update forgets those of the
     /// fewest photons (the least certain) down to three quarters of it.
-    static constexpr size_t kMaxPairs = size_t(1) << 19;
+    static constexpr size_t kMaxPairs = size_t(1) << 17;
     /// The bytes the windows hold at most: the sums and choices of kMaxPairs pairs, and the
     /// records of a pass before Update (the render's memory reserve).
-    static constexpr uint64_t kMemoryReserveBytes = kMaxPairs * 64 + (uint64_t(16) << 20);
+    static constexpr uint64_t kMemoryReserveBytes = kMaxPairs * 64 + (uint64_t(4) << 20);
 
     /// A region's learned choice of windows: entries [first, first + count) of the tables.
     struct Region {
