@@ -364,12 +364,10 @@ TEST(SceneConfigGlass, ExtinctionCoefficientSetsTheGlassAbsorption) {
         std::get_if<DielectricMaterial>(&t->scene.materials[1].material);
     ASSERT_NE(solid, nullptr);
     EXPECT_NEAR(solid->absorption_per_m(550.f), 34.272, 0.01);
-    const char* bad[] = {
-        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\nkappa = 1e-6\nthickness_mm = 4\n",
-        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\n",
-        "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\nthickness_mm = 4\ntransmittance = "
-        "0.9\n"};
-    for (const char* b : bad) {
+    const std::string pane = "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\n";
+    const std::string bad[] = {pane + "kappa = 1e-6\nthickness_mm = 4\n", pane,
+                               pane + "thickness_mm = 4\ntransmittance = 0.9\n"};
+    for (const std::string& b : bad) {
         auto config = ParseSceneConfig(camera + b, "glass.toml");
         ASSERT_FALSE(config.ok()) << b;
         EXPECT_NE(config.status().message().find("materials.pane"), std::string::npos)
