@@ -364,9 +364,9 @@ TEST(SceneConfigGlass, ExtinctionCoefficientSetsTheGlassAbsorption) {
         std::get_if<DielectricMaterial>(&t->scene.materials[1].material);
     ASSERT_NE(solid, nullptr);
     EXPECT_NEAR(solid->absorption_per_m(550.f), 34.272, 0.01);
-    const std::string pane = "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\n";
-    const std::string bad[] = {pane + "kappa = 1e-6\nthickness_mm = 4\n", pane,
-                               pane + "thickness_mm = 4\ntransmittance = 0.9\n"};
+    const std::string pane_keys = "[materials.pane]\ntype = \"thin_dielectric\"\nk = 1e-6\n";
+    const std::string bad[] = {pane_keys + "kappa = 1e-6\nthickness_mm = 4\n", pane_keys,
+                               pane_keys + "thickness_mm = 4\ntransmittance = 0.9\n"};
     for (const std::string& b : bad) {
         auto config = ParseSceneConfig(camera + b, "glass.toml");
         ASSERT_FALSE(config.ok()) << b;
