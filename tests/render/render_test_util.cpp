@@ -193,4 +193,25 @@ store::BrickMesh RoomWithRoofWindow() {
     return m;
 }
 
+std::string RoomWithRoofWindowScene() {
+    return R"(
+[camera]
+position = [0.0, -1.8, 1.5]
+look_at = [0.0, 0.0, 0.0]
+up = [0, 0, 1]
+fov_deg = 70
+resolution = [24, 24]
+[sky]
+radiance = 1.0
+[materials.floor]
+reflectance = 0.5
+[materials.wall]
+reflectance = 0.5
+[materials.window]
+type = "thin_dielectric"
+eta = 1.5
+portal = true
+)";
+}
+
 }  // namespace nave::render::testing

@@ -137,4 +137,8 @@ std::string ClutterScene(int width, int height);
 /// 2) in the roof.
 store::BrickMesh RoomWithRoofWindow();
 
+/// RoomWithRoofWindow's camera (24 x 24), uniform sky and materials ("floor", "wall", and "window":
+/// thin glass and a portal), without a [render] table.
+std::string RoomWithRoofWindowScene();
+
 }  // namespace nave::render::testing

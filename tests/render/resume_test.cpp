@@ -161,22 +161,8 @@ TEST_F(ResumeTest, PhotonModeWithRadiiDensitiesAndPhotonGuides) {
 TEST_F(ResumeTest, PhotonModeWithFinalGatherItsGuideAndTheLearnedWindows) {
     // The room lit by the sky through a window in its roof: what the gather guide and the sky's
     // windows learn from the photons carries over a stop.
-    LoadMesh(testing::RoomWithRoofWindow(), {"floor", "wall", "window"}, R"(
-[camera]
-position = [0.0, -1.8, 1.5]
-look_at = [0.0, 0.0, 0.0]
-fov_deg = 70
-resolution = [24, 24]
-[sky]
-radiance = 1.0
-[materials.floor]
-reflectance = 0.5
-[materials.wall]
-reflectance = 0.5
-[materials.window]
-type = "thin_dielectric"
-eta = 1.5
-portal = true
+    LoadMesh(testing::RoomWithRoofWindow(), {"floor", "wall", "window"},
+             testing::RoomWithRoofWindowScene() + R"(
 [render]
 mode = "photon"
 final_gather = true

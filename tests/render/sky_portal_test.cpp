@@ -17,32 +17,17 @@ namespace {
 
 const std::vector<std::string> kMaterials = {"floor", "wall", "window"};
 
-constexpr const char* kConfig = R"(
-[camera]
-position = [0.0, -1.8, 1.5]
-look_at = [0.0, 0.0, 0.0]
-up = [0, 0, 1]
-fov_deg = 70
-resolution = [24, 24]
-[sky]
-radiance = 1.0
-[materials.floor]
-reflectance = 0.5
-[materials.wall]
-reflectance = 0.5
-[materials.window]
-type = "thin_dielectric"
-eta = 1.5
-portal = true
+std::string RoomConfig() {
+    return testing::RoomWithRoofWindowScene() + R"(
 [render]
 spp = 32
 max_depth = 1
 )";
+}
 
 testing::SeedPair RenderRoom(const std::string& sky_sampling) {
     return testing::RenderSeedPair(testing::RoomWithRoofWindow(), kMaterials,
-                                   std::string(kConfig) + "sky_sampling = \"" + sky_sampling + "\"",
-                                   2);
+                                   RoomConfig() + "sky_sampling = \"" + sky_sampling + "\"", 2);
 }
 
 TEST(SkyPortals, SameImageInExpectationWithLessNoise) {
@@ -62,7 +47,7 @@ TEST(SkyPortals, SameImageInExpectationWithLessNoise) {
 // room, now with indirect light (max_depth 4), agrees with path tracing through the portals.
 TEST(SkyPortals, FinalGatherWithLearnedWindowsAgreesWithPathTracing) {
     const std::string deeper = [] {
-        std::string c = kConfig;
+        std::string c = RoomConfig();
         c.replace(c.find("max_depth = 1"), std::string("max_depth = 1").size(), "max_depth = 4");
         return c + "sky_sampling = \"portals\"\n";
     }();
@@ -83,7 +68,7 @@ TEST(SkyPortals, FinalGatherWithLearnedWindowsAgreesWithPathTracing) {
 }
 
 TEST(SkyPortals, PortalSamplingWithoutPortalsIsAnError) {
-    std::string config = kConfig;
+    std::string config = RoomConfig();
     config.replace(config.find("portal = true"), std::string("portal = true").size(), "");
     Status s;
     auto t = testing::Render(testing::RoomWithRoofWindow(), kMaterials,

@@ -143,7 +143,7 @@ bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& br
     VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
     // The side the path sees of the surface, which keeps the guide's histograms of a floor and
     // of the wall above it apart.
-    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const int side = PathGuide::SideSeenFrom(h.ns, wo);
     const GuidedBsdf continuation(bsdf, owned_guide_.get(), h.p, side);
     if (flags & (kBxdfDiffuse | kBxdfGlossy)) {
         // What next-event estimation finds here, reflected once more, is light arriving at the

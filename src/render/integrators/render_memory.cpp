@@ -19,9 +19,7 @@ RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, in
         state.transport = VisiblePoints::MemoryBytes(pixels) +
                           PhotonEmitters::LearningBytes(settings.photons_per_iteration);
         // The windows the sky's photons teach its next-event estimation.
-        if (settings.sky_sampling == RenderSettings::SkySampling::kPortals &&
-            settings.photon_target == RenderSettings::PhotonTarget::kPortals)
-            state.transport += SkyWindows::kMemoryReserveBytes;
+        if (settings.LearnsSkyWindows()) state.transport += SkyWindows::kMemoryReserveBytes;
         // Final gathering's guide, learned from the photons.
         if (settings.final_gather)
             state.transport +=

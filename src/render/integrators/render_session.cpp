@@ -19,9 +19,7 @@ uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int he
         state = pixels * 4 * sizeof(double) + (uint64_t(1) << 20);
         if (settings.final_gather)
             state += PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGatherGuideMaxCells);
-        if (settings.sky_sampling == RenderSettings::SkySampling::kPortals &&
-            settings.photon_target == RenderSettings::PhotonTarget::kPortals)
-            state += SkyWindows::kMaxPairs * 20;
+        if (settings.LearnsSkyWindows()) state += SkyWindows::kMaxPairs * 20;
     }
     return Film::StateBytes(width, height, aov) + state;
 }

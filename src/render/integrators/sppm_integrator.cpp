@@ -193,7 +193,7 @@ void SppmIntegrator::LearnWindow(const RayRecord& r, const SurfaceHit& h) {
     const Vec3f wo = -r.dir;
     const std::optional<BrickHit> window = emitters_->sky_portals()->FirstCrossing(h.p, wo);
     if (!window) return;  // outside, or in through an opening that is not a portal
-    windows->Record(h.p, PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns), window->triangle,
+    windows->Record(h.p, PathGuide::SideSeenFrom(h.ns, wo), window->triangle,
                     double(r.beta.Average()));
 }
 
@@ -228,7 +228,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
         // Light that bounced before arriving here: what a gather from here should look for (its
         // direct light is next-event estimated). Jensen 1995, "Importance driven path tracing
         // using the photon map", guides the bounce by the photons around the vertex likewise.
-        const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+        const int side = PathGuide::SideSeenFrom(h.ns, wo);
         gather_guide_->Credit(gather_guide_->CreditKey(h.p, side, wo),
                               std::max(0.0, double(r.beta.Average())));
     }

@@ -29,16 +29,8 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
-    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
-    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
-    if ((flags & kBxdfDiffuse) && final_gather_) {
-        if (r.flags & kGathering) {
-            // The gather bounce landed: every photon arriving here is light leaving toward the
-            // first diffuse vertex, its direct light included, so no next-event estimation.
-            visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr,
-                                 h.footprint, r.beta, r.lambda);
-            return false;
-        }
+    const int side = PathGuide::SideSeenFrom(h.ns, wo);
+    if ((flags & kBxdfDiffuse) && final_gather_ && !(r.flags & kGathering)) {
         // Final gathering (Jensen 1996, "Global illumination using photon maps", 3.3): direct
         // light at the first diffuse vertex from next-event estimation weighed against the bounce
         // (power heuristic, as in path mode), which goes on to the vertex whose photons it reads.
@@ -51,14 +43,20 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
         return Continue(r, h, gather, rng, side, last);
     }
     if (flags & kBxdfDiffuse) {
-        // With render.sky_direct = "photons", the sky's photons bring its direct light here.
-        EstimateDirect(r, b, brick, h, bsdf, wo, rng, nullptr, scene_.sky && !sky_from_photons_,
-                       PathGuide::kNoCredit, 0, out);
+        // Where a gather bounce landed, every photon arriving is light leaving toward the first
+        // diffuse vertex, its direct light included: no next-event estimation. Otherwise direct
+        // light here is estimated, the sky's only if its photons do not bring it
+        // (render.sky_direct = "photons").
+        if (!(r.flags & kGathering)) {
+            EstimateDirect(r, b, brick, h, bsdf, wo, rng, nullptr, scene_.sky && !sky_from_photons_,
+                           PathGuide::kNoCredit, 0, out);
+        }
         // SPPM: indirect light at the visible point comes from photons.
         visible_points_->Add(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr, h.footprint,
                              r.beta, r.lambda);
         return false;
     }
+    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
     if (flags & kBxdfGlossy) {
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);

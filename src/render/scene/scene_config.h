@@ -161,6 +161,12 @@ struct RenderSettings {
     /// (final gathering, Jensen 1996), so no single photon is seen directly. Excludes sky_direct =
     /// "photons".
     bool final_gather = false;
+    /// Photon mode aiming both the sky's samples and its photons at the portals: the sky's
+    /// photons then teach its next-event estimation which windows light each region.
+    bool LearnsSkyWindows() const {
+        return mode == Mode::kPhoton && sky_sampling == SkySampling::kPortals &&
+               photon_target == PhotonTarget::kPortals;
+    }
     /// Path mode: paths learn where the light reflected toward each part of the model comes from
     /// and draw half of their continuations from it (PathGuide).
     bool path_guiding = false;

@@ -118,29 +118,28 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                                                  const VertexRng& rng,
                                                  const GuidedBsdf* continuation) const {
     const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
-    const int side = PathGuide::SideOf(Dot(h.ns, wo) >= 0 ? h.ns : -h.ns);
+    const int side = PathGuide::SideSeenFrom(h.ns, wo);
     const SkyWindows::Region* region = windows_ ? windows_->Find(h.p, side) : nullptr;
     // With a learned region, kLearnedSkyShare of the samples from it and the rest split as
     // without: u_strategy below kLearnedSkyShare picks a learned window, above it is rescaled.
     float u_strategy = rng.Uniform(dim + 2);
-    Vec3f wi;
+    const Point2f u(rng.Uniform(dim), rng.Uniform(dim + 1));
+    std::optional<Vec3f> on_window;  // the point aimed at, when a window was chosen
     if (region != nullptr && u_strategy < kLearnedSkyShare) {
-        const Vec3f q = windows_->SamplePoint(*region, rng.Uniform(dim + 3),
-                                              Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
-        const float d = Length(q - h.p);
-        if (!(d > 0)) return std::nullopt;
-        wi = (q - h.p) / d;
-    } else if (portals_ != nullptr &&
-               (region == nullptr
-                    ? u_strategy
-                    : (u_strategy - kLearnedSkyShare) / (1 - kLearnedSkyShare)) < kPortalSkyShare) {
-        const Vec3f q = portals_->SamplePoint(rng.Uniform(dim + 3),
-                                              Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
-        const float d = Length(q - h.p);
-        if (!(d > 0)) return std::nullopt;
-        wi = (q - h.p) / d;
+        on_window = windows_->SamplePoint(*region, rng.Uniform(dim + 3), u);
     } else {
-        wi = SkyLight::SampleUniform(Point2f(rng.Uniform(dim), rng.Uniform(dim + 1)));
+        if (region != nullptr)
+            u_strategy = (u_strategy - kLearnedSkyShare) / (1 - kLearnedSkyShare);
+        if (portals_ != nullptr && u_strategy < kPortalSkyShare)
+            on_window = portals_->SamplePoint(rng.Uniform(dim + 3), u);
+    }
+    Vec3f wi;
+    if (on_window) {
+        const float d = Length(*on_window - h.p);
+        if (!(d > 0)) return std::nullopt;
+        wi = (*on_window - h.p) / d;
+    } else {
+        wi = SkyLight::SampleUniform(u);
     }
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;

@@ -77,6 +77,11 @@ class PathGuide {
     /// The side of a surface whose normal, turned toward the path, is `n`: its largest axis and
     /// that axis' sign.
     static int SideOf(const Vec3f& n);
+    /// The side of a surface of normal `n` seen from direction `w` (pointing away from it): n
+    /// turned toward w.
+    static int SideSeenFrom(const Vec3f& n, const Vec3f& w) {
+        return SideOf(Dot(n, w) >= 0 ? n : -n);
+    }
 
     /// The key that credits direction `w` (unit) at point `p` on a surface of side `side`, or
     /// kNoCredit outside the grid.

@@ -97,31 +97,27 @@ void SkyWindows::Update() {
     if (sums_.size() > kMaxPairs) Forget(sums_.size() - kMaxPairs * 3 / 4);
     // Every region's windows in window order (the map's order is not the same on every run, the
     // choice must be).
-    std::vector<uint64_t> keys;
-    keys.reserve(sums_.size());
-    for (const auto& entry : sums_) keys.push_back(entry.first);
-    std::sort(keys.begin(), keys.end());
+    const std::vector<std::pair<uint64_t, Sum>> sums = SortedSums();
     regions_.clear();
     choice_window_.clear();
     choice_probability_.clear();
     choice_cdf_.clear();
-    for (size_t i = 0; i < keys.size();) {
-        const uint32_t region = uint32_t(keys[i] >> 32);
+    for (size_t i = 0; i < sums.size();) {
+        const uint32_t region = uint32_t(sums[i].first >> 32);
         size_t j = i;
         uint64_t photons = 0;
         double total = 0;
-        for (; j < keys.size() && uint32_t(keys[j] >> 32) == region; ++j) {
-            const Sum& s = sums_[keys[j]];
-            photons += s.photons;
-            total += double(s.fixed);
+        for (; j < sums.size() && uint32_t(sums[j].first >> 32) == region; ++j) {
+            photons += sums[j].second.photons;
+            total += double(sums[j].second.fixed);
         }
         if (photons >= kMinPhotons && total > 0) {
             Region r{uint32_t(choice_window_.size()), uint32_t(j - i)};
             double cdf = 0;
             for (size_t k = i; k < j; ++k) {
-                const double p = double(sums_[keys[k]].fixed) / total;
+                const double p = double(sums[k].second.fixed) / total;
                 cdf += p;
-                choice_window_.push_back(uint32_t(keys[k] & 0xffffffffu));
+                choice_window_.push_back(uint32_t(sums[k].first & 0xffffffffu));
                 choice_probability_.push_back(float(p));
                 choice_cdf_.push_back(float(cdf));
             }
@@ -130,6 +126,13 @@ void SkyWindows::Update() {
         }
         i = j;
     }
+}
+
+std::vector<std::pair<uint64_t, SkyWindows::Sum>> SkyWindows::SortedSums() const {
+    std::vector<std::pair<uint64_t, Sum>> sorted(sums_.begin(), sums_.end());
+    std::sort(sorted.begin(), sorted.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    return sorted;
 }
 
 void SkyWindows::Forget(size_t count) {
@@ -183,13 +186,9 @@ uint64_t SkyWindows::MemoryBytes() const {
 }
 
 void SkyWindows::SaveState(ByteWriter* out) const {
-    std::vector<uint64_t> keys;
-    keys.reserve(sums_.size());
-    for (const auto& entry : sums_) keys.push_back(entry.first);
-    std::sort(keys.begin(), keys.end());
-    out->Put(uint64_t(keys.size()));
-    for (uint64_t key : keys) {
-        const Sum& s = sums_.at(key);
+    const std::vector<std::pair<uint64_t, Sum>> sums = SortedSums();
+    out->Put(uint64_t(sums.size()));
+    for (const auto& [key, s] : sums) {
         out->Put(key);
         out->Put(s.fixed);
         out->Put(s.photons);

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "src/core/byte_stream.h"
@@ -88,6 +89,8 @@ class SkyWindows {
         uint32_t photons = 0;
     };
     struct ThreadSums;
+    /// The sums in key order: region, then window.
+    std::vector<std::pair<uint64_t, Sum>> SortedSums() const;
     /// Forgets the `count` sums of the fewest photons (ties by key: the same on every run).
     void Forget(size_t count);
     /// The region key of `p` and `side`, or kNoRegion outside the bounds.
