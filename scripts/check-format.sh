@@ -3,8 +3,13 @@
 # lay them out. `scripts/check-format.sh --fix` formats them instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup-debian.sh clang-format
+bash scripts/setup-debian.sh clang-format git
 mapfile -t files < <(git ls-files '*.cpp' '*.h')
+if ((${#files[@]} == 0)); then
+  # clang-format with no file reads its standard input: it would pass whatever the sources are.
+  echo "nave: check-format found no C++ source through git ls-files (run it in a git checkout)" >&2
+  exit 1
+fi
 if [[ ${1:-} == --fix ]]; then
   clang-format -i "${files[@]}"
   exit 0

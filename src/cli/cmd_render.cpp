@@ -26,6 +26,7 @@
 #include "src/render/scene/scene_config.h"
 #include "src/render/stream/memory_plan.h"
 #include "src/render/stream/pager.h"
+#include "src/render/transport/visible_points.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {
@@ -176,7 +177,7 @@ Status PlanMemory(const RenderOptions& o, uint64_t memory_bytes, const render::S
     inputs.state = render::RenderStateMemory(
         scene->settings, config.camera.width, config.camera.height,
         config.output.aov_albedo || config.output.aov_normal || config.output.aov_depth,
-        checkpoints);
+        checkpoints, render::UsesCausticPoints(scene->settings, scene->materials));
     inputs.texture_cache_bytes = textures ? textures->max_memory_bytes() : 0;
     inputs.image_library_loaded = textures != nullptr;
     NAVE_ASSIGN_OR_RETURN(render::RenderMemoryPlan plan, render::RenderMemoryPlan::Make(inputs));

@@ -80,8 +80,15 @@ TEST(RenderMemoryPlanTest, RenderStateCountsTheFilmAndTheModesState) {
     photon.photons_per_iteration = 100000;
     state = RenderStateMemory(photon, 64, 48, true, true);
     EXPECT_EQ(state.transport,
-              VisiblePoints::MemoryBytes(64 * 48) + PhotonEmitters::LearningBytes(100000));
+              VisiblePoints::MemoryBytes(64 * 48, false) + PhotonEmitters::LearningBytes(100000));
     EXPECT_EQ(state.checkpoint, CheckpointMemoryBytes(photon, 64, 48, true));
+    // Caustic points (final gathering in a scene with smooth glass or metal): a second point per
+    // pixel, not a second pixel state.
+    const uint64_t caustic_extra =
+        RenderStateMemory(photon, 64, 48, true, true, /*caustic_points=*/true).transport -
+        state.transport;
+    EXPECT_GT(caustic_extra, 0u);
+    EXPECT_LT(caustic_extra, VisiblePoints::MemoryBytes(64 * 48, false));
 
     // The plan reserves them.
     RenderMemoryInputs in = SmallModel();

@@ -89,6 +89,7 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
 
 void CameraPaths::Escape(const RayRecord& r) {
     if (progress_ != nullptr) progress_->Add(1);  // the path ends here
+    if (CausticFromPhotons(r)) return;
     SampledSpectrum L;
     if (scene_.sky) {
         // The sky is also next-event estimated: weight the BSDF-sampled escape against it, at the
@@ -176,7 +177,7 @@ bool CameraPaths::ShadePath(RayRecord& r, uint32_t b, const ResidentBrick& brick
     const SurfaceMaterial& mat = *h.material;
     AbsorbInsideGlass(mat, h, &r);
     if (r.depth == 0) film_->AddAov(r.pixel, Vec3f(1, 1, 1) * mat.AlbedoForAov(), h.ns, hit.t);
-    if (mat.emissive) {
+    if (mat.emissive && !CausticFromPhotons(r)) {
         // Emission found by the path itself (two-sided; emissive surfaces are not light-sampled, so
         // weight 1). In photon mode paths stop at their first diffuse vertex, so this only sees
         // specular and glossy chains; light reaching diffuse vertices from emitters comes with the
@@ -222,6 +223,8 @@ bool CameraPaths::Continue(RayRecord& r, const SurfaceHit& h, const GuidedBsdf& 
     if (IsPassThrough(*h.material, *bs)) return PassThrough(r, h, bs->wi);
     if (last) return false;
     r.flags = uint8_t((r.flags & ~kSpecularBounce) | (bs->IsSpecular() ? kSpecularBounce : 0));
+    if (r.flags & kGathering)
+        r.flags = ExtendSpecularChain(r.flags, bs->IsSpecular() && h.material->MakesCaustics());
     r.guide_side = uint8_t(side);
     r.prev_pdf = bs->pdf;
     if (r.depth >= 2) {

@@ -87,6 +87,12 @@ class CameraPaths : public RayProcessor {
     /// A path leaving the model: the sky and the sun it finds, weighted against their next-event
     /// estimation.
     void Escape(const RayRecord& r);
+    /// Whether light found by path `r` is a caustic that photon mode's caustic points count
+    /// already: a gathering path whose every bounce past its first diffuse vertex was specular
+    /// (visible_points.h). Path mode never gathers.
+    static bool CausticFromPhotons(const RayRecord& r) {
+        return (r.flags & kGathering) && (r.flags & kSpecularChain);
+    }
     /// A shadow ray that reached its light: its contribution to the film and, for a guided path,
     /// to the guide.
     void AddShadowContribution(const RayRecord& r);

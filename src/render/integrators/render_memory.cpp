@@ -10,13 +10,13 @@
 namespace nave::render {
 
 RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, int height, bool aov,
-                                   bool checkpoints) {
+                                   bool checkpoints, bool caustic_points) {
     const uint64_t pixels = uint64_t(width) * uint64_t(height);
     RenderStateBytes state;
     state.film = Film::MemoryBytes(width, height);
     if (settings.mode == RenderSettings::Mode::kPhoton) {
         // The visible points and what the photon emitters learn from.
-        state.transport = VisiblePoints::MemoryBytes(pixels) +
+        state.transport = VisiblePoints::MemoryBytes(pixels, caustic_points) +
                           PhotonEmitters::LearningBytes(settings.photons_per_iteration);
         // The windows the sky's photons teach its next-event estimation.
         if (settings.LearnsSkyWindows()) state.transport += SkyWindows::kMemoryReserveBytes;

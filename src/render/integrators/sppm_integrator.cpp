@@ -52,9 +52,9 @@ SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamSched
       scheduler_(scheduler),
       emitters_(std::move(emitters)),
       lights_(std::move(lights)),
-      visible_(std::make_unique<VisiblePoints>(film->pixel_count(), scene.source->brick_count(),
-                                               InitialRadius(scene, *emitters_),
-                                               scene.settings.alpha)),
+      visible_(std::make_unique<VisiblePoints>(
+          film->pixel_count(), scene.source->brick_count(), InitialRadius(scene, *emitters_),
+          scene.settings.alpha, UsesCausticPoints(scene.settings, scene.materials))),
       gather_guide_(std::move(gather_guide)),
       camera_pass_(scene, film, scheduler, *lights_, visible_.get(), gather_guide_.get()),
       sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons),
@@ -215,7 +215,8 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
         (flags & kBxdfDiffuse)) {
         const float added = visible_->Deposit(
             b, h.p, h.ng, wo, r.beta, r.lambda,
-            VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)));
+            VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)),
+            (r.flags & kSpecularChain) != 0);
         // One writer per photon: a photon is traced by one thread at a time.
         if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
     }
@@ -253,6 +254,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     float q = std::max(0.f, 1 - beta.Average() / std::max(1e-20f, r.beta.Average()));
     if (rng.Uniform(kDimRoulette) < q) return false;
     r.beta = beta / (1 - q);
+    r.flags = ExtendSpecularChain(r.flags, bs->IsSpecular() && mat.MakesCaustics());
     return Bounce(r, h, bs->wi);
 }
 

@@ -39,8 +39,15 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
         const GuidedBsdf gather(bsdf, gather_guide_, h.p, side);
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, &gather, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);
-        r.flags |= kGathering;
-        return Continue(r, h, gather, rng, side, last);
+        // Caustics here come from the caustic photons (visible_points.h): the gather finds them
+        // only by chance.
+        if (visible_points_->caustic_points()) {
+            visible_points_->AddCaustic(r.pixel, h.p, h.ns, wo, mat, h.has_uv ? &h.uv : nullptr,
+                                        h.footprint, r.beta, r.lambda);
+        }
+        const bool goes_on = Continue(r, h, gather, rng, side, last);
+        r.flags |= kGathering;  // after the gather bounce, which is no link of a specular chain
+        return goes_on;
     }
     if (flags & kBxdfDiffuse) {
         // Where a gather bounce landed, every photon arriving is light leaving toward the first

@@ -26,6 +26,15 @@ float SurfaceMaterial::AlbedoForAov() const {
     return 1;
 }
 
+bool SurfaceMaterial::MakesCaustics() const {
+    if (black) return false;
+    if (const auto* d = std::get_if<DielectricMaterial>(&material))
+        return TrowbridgeReitz(d->alpha, d->alpha).EffectivelySmooth();
+    if (const auto* c = std::get_if<ConductorMaterial>(&material))
+        return TrowbridgeReitz(c->alpha_x, c->alpha_y).EffectivelySmooth();
+    return false;
+}
+
 Spectrum HorizontalIrradiance(const RenderScene& scene) {
     std::vector<double> e(Spectrum::kNumSamples, 0.0);
     if (scene.sky) scene.sky->AddHorizontalIrradiance(&e);

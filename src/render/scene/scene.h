@@ -99,6 +99,10 @@ struct SurfaceMaterial {
     }
     /// Diffuse albedo at 550 nm for the albedo AOV (1 for specular materials, 0 for black).
     float AlbedoForAov() const;
+    /// Whether a specular bounce here bends or mirrors light into caustics: smooth solid glass and
+    /// smooth metal. Thin glass does not: light passes through a pane unbent, and the faint image
+    /// it mirrors is left to the paths that find it.
+    bool MakesCaustics() const;
 };
 
 struct RenderScene {

@@ -24,7 +24,18 @@ enum RayFlags : uint8_t {
     kFromSky = 1 << 2,    ///< photon from the sky
     kGathering = 1 << 3,  ///< photon mode's camera path past its first diffuse vertex, looking for
                           ///< the vertex whose photons it reads (render.final_gather)
+    /// Photons: every bounce so far was specular, and there was one (a caustic photon, Jensen
+    /// 1996). Gathering camera paths: every bounce past the first diffuse vertex was, and there was
+    /// one.
+    kSpecularChain = 1 << 4,
+    kChainBroken = 1 << 5,  ///< a non-specular bounce happened where kSpecularChain looks
 };
+
+/// Follows kSpecularChain across a bounce that was `specular` or not.
+inline uint8_t ExtendSpecularChain(uint8_t flags, bool specular) {
+    if (!specular) return uint8_t((flags & ~kSpecularChain) | kChainBroken);
+    return (flags & kChainBroken) ? flags : uint8_t(flags | kSpecularChain);
+}
 
 struct RayRecord {
     Vec3f origin;

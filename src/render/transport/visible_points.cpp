@@ -15,8 +15,8 @@
 namespace nave::render {
 
 VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius,
-                             float alpha)
-    : points_(pixel_count),
+                             float alpha, bool caustic_points)
+    : points_(pixel_count * (caustic_points ? 2 : 1)),
       pixels_(new PixelState[pixel_count]),
       pixel_count_(pixel_count),
       radius_(initial_radius),
@@ -25,6 +25,13 @@ VisiblePoints::VisiblePoints(size_t pixel_count, uint32_t brick_count, float ini
     for (size_t i = 0; i < pixel_count; ++i) {
         for (auto& f : pixels_[i].phi) f.store(0, std::memory_order_relaxed);
     }
+}
+
+bool UsesCausticPoints(const RenderSettings& settings,
+                       const std::vector<SurfaceMaterial>& materials) {
+    return settings.mode == RenderSettings::Mode::kPhoton && settings.final_gather &&
+           std::any_of(materials.begin(), materials.end(),
+                       [](const SurfaceMaterial& m) { return m.MakesCaustics(); });
 }
 
 SampledWavelengths IterationWavelengths(uint64_t seed, uint32_t iteration, int channel) {
@@ -51,7 +58,21 @@ void VisiblePoints::Add(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const V
                         const SurfaceMaterial& material, const std::array<float, 2>* uv,
                         const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
                         const SampledWavelengths& lambda) {
-    Point& vp = points_[pixel];
+    Set(&points_[pixel], pixel, p, ns, wo, material, uv, footprint, beta, lambda);
+}
+
+void VisiblePoints::AddCaustic(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
+                               const SurfaceMaterial& material, const std::array<float, 2>* uv,
+                               const imaging::TextureFootprint& footprint,
+                               const SampledSpectrum& beta, const SampledWavelengths& lambda) {
+    Set(&points_[pixel_count_ + pixel], pixel, p, ns, wo, material, uv, footprint, beta, lambda);
+}
+
+void VisiblePoints::Set(Point* point, uint32_t pixel, const Vec3f& p, const Vec3f& ns,
+                        const Vec3f& wo, const SurfaceMaterial& material,
+                        const std::array<float, 2>* uv, const imaging::TextureFootprint& footprint,
+                        const SampledSpectrum& beta, const SampledWavelengths& lambda) {
+    Point& vp = *point;
     vp.footprint = footprint;
     vp.has_uv = uv != nullptr;
     if (uv != nullptr) vp.uv = *uv;
@@ -115,7 +136,7 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
     if (radius_ <= 0) return;
     for (BrickGrid& g : grids_) g.cell = 2 * radius_;
     std::vector<uint32_t> bricks;
-    for (size_t i = 0; i < pixel_count_; ++i) {
+    for (size_t i = 0; i < points_.size(); ++i) {
         const Point& vp = points_[i];
         if (!vp.valid) continue;
         const float r = radius_;
@@ -141,19 +162,23 @@ void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
 
 float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
                              const SampledSpectrum& beta, const SampledWavelengths& lambda,
-                             int channel) {
+                             int channel, bool caustic) {
     const BrickGrid& g = grids_[brick];
     auto it = g.cells.find(CellKey(p, g.cell));
     if (it == g.cells.end()) return 0;
     float added = 0;
     for (uint32_t i : it->second) {
+        // Caustic points follow the visible points, a pixel's at pixel_count_ + pixel.
+        const bool caustic_point = i >= pixel_count_;
+        if (caustic_point && !caustic) continue;
+        const uint32_t pixel = caustic_point ? uint32_t(i - pixel_count_) : i;
         const Point& vp = points_[i];
-        PixelState& px = pixels_[i];
+        PixelState& px = pixels_[pixel];
         Vec3f d = vp.p - p;
         if (Dot(d, d) > radius_ * radius_) continue;
         if (vp.throughput == Throughput::kHeroOnly) continue;
         if ((vp.throughput == Throughput::kHeroShared) != (channel != kOwnWavelengths)) continue;
-        if (channel != kOwnWavelengths && PixelChannel(i) != channel) continue;
+        if (channel != kOwnWavelengths && PixelChannel(pixel) != channel) continue;
         if (std::abs(Dot(ng, vp.ns)) < kSameSurfaceCos) continue;
         Vec3d xyz;
         if (vp.throughput == Throughput::kHeroShared) {
@@ -187,7 +212,7 @@ void VisiblePoints::EndIteration(int half) {
     const double area = std::numbers::pi * double(radius_) * radius_;
     for (size_t i = 0; i < pixel_count_; ++i) {
         PixelState& px = pixels_[i];
-        if (points_[i].valid) {
+        if (points_[i].valid || (caustic_points() && points_[pixel_count_ + i].valid)) {
             Vec3d density;
             for (int c = 0; c < 3; ++c)
                 density[c] = px.phi[c].load(std::memory_order_relaxed) / area;

@@ -38,6 +38,16 @@
 // Visible points are kept per brick: a point is registered in every brick whose cell its gather
 // sphere overlaps, so a photon landing in a brick finds all the points it can reach in that brick's
 // own grid.
+//
+// With final gathering (render.final_gather) the visible point lies one bounce past the first
+// diffuse vertex, and light reaching that vertex through a chain of specular bounces (a caustic:
+// sunlight through a glass ball, off a mirror) is found neither by its next-event estimation nor,
+// but by chance, by the gather bounce. So, as in Jensen 1996 ("Global illumination using photon
+// maps", 3.3: caustics from a separate map, seen directly), each pixel then has a second, caustic
+// point at the first diffuse vertex that takes only the photons whose every bounce was specular
+// (kSpecularChain), and a gathering path that finds light at the end of a specular chain drops it
+// (the caustic point has it). Only scenes with a material that makes caustics
+// (SurfaceMaterial::MakesCaustics) have them.
 
 #include <array>
 #include <atomic>
@@ -56,18 +66,23 @@
 namespace nave::render {
 
 struct SurfaceMaterial;
+struct RenderSettings;
 
 class VisiblePoints {
   public:
-    /// `initial_radius`: r_1 in metres; `alpha`: the schedule's alpha in (0, 1].
-    VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius, float alpha);
+    /// `initial_radius`: r_1 in metres; `alpha`: the schedule's alpha in (0, 1];
+    /// `caustic_points`: a caustic point per pixel besides its visible point (UsesCausticPoints).
+    VisiblePoints(size_t pixel_count, uint32_t brick_count, float initial_radius, float alpha,
+                  bool caustic_points = false);
 
-    /// The bytes the visible points of `pixel_count` pixels take: a point and a pixel state each,
-    /// and their references in the brick grids (a gather sphere overlaps up to 8 cells of the
-    /// grid, whose vectors grow by doubling).
-    static uint64_t MemoryBytes(uint64_t pixel_count) {
-        return pixel_count * (sizeof(Point) + sizeof(PixelState) + 2 * 8 * sizeof(uint32_t) + 32);
+    /// The bytes the visible points of `pixel_count` pixels take: a point (two with
+    /// `caustic_points`) and a pixel state each, and the points' references in the brick grids (a
+    /// gather sphere overlaps up to 8 cells of the grid, whose vectors grow by doubling).
+    static uint64_t MemoryBytes(uint64_t pixel_count, bool caustic_points) {
+        const uint64_t per_point = sizeof(Point) + 2 * 8 * sizeof(uint32_t) + 32;
+        return pixel_count * (sizeof(PixelState) + per_point * (caustic_points ? 2 : 1));
     }
+    bool caustic_points() const { return points_.size() > pixel_count_; }
 
     /// Starts iteration `iteration` of `photons` photons (its shared wavelengths are
     /// IterationWavelengths(seed, iteration, channel)): forgets the previous visible points.
@@ -88,6 +103,12 @@ class VisiblePoints {
              const SurfaceMaterial& material, const std::array<float, 2>* uv,
              const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
              const SampledWavelengths& lambda);
+    /// Records pixel's caustic point (as Add; only with caustic_points()): the first diffuse
+    /// vertex of a gathering camera path, lit by caustic photons only.
+    void AddCaustic(uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
+                    const SurfaceMaterial& material, const std::array<float, 2>* uv,
+                    const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
+                    const SampledWavelengths& lambda);
     /// Registers every visible point in the bricks its gather sphere overlaps (after the camera
     /// pass).
     void BuildBrickGrids(const store::BrickTree& tree);
@@ -97,9 +118,11 @@ class VisiblePoints {
     /// radius whose surface faces the same way (|ng . ns| >= kSameSurfaceCos); returns the
     /// luminance it added. Thread-safe.
     /// `channel`: PhotonChannel of the photon; one on shared wavelengths lights only the points
-    /// seen through dispersive glass of its channel.
+    /// seen through dispersive glass of its channel. `caustic`: the photon's every bounce was
+    /// specular (kSpecularChain); only such photons light caustic points.
     float Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, const Vec3f& wi,
-                  const SampledSpectrum& beta, const SampledWavelengths& lambda, int channel);
+                  const SampledSpectrum& beta, const SampledWavelengths& lambda, int channel,
+                  bool caustic = false);
     /// A photon counts at a visible point only if their surfaces are within ~70 degrees of each
     /// other: the density estimate divides by the area of a flat disc, so photons on a wall must
     /// not add to the floor in the corner below it (Jensen 2001, "Realistic image synthesis using
@@ -164,8 +187,12 @@ class VisiblePoints {
         std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
     };
     uint64_t CellKey(const Vec3f& p, float cell) const;
+    void Set(Point* vp, uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
+             const SurfaceMaterial& material, const std::array<float, 2>* uv,
+             const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
+             const SampledWavelengths& lambda);
 
-    std::vector<Point> points_;
+    std::vector<Point> points_;  // the pixels' visible points, then their caustic points if any
     std::array<SampledWavelengths, kWavelengthChannels> shared_lambda_;  // the iteration's
     // How many photons each photon on a channel's shared wavelengths, and each other one, stands
     // for.
@@ -184,5 +211,10 @@ class VisiblePoints {
 /// (visible_points.h): the same for all its camera paths and photons that take them, a sample of
 /// the visible distribution drawn from (seed, iteration, channel).
 SampledWavelengths IterationWavelengths(uint64_t seed, uint32_t iteration, int channel);
+
+/// Whether photon mode with final gathering keeps caustic points: some material of `materials`
+/// makes caustics (visible_points.h).
+bool UsesCausticPoints(const RenderSettings& settings,
+                       const std::vector<SurfaceMaterial>& materials);
 
 }  // namespace nave::render
