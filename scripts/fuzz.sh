@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds nave's libFuzzer targets (preset `fuzz`: clang, ASan + UBSan) and runs each for SECONDS on a
-# seed corpus made from the test fixtures, in a scratch copy (the repository is never modified).
+# Builds nave's libFuzzer targets (build preset `fuzz` of the `asan` configuration: clang, ASan +
+# UBSan, the same build as `scripts/test.sh asan`'s) and runs each for SECONDS on a seed corpus made from the test fixtures, in a scratch copy (the repository is never modified).
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     default: 10 seconds, every target but fuzz_assimp_in_process
 #
@@ -23,9 +23,9 @@ if ((${#targets[@]} == 0)); then
 fi
 
 bash scripts/setup-debian.sh clang  # clang 14 and its libFuzzer runtime (Debian 12), for the preset only
-cmake --preset fuzz >/dev/null
+cmake --preset asan >/dev/null
 cmake --build --preset fuzz -j "$(nproc)"
-bin=build/fuzz/tests/fuzz
+bin=build/asan/tests/fuzz
 
 work=${NAVE_FUZZ_WORK:-}
 keep_work=1

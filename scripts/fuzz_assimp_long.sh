@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=$1
 runs=${2:-1000000}
-bin=$PWD/build/fuzz/tests/fuzz/fuzz_assimp_in_process
+bin=$PWD/build/asan/tests/fuzz/fuzz_assimp_in_process
 [[ -x $bin ]] || { echo "fuzz_assimp_long.sh: $bin missing: run scripts/fuzz.sh first (above)" >&2; exit 2; }
 [[ -d $dir/corpus ]] || { echo "fuzz_assimp_long.sh: $dir/corpus missing: seed it with scripts/fuzz.sh (above)" >&2; exit 2; }
 cd "$dir"

@@ -471,7 +471,7 @@ std::vector<AbbeyPart> AbbeyParts(const Detail& detail) {
                 EmitSlateRoof(
                     em, r, x1 - x0, std::hypot(y_low - y_high, z_high - z_low),
                     [=](const Vec3d&) { return Vec3d(0, s * (z_high - z_low), y_low - y_high); }, d,
-                    30 + (s > 0) + uint64_t(x0));
+                    30 + (s > 0) + uint64_t(int64_t(x0)));  // x0 < 0 on one side: via int64
             }
         });
     }

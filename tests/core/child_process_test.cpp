@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/sanitizers.h"
 #include "src/core/memory.h"
 
 namespace nave {
@@ -101,7 +102,7 @@ TEST(ChildProcess, AddressSpaceIsCappedByTheAvailableMemory) {
     EXPECT_NE(limit, uint64_t(RLIM_INFINITY));
     EXPECT_GT(limit, parent_size);
     EXPECT_LE(limit, parent_size + PhysicalMemoryBytes() + (uint64_t(64) << 20));  // + statm drift
-#if !defined(__SANITIZE_ADDRESS__)  // ASan's allocator aborts on such a size instead of failing it
+#if !NAVE_TEST_UNDER_ASAN  // ASan's allocator aborts on such a size instead of failing it
     // And an allocation beyond it fails in the child instead of being granted.
     auto greedy = RunInChildProcess([](int) {
         try {

@@ -9,6 +9,7 @@
 
 #include "common/file_size_limit.h"
 #include "common/run_nave.h"
+#include "common/sanitizers.h"
 #include "pager_test_scene.h"
 #include "render_test_util.h"
 #include "src/core/memory.h"
@@ -86,7 +87,7 @@ TEST(PagerCliTest, NaveAllocatesWithJemalloc) {
 // at exit, image writing included) at the smallest budget nave accepts, halfway to in-core, and
 // with room for every brick: a store of 6 x 6 dense balls in 72 bricks.
 TEST(PagerCliTest, WholeProcessPeakStaysWithinTheBudget) {
-#if defined(__SANITIZE_ADDRESS__)
+#if NAVE_TEST_UNDER_ASAN
     GTEST_SKIP() << "AddressSanitizer's shadow memory and quarantine are not in nave's budget";
 #endif
     const auto dir =
