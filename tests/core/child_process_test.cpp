@@ -121,6 +121,7 @@ TEST(ChildProcess, AddressSpaceIsCappedByTheAvailableMemory) {
 TEST(ChildProcess, WorksFromAProcessWithOtherThreadsRunning) {
     std::atomic<bool> stop{false};
     std::vector<std::thread> busy;
+    busy.reserve(3);
     for (int t = 0; t < 3; ++t) {
         busy.emplace_back([&] {
             while (!stop) {

@@ -187,7 +187,7 @@ class VisiblePoints {
         std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
     };
     uint64_t CellKey(const Vec3f& p, float cell) const;
-    void Set(Point* vp, uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
+    void Set(Point* point, uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
              const SurfaceMaterial& material, const std::array<float, 2>* uv,
              const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
              const SampledWavelengths& lambda);
