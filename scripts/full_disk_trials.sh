@@ -106,7 +106,7 @@ judge() {
 # far too small to comfortably enough.
 sizes_for() {
     awk -v need="$1" -v base="${2:-0}" 'BEGIN {
-        n = split("0.01 0.05 0.15 0.3 0.5 0.7 0.85 0.95 1.05 1.3 2.0", f, " ")
+        n = split("0.01 0.15 0.5 0.85 0.95 1.05 2.0", f, " ")
         for (i = 1; i <= n; i++) { s = base + int(need * f[i]); if (s < 16384) s = 16384; print s }
     }'
 }

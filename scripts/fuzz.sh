@@ -22,7 +22,7 @@ if ((${#targets[@]} == 0)); then
            fuzz_scene_config)
 fi
 
-bash scripts/setup-debian.sh clang  # clang 14 and its libFuzzer runtime (Debian 12), for the preset only
+bash scripts/setup-debian.sh clang libclang-rt-14-dev  # clang 14, its sanitizer and libFuzzer runtimes (Debian 12)
 cmake --preset asan >/dev/null
 cmake --build --preset fuzz -j "$(nproc)"
 bin=build/asan/tests/fuzz

@@ -9,7 +9,7 @@ preset=${1:-release}
 if [[ ${CI:-} == true && $preset == release ]]; then preset=ci; fi  # warnings are errors in CI
 if [[ $preset == tsan ]]; then bash scripts/tsan-tbb.sh; fi
 # The sanitizer build is clang's, so that the fuzz targets (libFuzzer ships with clang) come from it too.
-if [[ $preset == asan ]]; then bash scripts/setup-debian.sh clang; fi
+if [[ $preset == asan ]]; then bash scripts/setup-debian.sh clang libclang-rt-14-dev; fi
 bash scripts/build.sh "$preset"
 if [[ -n ${NAVE_TEST_LABEL:-} ]]; then
   ctest --test-dir "build/$preset" --output-on-failure -j "$(nproc)" -L "$NAVE_TEST_LABEL"
