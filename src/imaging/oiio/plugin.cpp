@@ -97,6 +97,10 @@ class Plugin final : public OiioPlugin {
         std::error_code ec;
         if (!std::filesystem::exists(source, ec))
             return NotFoundError("{}: no such file", source.string());
+        // OpenEXR 3.1's tiled writer waits forever on its thread pool when a write fails (a full
+        // disk) with worker threads compressing tiles: seen as a preprocess that never returned in
+        // the full-disk trials. -1 turns OpenEXR's pool off (OpenImageIO's "exr_threads").
+        OIIO::attribute("exr_threads", -1);
         OIIO::ImageBuf in(source.string());
         if (!in.read(0, 0, /*force=*/true, OIIO::TypeFloat)) {
             Status st = OiioError(source, "unreadable", in.geterror());
