@@ -97,10 +97,6 @@ class Plugin final : public OiioPlugin {
         std::error_code ec;
         if (!std::filesystem::exists(source, ec))
             return NotFoundError("{}: no such file", source.string());
-        // OpenEXR 3.1's tiled writer waits forever on its thread pool when a write fails (a full
-        // disk) with worker threads compressing tiles: seen as a preprocess that never returned in
-        // the full-disk trials. -1 turns OpenEXR's pool off (OpenImageIO's "exr_threads").
-        OIIO::attribute("exr_threads", -1);
         OIIO::ImageBuf in(source.string());
         if (!in.read(0, 0, /*force=*/true, OIIO::TypeFloat)) {
             Status st = OiioError(source, "unreadable", in.geterror());
@@ -179,5 +175,10 @@ class Plugin final : public OiioPlugin {
 extern "C" __attribute__((visibility("default"))) nave::imaging::OiioPlugin* NaveCreateOiioPlugin(
     int version) {
     if (version != nave::imaging::kOiioPluginVersion) return nullptr;
+    // OpenEXR 3.1's writers wait forever on their thread pool when a write fails (a full disk)
+    // while worker threads compress: seen as a texture conversion that never returned in the
+    // full-disk trials. Every EXR nave writes (textures, images) goes through here, so the pool is
+    // turned off once, for all of them (-1: OpenImageIO's "exr_threads" without threads).
+    OIIO::attribute("exr_threads", -1);
     return new nave::imaging::oiio::Plugin();
 }
