@@ -202,5 +202,26 @@ TEST(RenderSummaryTest, TexturesInTheirOwnAttributeAndOnTheTerminal) {
         << Joined(lines);
 }
 
+TEST(RenderSummaryTest, PhotonModeSaysHowManyRegionsLearnedTheirWindows) {
+    RenderSettings settings;
+    settings.mode = RenderSettings::Mode::kPhoton;
+    settings.sky_sampling = RenderSettings::SkySampling::kPortals;
+    settings.photon_target = RenderSettings::PhotonTarget::kPortals;
+    RenderStats stats = BusyStats();
+    stats.iterations = 12;
+    stats.sky_window_regions = 1234;
+    auto noise_line = [&] {
+        RenderSummary summary(settings, stats, std::nullopt);
+        summary.RecordProcessPeak(10 * kMiB);
+        return summary.TerminalLines("")[2];
+    };
+    EXPECT_EQ(noise_line(),
+              "noise: estimated relMSE 0.0123 after 12 iterations; sky windows: 1234 regions "
+              "chose theirs");
+    // Without photons aimed at the portals nothing teaches the windows: nothing to say.
+    settings.photon_target = RenderSettings::PhotonTarget::kBounds;
+    EXPECT_EQ(noise_line(), "noise: estimated relMSE 0.0123 after 12 iterations");
+}
+
 }  // namespace
 }  // namespace nave::render

@@ -201,6 +201,11 @@ look_at = [0.0, 0.0, 0.0]
 up = [0, 0, 1]
 fov_deg = 70
 resolution = [24, 24]
+)" + RoomWithRoofWindowSkyAndMaterials();
+}
+
+std::string RoomWithRoofWindowSkyAndMaterials() {
+    return R"(
 [sky]
 radiance = 1.0
 [materials.floor]

@@ -140,5 +140,7 @@ store::BrickMesh RoomWithRoofWindow();
 /// RoomWithRoofWindow's camera (24 x 24), uniform sky and materials ("floor", "wall", and "window":
 /// thin glass and a portal), without a [render] table.
 std::string RoomWithRoofWindowScene();
+/// RoomWithRoofWindowScene without its [camera] table.
+std::string RoomWithRoofWindowSkyAndMaterials();
 
 }  // namespace nave::render::testing

@@ -67,6 +67,34 @@ TEST(SkyPortals, FinalGatherWithLearnedWindowsAgreesWithPathTracing) {
         << "path noise " << path.noise << ", photon noise " << photon.noise;
 }
 
+// The camera's shadow rays toward the sky teach the windows too. The camera looks straight down
+// at 2 cm of floor under the window, so that its 576 pixels fall in one or two regions (cells of
+// 4 m / 64); with 12 photons an iteration, at most 3 of which record a window (fewer than
+// SkyWindows::kMinPhotons), those regions have chosen their window after the first iteration only
+// if the shadow rays taught them.
+TEST(SkyPortals, TheCamerasShadowRaysTeachTheWindows) {
+    auto t = testing::Render(testing::RoomWithRoofWindow(), kMaterials, R"(
+[camera]
+position = [0.3, 0.3, 1.0]
+look_at = [0.3, 0.3, 0.0]
+up = [0, 1, 0]
+fov_deg = 1
+resolution = [24, 24]
+)" + testing::RoomWithRoofWindowSkyAndMaterials() + R"(
+[render]
+mode = "photon"
+final_gather = true
+sky_sampling = "portals"
+photon_target = "portals"
+iterations = 1
+photons_per_iteration = 12
+max_depth = 4
+)",
+                             2);
+    ASSERT_TRUE(t != nullptr);
+    EXPECT_GT(t->stats.sky_window_regions, 0u);
+}
+
 TEST(SkyPortals, PortalSamplingWithoutPortalsIsAnError) {
     std::string config = RoomConfig();
     config.replace(config.find("portal = true"), std::string("portal = true").size(), "");

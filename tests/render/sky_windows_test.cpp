@@ -86,6 +86,21 @@ TEST(SkyWindows, ARegionChoosesWindowsInProportionToTheLightTheyBrought) {
     EXPECT_NEAR(double(lower_half) / first, 0.5, 0.05);
 }
 
+TEST(SkyWindows, PhotonsAndShadowRaysTeachInTheirOwnUnits) {
+    // Photons of typical power 1 and shadow-ray estimates of typical light 100: each kind of
+    // record is counted against its own typical value, so 20 photons of power 1 through the first
+    // window and 20 estimates of 100 through the second bring as much.
+    TwoWindows w;
+    SkyWindows windows(*w.portals, w.source->bounds(), 1.0, 100.0);
+    for (int i = 0; i < 20; ++i) windows.Record(kInside, kUp, 0, 1.0);
+    for (int i = 0; i < 20; ++i) windows.RecordEstimate(kInside, kUp, 2, 100.0);
+    windows.Update();
+    const SkyWindows::Region* region = windows.Find(kInside, kUp);
+    ASSERT_NE(region, nullptr);
+    EXPECT_NEAR(windows.AreaDensity(*region, 0), 0.5 / 0.16, 1e-4);
+    EXPECT_NEAR(windows.AreaDensity(*region, 3), 0.5 / 0.16, 1e-4);
+}
+
 TEST(SkyWindows, TooFewPhotonsTeachNothing) {
     TwoWindows w;
     for (uint32_t i = 0; i + 1 < SkyWindows::kMinPhotons; ++i)

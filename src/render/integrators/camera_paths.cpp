@@ -127,6 +127,7 @@ void CameraPaths::Escape(const RayRecord& r) {
 
 void CameraPaths::AddShadowContribution(const RayRecord& r) {
     film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));
+    if (r.flags & kSkyShadow) lights_.LearnFromSkyShadow(r);
     if (guide_ != nullptr && r.guide_credit != PathGuide::kNoCredit)
         guide_->Credit(r.guide_credit, double(r.beta.Average()) * double(r.guide_scale));
 }

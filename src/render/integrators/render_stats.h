@@ -22,6 +22,8 @@ struct RenderStats : StreamStats {
     /// Path mode with render.path_guiding: the guide's cells with histograms, and those guiding.
     uint32_t guide_cells = 0;
     uint32_t guide_cells_guiding = 0;
+    /// With render.LearnsSkyWindows: the regions that chose their windows (SkyWindows::regions).
+    uint64_t sky_window_regions = 0;
 };
 
 }  // namespace nave::render

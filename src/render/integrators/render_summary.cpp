@@ -98,6 +98,7 @@ RenderSummary::RenderSummary(const RenderSettings& settings, const RenderStats& 
     Add(kTerminalOnly, "iterations", Unit::kCount, uint64_t(stats.iterations));
     Add(kTerminalOnly, "guide_cells", Unit::kCount, stats.guide_cells);
     Add(kTerminalOnly, "guide_cells_guiding", Unit::kCount, stats.guide_cells_guiding);
+    Add(kTerminalOnly, "sky_window_regions", Unit::kCount, stats.sky_window_regions);
 
     if (textures) {
         has_textures_ = true;
@@ -176,6 +177,9 @@ std::string RenderSummary::NoiseLine() const {
         line += fmt::format("; path guide: {} cells learning, {} guiding", Integer("guide_cells"),
                             Integer("guide_cells_guiding"));
     }
+    if (settings_.LearnsSkyWindows())
+        line +=
+            fmt::format("; sky windows: {} regions chose theirs", Integer("sky_window_regions"));
     return line;
 }
 

@@ -152,6 +152,8 @@ Status SppmIntegrator::Finish(int done, RenderStats* stats) {
     stats->samples_per_pixel = done;
     stats->camera_paths = pixels * uint64_t(done);
     stats->photons = emitted;
+    if (const SkyWindows* windows = lights_->sky_windows())
+        stats->sky_window_regions = windows->regions();
     return Status::Ok();
 }
 

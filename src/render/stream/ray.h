@@ -29,6 +29,9 @@ enum RayFlags : uint8_t {
     /// one.
     kSpecularChain = 1 << 4,
     kChainBroken = 1 << 5,  ///< a non-specular bounce happened where kSpecularChain looks
+    /// Shadow rays toward the sky (LightSampler::SampleSky): the ones that reach it teach the
+    /// sky's sampling its windows (LightSampler::LearnFromSkyShadow).
+    kSkyShadow = 1 << 6,
 };
 
 /// Follows kSpecularChain across a bounce that was `specular` or not.
@@ -50,8 +53,12 @@ struct RayRecord {
     uint8_t flags = 0;
     uint16_t vertex =
         0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
-    uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's surface
-    float prev_pdf = 0;  ///< solid-angle pdf of the last BSDF sample (MIS against the sun and sky)
+    uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
+                             ///< surface; sky shadow rays: that of their own vertex
+    /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky). Sky
+    /// shadow rays (kSkyShadow): what turns the contribution's average into the ray's estimate of
+    /// the light its window brings (LightSampler::LearnFromSkyShadow).
+    float prev_pdf = 0;
     float since_vertex =
         0;  ///< distance from the last scattering vertex to `origin` (passes through thin
             ///< glass move the origin along the ray; the sky's MIS needs the vertex)

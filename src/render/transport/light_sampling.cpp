@@ -59,11 +59,11 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
         }
         sampler->portals_ = photon_portals;
         if (photon_portals != nullptr) {
-            sampler->windows_ =
-                std::make_unique<SkyWindows>(*photon_portals, scene.source->bounds(), photon_power);
+            sampler->windows_ = std::make_unique<SkyWindows>(
+                *photon_portals, scene.source->bounds(), photon_power, TypicalWindowLight(scene));
             log::Info(
-                "sky through {} windows ({} portal triangles): the sky's photons teach "
-                "each region its own",
+                "sky through {} windows ({} portal triangles): the sky's photons and shadow rays "
+                "teach each region its own",
                 sampler->windows_->window_count(), photon_portals->triangle_count());
         }
         return sampler;
@@ -88,6 +88,16 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
                           SkyPortals::Build(*scene.source, std::move(triangles)));
     sampler->portals_ = sampler->own_portals_.get();
     return sampler;
+}
+
+double LightSampler::TypicalWindowLight(const RenderScene& scene) {
+    // The sky's brightest axis over a window of 0.01 sr (2 m² seen from 14 m).
+    const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
+    double radiance = 0;
+    for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
+                           Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
+        radiance = std::max(radiance, double(scene.sky->Radiance(w, green).Average()));
+    return radiance > 0 ? radiance * 0.01 : 1.0;
 }
 
 std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index,
@@ -150,12 +160,27 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                   : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
+    s.flags = uint8_t(r.flags | kSkyShadow);
+    s.guide_side = uint8_t(side);
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = kInfinity;
-    s.beta = r.beta * f * scene_.sky->Radiance(wi, r.lambda) * (w / light_pdf);
+    const SampledSpectrum radiance = scene_.sky->Radiance(wi, r.lambda);
+    s.beta = r.beta * f * radiance * (w / light_pdf);
     if (s.beta.IsZero()) return std::nullopt;
+    // What LearnFromSkyShadow turns the contribution into, once the panes on the way have dimmed
+    // it: radiance x |cos θ| / pdf, without the throughput, the BSDF or the MIS weight.
+    s.prev_pdf = radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
     return s;
+}
+
+void LightSampler::LearnFromSkyShadow(const RayRecord& shadow) const {
+    // A contribution so small that its factor overflowed teaches nothing worth its risk.
+    if (windows_ == nullptr || !(shadow.prev_pdf > 0) || !std::isfinite(shadow.prev_pdf)) return;
+    const std::optional<BrickHit> window = portals_->FirstCrossing(shadow.origin, shadow.dir);
+    if (!window) return;  // a uniform direction that no window lets in
+    windows_->RecordEstimate(shadow.origin, shadow.guide_side, window->triangle,
+                             double(shadow.beta.Average()) * double(shadow.prev_pdf));
 }
 
 float LightSampler::SkyPdf(const Vec3f& p, int side, const Vec3f& w) const {

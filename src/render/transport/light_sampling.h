@@ -112,13 +112,21 @@ class LightSampler {
     /// Veach 1997 §9.2 area-to-solid-angle conversion), and the region's learned windows, which
     /// sums d² / |cos θ| times the crossed triangle's SkyWindows::AreaDensity.
     float SkyPdf(const Vec3f& p, int side, const Vec3f& w) const;
-    /// Photon mode with portals: the windows the sky's photons teach (null otherwise). Record
-    /// into it while photons are traced; SkyWindows::Update between passes, never while the
-    /// sampler samples.
+    /// Photon mode with portals: the windows the sky's photons and shadow rays teach (null
+    /// otherwise). Record into it while photons are traced; SkyWindows::Update between passes,
+    /// never while the sampler samples.
     SkyWindows* sky_windows() const { return windows_.get(); }
+    /// A shadow ray of SampleSky (kSkyShadow) that reached the sky records, for its vertex's
+    /// region, the window it crossed and its estimate of that window's light there: the
+    /// contribution without the path's throughput, the BSDF or the MIS weight, that is the sky's
+    /// radiance x the panes' transmittance x |cos θ| / the pdf of its direction. Nothing without
+    /// sky_windows(). Thread-safe.
+    void LearnFromSkyShadow(const RayRecord& shadow) const;
 
   private:
     explicit LightSampler(const RenderScene& scene) : scene_(scene) {}
+    /// The order of a shadow ray's estimate of a window's light in `scene` (SkyWindows' scale).
+    static double TypicalWindowLight(const RenderScene& scene);
 
     // Sky next-event estimation toward the portals: this share of the samples, the rest uniform
     // (which keeps light that enters elsewhere, and vertices outside, sampled).

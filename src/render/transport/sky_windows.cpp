@@ -15,12 +15,14 @@ struct SkyWindows::ThreadSums {
     tbb::enumerable_thread_specific<std::unordered_map<uint64_t, Sum>> local;
 };
 
-SkyWindows::SkyWindows(const SkyPortals& portals, const Bounds3f& bounds, double photon_power)
+SkyWindows::SkyWindows(const SkyPortals& portals, const Bounds3f& bounds, double photon_power,
+                       double estimate_power)
     : portals_(portals),
       bounds_(bounds),
-      // A typical photon is about 2^20 units: sums of billions of photons stay far from 2^64, and
-      // a photon a millionth as bright still counts.
-      to_fixed_(photon_power > 0 ? double(1 << 20) / photon_power : 1.0),
+      // A typical photon or estimate is about 2^20 units: sums of billions of records stay far
+      // from 2^64, and a record a millionth as bright still counts.
+      photon_to_fixed_(photon_power > 0 ? double(1 << 20) / photon_power : 1.0),
+      estimate_to_fixed_(estimate_power > 0 ? double(1 << 20) / estimate_power : 1.0),
       pending_(std::make_unique<ThreadSums>()) {
     const Vec3f extent = bounds.max - bounds.min;
     const float longest = std::max({extent.x, extent.y, extent.z, 1e-6f});
@@ -76,12 +78,12 @@ uint32_t SkyWindows::RegionKey(const Vec3f& p, int side) const {
            uint32_t(side);
 }
 
-void SkyWindows::Record(const Vec3f& p, int side, uint32_t triangle, double power) {
+void SkyWindows::RecordFixed(const Vec3f& p, int side, uint32_t triangle, double fixed) {
     const uint32_t region = RegionKey(p, side);
-    if (region == kNoRegion || triangle >= triangle_window_.size() || !(power > 0)) return;
+    if (region == kNoRegion || triangle >= triangle_window_.size() || !(fixed > 0)) return;
     const uint64_t key = (uint64_t(region) << 32) | triangle_window_[triangle];
     Sum& s = pending_->local.local()[key];
-    s.fixed += uint64_t(std::llround(std::min(power * to_fixed_, 1e15)));
+    s.fixed += uint64_t(std::llround(std::min(fixed, 1e15)));
     s.photons += 1;
 }
 

@@ -10,9 +10,15 @@
 // window's contribution (solid angle x radiance x transmittance x cosine x visibility) without
 // modelling any of them. Next-event estimation then picks a window in proportion to it (Vévoda et
 // al. 2018, "Bayesian online regression for adaptive direct illumination sampling", learns such
-// per-region light selection from the estimator's own samples; photons teach it here), mixed with
-// the area-proportional and uniform strategies so that light the photons have not found yet keeps
-// a nonzero density (LightSampler::SampleSky).
+// per-region light selection from the estimator's own samples), mixed with the area-proportional
+// and uniform strategies so that light the photons have not found yet keeps a nonzero density
+// (LightSampler::SampleSky). The estimator's own samples teach it too: each of the sky's shadow
+// rays that reaches the sky estimates the light of the window it crossed (radiance x
+// transmittance x cosine / the pdf of its direction, unbiased whichever strategy drew it). Both
+// sums are proportional to a window's light within a region, so their sum is too; the camera's
+// shadow rays are many more than the sky's photons at first hits (150 k against some 3 k per
+// iteration of the abbey at 480 x 320) and teach the regions the camera sees from the first
+// iteration.
 
 #include <cstdint>
 #include <memory>
@@ -33,21 +39,24 @@ class SkyWindows {
   public:
     /// The windows of `portals` (which must outlive this) over the model's `bounds`, regions and
     /// windows both cells of about the longest axis / kCellsLongAxis. `photon_power`: the
-    /// luminance of a typical photon, which sets the fixed-point resolution of the sums.
-    SkyWindows(const SkyPortals& portals, const Bounds3f& bounds, double photon_power);
+    /// luminance of a typical photon, and `estimate_power` that of a shadow ray's estimate of a
+    /// typical window's light: they set the fixed-point resolution of each kind of record.
+    SkyWindows(const SkyPortals& portals, const Bounds3f& bounds, double photon_power,
+               double estimate_power = 1.0);
     ~SkyWindows();
     SkyWindows(const SkyWindows&) = delete;
     SkyWindows& operator=(const SkyWindows&) = delete;
 
     static constexpr int kCellsLongAxis = 64;
-    /// A region learns its windows once this many photons reached it.
+    /// A region learns its windows once this many records (photons or shadow rays) reached it.
     static constexpr uint32_t kMinPhotons = 16;
     /// At most this many (region, window) sums are kept: beyond it, Update forgets those of the
     /// fewest photons (the least certain) down to three quarters of it.
     static constexpr size_t kMaxPairs = size_t(1) << 17;
     /// The bytes the windows hold at most: the sums and choices of kMaxPairs pairs, and the
-    /// records of a pass before Update (the render's memory reserve).
-    static constexpr uint64_t kMemoryReserveBytes = kMaxPairs * 64 + (uint64_t(4) << 20);
+    /// records of an iteration before Update, a few hundred thousand pairs (the render's memory
+    /// reserve).
+    static constexpr uint64_t kMemoryReserveBytes = kMaxPairs * 64 + (uint64_t(16) << 20);
 
     /// A region's learned choice of windows: entries [first, first + count) of the tables.
     struct Region {
@@ -59,7 +68,14 @@ class SkyWindows {
     /// `triangle` onto a surface of side `side` (PathGuide::SideOf) at `p`. Thread-safe; the sums
     /// are integers, so the order of records does not change them (nor the image with threads or
     /// the memory budget).
-    void Record(const Vec3f& p, int side, uint32_t triangle, double power);
+    void Record(const Vec3f& p, int side, uint32_t triangle, double power) {
+        RecordFixed(p, side, triangle, power * photon_to_fixed_);
+    }
+    /// Records a shadow ray's estimate `estimate` of the light that portal triangle `triangle`'s
+    /// window brings at `p`, on a surface of side `side`. Thread-safe, as Record.
+    void RecordEstimate(const Vec3f& p, int side, uint32_t triangle, double estimate) {
+        RecordFixed(p, side, triangle, estimate * estimate_to_fixed_);
+    }
     /// Makes what was recorded so far the regions' choices. Not concurrent with anything else.
     void Update();
     /// The learned choice at `p` on a surface of side `side`, or null where none was learned.
@@ -89,6 +105,7 @@ class SkyWindows {
         uint32_t photons = 0;
     };
     struct ThreadSums;
+    void RecordFixed(const Vec3f& p, int side, uint32_t triangle, double fixed);
     /// The sums in key order: region, then window.
     std::vector<std::pair<uint64_t, Sum>> SortedSums() const;
     /// Forgets the `count` sums of the fewest photons (ties by key: the same on every run).
@@ -101,7 +118,7 @@ class SkyWindows {
     Bounds3f bounds_;
     int res_[3] = {1, 1, 1};
     Vec3f inv_cell_;
-    double to_fixed_;
+    double photon_to_fixed_, estimate_to_fixed_;
     // Windows: each portal triangle's window; per window its triangles (by area CDF) and area.
     std::vector<uint32_t> triangle_window_;
     std::vector<uint32_t> window_first_;  // window w's triangles: window_triangles_[first[w],
