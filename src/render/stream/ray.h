@@ -55,10 +55,13 @@ struct RayRecord {
         0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
                              ///< surface; sky shadow rays: that of their own vertex
-    /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky). Sky
-    /// shadow rays (kSkyShadow): what turns the contribution's average into the ray's estimate of
-    /// the light its window brings (LightSampler::LearnFromSkyShadow).
-    float prev_pdf = 0;
+    union {
+        /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky).
+        float prev_pdf = 0;
+        /// Sky shadow rays (kSkyShadow): what turns the contribution's average into the ray's
+        /// estimate of the light its window brings (LightSampler::LearnFromSkyShadow).
+        float window_estimate_scale;
+    };
     float since_vertex =
         0;  ///< distance from the last scattering vertex to `origin` (passes through thin
             ///< glass move the origin along the ray; the sky's MIS needs the vertex)

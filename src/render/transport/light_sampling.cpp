@@ -170,17 +170,20 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
     if (s.beta.IsZero()) return std::nullopt;
     // What LearnFromSkyShadow turns the contribution into, once the panes on the way have dimmed
     // it: radiance x |cos θ| / pdf, without the throughput, the BSDF or the MIS weight.
-    s.prev_pdf = radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
+    s.window_estimate_scale =
+        radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
     return s;
 }
 
 void LightSampler::LearnFromSkyShadow(const RayRecord& shadow) const {
     // A contribution so small that its factor overflowed teaches nothing worth its risk.
-    if (windows_ == nullptr || !(shadow.prev_pdf > 0) || !std::isfinite(shadow.prev_pdf)) return;
+    if (windows_ == nullptr || !(shadow.window_estimate_scale > 0) ||
+        !std::isfinite(shadow.window_estimate_scale))
+        return;
     const std::optional<BrickHit> window = portals_->FirstCrossing(shadow.origin, shadow.dir);
     if (!window) return;  // a uniform direction that no window lets in
     windows_->RecordEstimate(shadow.origin, shadow.guide_side, window->triangle,
-                             double(shadow.beta.Average()) * double(shadow.prev_pdf));
+                             double(shadow.beta.Average()) * double(shadow.window_estimate_scale));
 }
 
 float LightSampler::SkyPdf(const Vec3f& p, int side, const Vec3f& w) const {
