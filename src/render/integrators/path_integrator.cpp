@@ -42,11 +42,7 @@ double PathIntegrator::GuideRadianceScale(const RenderScene& scene) {
         const double solid_angle = sun.SolidAngle();
         scale = double(sun.radiance().Sample(green).Average()) * solid_angle * kInvPi;
     }
-    if (scene.sky) {
-        for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
-                               Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
-            scale = std::max(scale, double(scene.sky->Radiance(w, green).Average()));
-    }
+    if (scene.sky) scale = std::max(scale, scene.sky->BrightestAxisRadiance());
     return scale > 0 ? scale : 1.0;
 }
 

@@ -29,8 +29,8 @@ enum RayFlags : uint8_t {
     /// one.
     kSpecularChain = 1 << 4,
     kChainBroken = 1 << 5,  ///< a non-specular bounce happened where kSpecularChain looks
-    /// Shadow rays toward the sky (LightSampler::SampleSky): the ones that reach it teach the
-    /// sky's sampling its windows (LightSampler::LearnFromSkyShadow).
+    /// Shadow rays toward the sky (LightSampler::SampleSky) where its windows learn
+    /// (LightSampler::sky_windows): the ones that reach it teach them (LearnFromSkyShadow).
     kSkyShadow = 1 << 6,
 };
 
@@ -54,7 +54,7 @@ struct RayRecord {
     uint16_t vertex =
         0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
-                             ///< surface; sky shadow rays: that of their own vertex
+                             ///< surface; kSkyShadow rays: that of their own vertex
     union {
         /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky).
         float prev_pdf = 0;

@@ -92,11 +92,7 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
 
 double LightSampler::TypicalWindowLight(const RenderScene& scene) {
     // The sky's brightest axis over a window of 0.01 sr (2 m² seen from 14 m).
-    const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
-    double radiance = 0;
-    for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
-                           Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
-        radiance = std::max(radiance, double(scene.sky->Radiance(w, green).Average()));
+    const double radiance = scene.sky->BrightestAxisRadiance();
     return radiance > 0 ? radiance * 0.01 : 1.0;
 }
 
@@ -160,18 +156,21 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                   : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
-    s.flags = uint8_t(r.flags | kSkyShadow);
-    s.guide_side = uint8_t(side);
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = kInfinity;
     const SampledSpectrum radiance = scene_.sky->Radiance(wi, r.lambda);
     s.beta = r.beta * f * radiance * (w / light_pdf);
     if (s.beta.IsZero()) return std::nullopt;
-    // What LearnFromSkyShadow turns the contribution into, once the panes on the way have dimmed
-    // it: radiance x |cos θ| / pdf, without the throughput, the BSDF or the MIS weight.
-    s.window_estimate_scale =
-        radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
+    if (windows_ != nullptr) {
+        // The ray teaches the windows if it reaches the sky: what LearnFromSkyShadow turns the
+        // contribution into, once the panes on the way have dimmed it, is radiance x |cos θ| /
+        // pdf, without the throughput, the BSDF or the MIS weight.
+        s.flags = uint8_t(r.flags | kSkyShadow);
+        s.guide_side = uint8_t(side);
+        s.window_estimate_scale =
+            radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
+    }
     return s;
 }
 

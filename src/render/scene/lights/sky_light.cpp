@@ -1,5 +1,6 @@
 #include "src/render/scene/lights/sky_light.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -24,6 +25,15 @@ void SkyLight::AddHorizontalIrradiance(std::vector<double>* e) const {
         for (int k = 0; k < Spectrum::kNumSamples; ++k)
             (*e)[size_t(k)] += std::numbers::pi * radiance_.sample(k);
     }
+}
+
+double SkyLight::BrightestAxisRadiance() const {
+    const SampledWavelengths green = SampledWavelengths::SampleVisible(0.5f);
+    double radiance = 0;
+    for (const Vec3f& w : {Vec3f(1, 0, 0), Vec3f(-1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
+                           Vec3f(0, 0, 1), Vec3f(0, 0, -1)})
+        radiance = std::max(radiance, double(Radiance(w, green).Average()));
+    return radiance;
 }
 
 double SkyLight::Power(const PhotonTarget& target) const {

@@ -44,6 +44,10 @@ class SkyLight final : public Light {
     /// horizon on a horizontal surface facing up, ∫ L cos θ dω over the upper hemisphere: π L for a
     /// uniform sky, a 64 x 128 midpoint quadrature in cos θ and φ for a physical one.
     void AddHorizontalIrradiance(std::vector<double>* e) const;
+    /// The largest of the sky's radiances along the six axis directions, averaged over the
+    /// wavelengths SampledWavelengths::SampleVisible(0.5) draws: the order of the light the sky
+    /// brings, for scales of learned sums.
+    double BrightestAxisRadiance() const;
     /// With a physical sky: the radiance of the ground below the horizon.
     void set_ground_radiance(Spectrum radiance) { ground_radiance_ = radiance; }
     /// The mean radiance over the sphere of directions times the measure of the lines its photons
