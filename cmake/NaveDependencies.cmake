@@ -17,6 +17,7 @@ find_package(spdlog REQUIRED)                    # target: spdlog::spdlog
 find_package(fmt REQUIRED)                       # target: fmt::fmt
 find_package(TinyGLTF REQUIRED)                  # target: TinyGLTF::TinyGLTF
 find_package(assimp REQUIRED)                    # target: assimp::assimp
+find_package(meshoptimizer REQUIRED)             # target: meshoptimizer::meshoptimizer
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
 # jemalloc: the `nave` executable's allocator (glibc's heap fragments under paging: docs/pager.md, "Memory").

@@ -8,6 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libembree-dev            # Embree 3: ray tracing inside a brick
   libdraco-dev             # Draco: brick mesh compression
+  libmeshoptimizer-dev     # meshoptimizer: simplification of bricks into levels of detail
   libopenvdb-dev libboost-iostreams-dev zlib1g-dev libblosc-dev  # OpenVDB (participating media); its Find module needs these but the package does not pull them in
   libopenimageio-dev openimageio-tools  # OpenImageIO: EXR/PNG output, textures (its CMake config requires the tools)
   liblz4-dev               # LZ4: side sections and temporary bins

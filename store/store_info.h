@@ -34,6 +34,18 @@ struct SectionInfo {
     uint64_t checksum = 0;  ///< XXH64 of those bytes
 };
 
+/// A coarser version of a brick (docs/store-format.md, "Levels"). Level 0 is the brick itself
+/// (BrickInfo's own fields); BrickInfo::levels[k - 1] is level k.
+struct LevelInfo {
+    float error = 0;  ///< estimated largest distance from the full surface, model units
+    uint64_t triangle_count = 0;
+    uint64_t vertex_count = 0;
+    uint64_t decoded_bytes = 0;  ///< as BrickInfo::decoded_bytes
+    bool has_normals = false;
+    bool has_uvs = false;
+    SectionInfo mesh;  ///< position base + Draco mesh, as the brick's own mesh section
+};
+
 /// A brick as the directory describes it. Reading the directory never touches brick payloads.
 struct BrickInfo {
     uint32_t id = 0;
@@ -47,6 +59,9 @@ struct BrickInfo {
     bool has_uvs = false;        ///< the decoded mesh has texture coordinates
     SectionInfo mesh;            ///< position base + Draco-encoded mesh (docs/store-format.md)
     SectionInfo side;  ///< LZ4-compressed side section (see docs/store-format.md); length 0 if none
+    /// Coarser versions of the brick, coarsest last, each with a larger error (the store's levels
+    /// table, format 3.1); empty for stores without levels.
+    std::vector<LevelInfo> levels;
     uint64_t BytesOnDisk() const { return mesh.length + side.length; }
 };
 

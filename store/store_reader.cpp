@@ -138,13 +138,17 @@ const std::vector<MaterialRecord>& Store::materials() const { return impl_->mate
 uint64_t Store::file_size() const { return impl_->file.size(); }
 uint64_t Store::bytes_read() const { return impl_->bytes_read.load(std::memory_order_relaxed); }
 
-StatusOr<BrickMesh> Store::ReadBrick(uint32_t id) const {
+StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
     const Impl& s = *impl_;
     if (id >= s.bricks.size()) {
         return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
                              s.bricks.size());
     }
     const BrickInfo& info = s.bricks[id];
+    if (level > info.levels.size()) {
+        return NotFoundError("{}: brick {} has no level {} (its levels are 0 to {})", s.name, id,
+                             level, info.levels.size());
+    }
     const std::string what = fmt::format("{} brick {} @0x{:x}", s.name, id, info.mesh.offset);
     if (info.side.length > 0) {
         // Format 1.0 defines no side-section content; verify it so corruption never passes

@@ -31,9 +31,13 @@ class Store {
     const std::vector<MaterialRecord>& materials() const;
     uint64_t file_size() const;
 
-    /// Reads, verifies and decodes brick `id`. Thread-safe. Adds the bytes read to bytes_read().
-    StatusOr<BrickMesh> ReadBrick(uint32_t id) const;
-    /// Reads brick `id` and checks its checksums and that it decodes to the directory's counts.
+    /// Reads, verifies and decodes brick `id` at `level` (0: the brick itself; k: its level k,
+    /// BrickInfo::levels[k - 1]). Thread-safe. Adds the bytes read to bytes_read(). NotFound for a
+    /// brick or level that does not exist; DataLoss for a checksum or a decoded count that
+    /// disagrees with the tables.
+    StatusOr<BrickMesh> ReadBrick(uint32_t id, uint32_t level = 0) const;
+    /// Reads brick `id` and each of its levels, and checks their checksums and that they decode to
+    /// the tables' counts.
     Status VerifyBrick(uint32_t id) const;
     /// Total payload bytes read from disk since Open (for statistics).
     uint64_t bytes_read() const;

@@ -1,0 +1,155 @@
+#include "store/brick_levels.h"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace nave::store {
+namespace {
+
+static_assert(sizeof(Vec3f) == 3 * sizeof(float), "meshoptimizer reads positions as float[3]");
+
+constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
+
+/// meshopt_simplify's target_error is relative to the mesh's extent; 1 (the whole extent) lets the
+/// triangle target alone decide how far a level goes, and the error it reaches is what we record.
+constexpr float kTargetErrorRelative = 1.f;
+
+/// The triangles of one material, as indices into the mesh's vertices.
+struct Submesh {
+    uint32_t material = 0;
+    std::vector<uint32_t> triangles;  ///< triangle numbers in the mesh, in order
+};
+
+/// Groups the triangles of `mesh` by material, by ascending material id (so the levels' bytes do
+/// not depend on anything but the mesh).
+std::vector<Submesh> SplitByMaterial(const BrickMesh& mesh) {
+    std::vector<uint32_t> order(mesh.TriangleCount());
+    for (uint32_t t = 0; t < order.size(); ++t) order[t] = t;
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return mesh.material_ids[a] < mesh.material_ids[b];
+    });
+    std::vector<Submesh> out;
+    for (uint32_t t : order) {
+        if (out.empty() || out.back().material != mesh.material_ids[t])
+            out.push_back({mesh.material_ids[t], {}});
+        out.back().triangles.push_back(t);
+    }
+    return out;
+}
+
+/// Reused between submeshes: a vertex's index in the current submesh, kUnused elsewhere.
+struct Scratch {
+    std::vector<uint32_t> local_of;
+    std::vector<uint32_t> global_of;
+    std::vector<Vec3f> positions;
+    std::vector<uint32_t> indices;
+    std::vector<uint32_t> simplified;
+};
+
+/// Simplifies one material's triangles of `mesh` toward `target_triangles`, appending the kept
+/// triangles (indices into `mesh`'s vertices) to `out`. Returns the absolute error: meshoptimizer's
+/// relative error times its scale (the submesh's extent), since the submesh alone is simplified.
+float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, size_t target_triangles,
+                      Scratch& s, BrickMesh* out) {
+    // A compact copy of the submesh's vertices: meshoptimizer's work and its scale then depend on
+    // this material's vertices only.
+    s.global_of.clear();
+    s.positions.clear();
+    s.indices.clear();
+    for (uint32_t t : sub.triangles) {
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t v = mesh.indices[3 * size_t(t) + c];
+            if (s.local_of[v] == kUnused) {
+                s.local_of[v] = uint32_t(s.global_of.size());
+                s.global_of.push_back(v);
+                s.positions.push_back(mesh.positions[v]);
+            }
+            s.indices.push_back(s.local_of[v]);
+        }
+    }
+    for (uint32_t v : s.global_of) s.local_of[v] = kUnused;
+
+    s.simplified.resize(s.indices.size());  // meshoptimizer's worst case: every index kept
+    float relative_error = 0;
+    const size_t kept = meshopt_simplify(s.simplified.data(), s.indices.data(), s.indices.size(),
+                                         &s.positions[0].x, s.positions.size(), sizeof(Vec3f),
+                                         3 * target_triangles, kTargetErrorRelative,
+                                         /*options=*/0, &relative_error);
+    const float scale = meshopt_simplifyScale(&s.positions[0].x, s.positions.size(), sizeof(Vec3f));
+    for (size_t i = 0; i < kept; ++i) out->indices.push_back(s.global_of[s.simplified[i]]);
+    out->material_ids.insert(out->material_ids.end(), kept / 3, sub.material);
+    return relative_error * scale;
+}
+
+/// Keeps only the vertices `level` references, in the order of their first use, with their normals
+/// and texture coordinates from `source`.
+void CompactVertices(const BrickMesh& source, BrickMesh* level) {
+    std::vector<uint32_t> remap(source.VertexCount());
+    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), level->indices.data(),
+                                                         level->indices.size(), remap.size());
+    level->positions.resize(used);
+    if (source.HasNormals()) level->normals.resize(used);
+    if (source.HasUvs()) level->uvs.resize(used);
+    for (size_t v = 0; v < remap.size(); ++v) {
+        const uint32_t to = remap[v];
+        if (to == kUnused) continue;
+        level->positions[to] = source.positions[v];
+        if (source.HasNormals()) level->normals[to] = source.normals[v];
+        if (source.HasUvs()) level->uvs[to] = source.uvs[v];
+    }
+    for (uint32_t& i : level->indices) i = remap[i];
+}
+
+}  // namespace
+
+std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options) {
+    std::vector<BrickLevel> levels;
+    // Each level is simplified from the one before, by reference: no reallocation.
+    levels.reserve(options.triangle_ratios.size());
+    if (full.TriangleCount() < kMinLevelSourceTriangles || full.VertexCount() == 0) return levels;
+
+    // Targets count from the full mesh's triangles of each material, so that every material keeps
+    // its share and the ratios mean the same whichever level a level is simplified from.
+    std::vector<size_t> full_triangles_of;  // by material id
+    for (uint32_t m : full.material_ids) {
+        if (m >= full_triangles_of.size()) full_triangles_of.resize(size_t(m) + 1, 0);
+        ++full_triangles_of[m];
+    }
+    Scratch scratch;
+    const BrickMesh* source = &full;
+    float source_error = 0;  // the error `source` already carries
+    for (const double ratio : options.triangle_ratios) {
+        if (!(ratio > 0 && ratio < 1)) break;
+        scratch.local_of.assign(source->VertexCount(), kUnused);
+        BrickLevel level;
+        float step_error = 0;
+        for (const Submesh& sub : SplitByMaterial(*source)) {
+            const size_t target =
+                size_t(std::llround(ratio * double(full_triangles_of[sub.material])));
+            step_error =
+                std::max(step_error, SimplifySubmesh(*source, sub, target, scratch, &level.mesh));
+        }
+        const size_t triangles = level.mesh.TriangleCount();
+        if (triangles == 0 ||
+            double(triangles) > options.max_kept_fraction * double(source->TriangleCount())) {
+            break;
+        }
+        CompactVertices(*source, &level.mesh);
+        // A level simplified from the one before differs from the full mesh by at most both
+        // errors (triangle inequality): conservative, and larger than the previous level's. A
+        // flat region simplifies without error; the next float keeps the errors increasing.
+        level.error = source_error + step_error;
+        if (!levels.empty() && !(level.error > source_error))
+            level.error = std::nextafter(source_error, std::numeric_limits<float>::infinity());
+        levels.push_back(std::move(level));
+        source = &levels.back().mesh;
+        source_error = levels.back().error;
+    }
+    return levels;
+}
+
+}  // namespace nave::store
