@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "src/core/hash.h"
+#include "store/brick_mesh.h"
 
 namespace nave::store::format {
 namespace {
@@ -100,6 +101,7 @@ std::string EncodeHeader(const RawHeader& h) {
     PutSection(w, h.directory);
     PutSection(w, h.tree);
     PutSection(w, h.materials);
+    PutSection(w, h.levels);  // 3.1
     NAVE_CHECK_LE(w.size(), size_t(kHeaderBytes - 8));
     w.PutZeros(kHeaderBytes - 8 - w.size());
     w.Put(Checksum64(w.bytes().data(), w.size()));
@@ -187,6 +189,9 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     NAVE_RETURN_IF_ERROR(GetSection(r, &h.directory));
     NAVE_RETURN_IF_ERROR(GetSection(r, &h.tree));
     NAVE_RETURN_IF_ERROR(GetSection(r, &h.materials));
+    // Before 3.1 these bytes are the zero padding: no levels table.
+    if (h.major > 3 || (h.major == 3 && h.minor >= 1))
+        NAVE_RETURN_IF_ERROR(GetSection(r, &h.levels));
 
     // The checksum matched, so what follows catches writer bugs and files cut or extended after
     // writing.
@@ -213,8 +218,10 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
         const char* what;
         const SectionInfo* ref;
     };
-    for (const Named& t : {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
-                           Named{"tree", &h.tree}, Named{"materials", &h.materials}}) {
+    for (const Named& t :
+         {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
+          Named{"tree", &h.tree}, Named{"materials", &h.materials}, Named{"levels", &h.levels}}) {
+        if (t.ref == &h.levels && t.ref->length == 0) continue;  // no levels
         if (t.ref->offset < h.header_bytes || t.ref->offset > file_bytes ||
             t.ref->length > file_bytes - t.ref->offset) {
             return DataLossError(
@@ -377,6 +384,108 @@ StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h,
     Status valid = tree.Validate(h.brick_count);
     if (!valid.ok()) return valid.WithContext(fmt::format("{} tree @0x{:x}", name, h.tree.offset));
     return tree;
+}
+
+// ---- levels
+
+std::string EncodeLevels(const std::vector<RawBrickEntry>& entries) {
+    ByteWriter w;
+    w.Put(kLevelEntryBytes);
+    w.Put(uint32_t(entries.size()));
+    for (const RawBrickEntry& e : entries) {
+        w.Put(uint32_t(e.info.levels.size()));
+        for (const LevelInfo& l : e.info.levels) {
+            const size_t start = w.size();
+            w.Put(l.error);
+            w.Put(
+                uint32_t((l.has_normals ? kBrickHasNormals : 0) | (l.has_uvs ? kBrickHasUvs : 0)));
+            w.Put(l.triangle_count);
+            w.Put(l.vertex_count);
+            w.Put(l.decoded_bytes);
+            PutSection(w, l.mesh);
+            NAVE_CHECK_EQ(w.size() - start, size_t(kLevelEntryBytes));
+        }
+    }
+    return std::move(w.bytes());
+}
+
+Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
+                    std::vector<RawBrickEntry>* entries) {
+    ByteReader r(bytes, name + " levels", h.levels.offset);
+    uint32_t entry_bytes = 0, brick_count = 0;
+    NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
+    NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
+    if (entry_bytes < kLevelEntryBytes || entry_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} levels @0x{:x}: level entry size {} out of range [{}, {}]", name,
+                             h.levels.offset, entry_bytes, kLevelEntryBytes, kMaxHeaderBytes);
+    }
+    if (brick_count != h.brick_count || brick_count != entries->size()) {
+        return DataLossError("{} levels @0x{:x}: the table has {} bricks, the header says {}", name,
+                             h.levels.offset, brick_count, h.brick_count);
+    }
+    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    for (uint32_t i = 0; i < brick_count; ++i) {
+        BrickInfo& b = (*entries)[i].info;
+        uint32_t count = 0;
+        const uint64_t count_at = r.file_pos();
+        NAVE_RETURN_IF_ERROR(r.Get(&count));
+        if (count > kMaxLevels || uint64_t(count) * entry_bytes > r.remaining()) {
+            return DataLossError(
+                "{} brick {} levels @0x{:x}: {} levels (at most {}, of {} bytes each in the {} "
+                "bytes left)",
+                name, i, count_at, count, kMaxLevels, entry_bytes, r.remaining());
+        }
+        b.levels.resize(count);
+        for (uint32_t k = 1; k <= count; ++k) {
+            LevelInfo& l = b.levels[k - 1];
+            const uint64_t at = r.file_pos();
+            const size_t start = r.pos();
+            uint32_t flags = 0;
+            NAVE_RETURN_IF_ERROR(r.Get(&l.error));
+            NAVE_RETURN_IF_ERROR(r.Get(&flags));
+            NAVE_RETURN_IF_ERROR(r.Get(&l.triangle_count));
+            NAVE_RETURN_IF_ERROR(r.Get(&l.vertex_count));
+            NAVE_RETURN_IF_ERROR(r.Get(&l.decoded_bytes));
+            NAVE_RETURN_IF_ERROR(GetSection(r, &l.mesh));
+            NAVE_RETURN_IF_ERROR(r.Skip(entry_bytes - (r.pos() - start)));
+            l.has_normals = (flags & kBrickHasNormals) != 0;
+            l.has_uvs = (flags & kBrickHasUvs) != 0;
+            const float previous_error = k == 1 ? 0.f : b.levels[k - 2].error;
+            if (!std::isfinite(l.error) || l.error < 0 || (k > 1 && !(l.error > previous_error))) {
+                return DataLossError(
+                    "{} brick {} level {} @0x{:x}: error {} (expected a finite error >= 0, "
+                    "larger than level {}'s {})",
+                    name, i, k, at, l.error, k - 1, previous_error);
+            }
+            const uint64_t finer_triangles =
+                k == 1 ? b.triangle_count : b.levels[k - 2].triangle_count;
+            if (l.triangle_count == 0 || l.triangle_count > finer_triangles) {
+                return DataLossError(
+                    "{} brick {} level {} @0x{:x}: {} triangles (expected 1 to level {}'s {})",
+                    name, i, k, at, l.triangle_count, k - 1, finer_triangles);
+            }
+            const uint64_t expected =
+                BrickMesh::BytesFor(l.vertex_count, l.triangle_count, l.has_normals, l.has_uvs);
+            if (l.decoded_bytes != expected) {
+                return DataLossError(
+                    "{} brick {} level {} @0x{:x}: decoded size {} != {} implied by its {} "
+                    "vertices and {} triangles",
+                    name, i, k, at, l.decoded_bytes, expected, l.vertex_count, l.triangle_count);
+            }
+            if (l.mesh.length == 0 || l.mesh.offset < h.header_bytes ||
+                l.mesh.offset > payload_end || l.mesh.length > payload_end - l.mesh.offset) {
+                return DataLossError(
+                    "{} brick {} level {} @0x{:x}: mesh section [0x{:x}, +{}) lies outside the "
+                    "payload area [0x{:x}, 0x{:x})",
+                    name, i, k, at, l.mesh.offset, l.mesh.length, h.header_bytes, payload_end);
+            }
+        }
+    }
+    if (r.remaining() != 0) {
+        return DataLossError("{} levels @0x{:x}: {} bytes left after {} bricks", name, r.file_pos(),
+                             r.remaining(), brick_count);
+    }
+    return Status::Ok();
 }
 
 // ---- materials

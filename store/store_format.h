@@ -4,6 +4,7 @@
 // tables; the brick payloads (Draco + LZ4) are brick_codec's business.
 //
 //   [header, kHeaderBytes]  [brick payloads ...]  [provenance] [directory] [tree] [materials]
+//   [levels (3.1)]
 //
 // The tables are written after the payloads and the header last, so a file cut anywhere fails to
 // open.
@@ -36,7 +37,14 @@ inline constexpr uint32_t kHeaderPrefixBytes = 16;
 inline constexpr uint32_t kDirectoryEntryBytes = 128;
 inline constexpr uint32_t kTreeNodeBytes = 20;
 
-/// Directory entry flags.
+/// Bytes of the levels table's prefix (uint32 entry size, uint32 brick count) and of one level's
+/// entry in version 3.1 (the prefix records it, so a newer minor may grow it).
+inline constexpr uint32_t kLevelsPrefixBytes = 8;
+inline constexpr uint32_t kLevelEntryBytes = 56;
+/// Most levels a brick may have (more is a corrupt count).
+inline constexpr uint32_t kMaxLevels = 16;
+
+/// Directory entry flags (also those of a level entry).
 inline constexpr uint32_t kBrickHasNormals = 1u << 0;
 inline constexpr uint32_t kBrickHasUvs = 1u << 1;
 
@@ -59,6 +67,7 @@ struct RawHeader {
     SectionInfo directory;
     SectionInfo tree;
     SectionInfo materials;
+    SectionInfo levels;  ///< 3.1; length 0 in stores without levels (and zero in older headers)
 };
 
 /// A directory entry as stored: BrickInfo plus flags.
@@ -140,6 +149,13 @@ StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, con
 
 std::string EncodeTree(const BrickTree& tree);
 StatusOr<BrickTree> DecodeTree(std::string_view bytes, const RawHeader& h, const std::string& name);
+
+/// The levels table: every brick's levels (BrickInfo::levels), in brick order.
+std::string EncodeLevels(const std::vector<RawBrickEntry>& entries);
+/// Fills `entries[i].info.levels` from the table, checking counts, errors (finite, >= 0,
+/// increasing), decoded sizes and that each level's mesh section lies in the payload area.
+Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
+                    std::vector<RawBrickEntry>* entries);
 
 std::string EncodeMaterials(const std::vector<MaterialRecord>& materials);
 StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, const RawHeader& h,

@@ -11,11 +11,13 @@
 namespace nave::store {
 
 /// Current format version. Readers refuse another major version; a newer minor version only adds
-/// fields. The version this nave writes. 3.0: each face's shading (stored, flat or derived normals)
-/// in the mesh section, so that smooth surfaces too may store no normals. 2.0: flat faces marked in
-/// the mesh section (no normals, shared corners). 1.1: material alpha_cutoff.
+/// fields. The version this nave writes. 3.1: levels of detail, coarser meshes of each brick (the
+/// levels table; older readers ignore it and stores without it have no levels). 3.0: each face's
+/// shading (stored, flat or derived normals) in the mesh section, so that smooth surfaces too may
+/// store no normals. 2.0: flat faces marked in the mesh section (no normals, shared corners). 1.1:
+/// material alpha_cutoff.
 inline constexpr uint16_t kFormatMajor = 3;
-inline constexpr uint16_t kFormatMinor = 0;
+inline constexpr uint16_t kFormatMinor = 1;
 /// The oldest major version this nave still reads (1.x stores decode as before).
 inline constexpr uint16_t kOldestReadableMajor = 1;
 

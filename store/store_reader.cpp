@@ -36,7 +36,8 @@ struct Store::Impl {
     }
 
     // Reads one section of brick `id` and checks its checksum.
-    StatusOr<std::string> ReadSection(uint32_t id, const char* what, const SectionInfo& s) const {
+    StatusOr<std::string> ReadSection(uint32_t id, const std::string& what,
+                                      const SectionInfo& s) const {
         std::string bytes(s.length, '\0');
         Status read = file.ReadAt(s.offset, bytes.data(), bytes.size());
         if (!read.ok())
@@ -51,6 +52,24 @@ struct Store::Impl {
         return bytes;
     }
 };
+
+namespace {
+
+// A decoded mesh against the counts its table (`table`: "directory", "levels table") gave.
+Status CheckCounts(const BrickMesh& mesh, const std::string& what, const char* table,
+                   uint64_t triangles, uint64_t vertices, bool normals, bool uvs) {
+    if (mesh.TriangleCount() != triangles || mesh.VertexCount() != vertices ||
+        mesh.HasNormals() != normals || mesh.HasUvs() != uvs) {
+        return DataLossError("{}: decoded {} triangles, {} vertices{}{} but the {} says {}, {}{}{}",
+                             what, mesh.TriangleCount(), mesh.VertexCount(),
+                             mesh.HasNormals() ? ", normals" : "", mesh.HasUvs() ? ", uvs" : "",
+                             table, triangles, vertices, normals ? ", normals" : "",
+                             uvs ? ", uvs" : "");
+    }
+    return Status::Ok();
+}
+
+}  // namespace
 
 Store::Store(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Store::~Store() = default;
@@ -86,6 +105,10 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
                           format::DecodeDirectory(directory_bytes, h, name));
     NAVE_ASSIGN_OR_RETURN(impl->tree, format::DecodeTree(tree_bytes, h, name));
     NAVE_ASSIGN_OR_RETURN(impl->materials, format::DecodeMaterials(material_bytes, h, name));
+    if (h.levels.length > 0) {
+        NAVE_ASSIGN_OR_RETURN(std::string level_bytes, impl->ReadTable("levels", h.levels));
+        NAVE_RETURN_IF_ERROR(format::DecodeLevels(level_bytes, h, name, &entries));
+    }
 
     impl->header.major = h.major;
     impl->header.minor = h.minor;
@@ -149,6 +172,18 @@ StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
         return NotFoundError("{}: brick {} has no level {} (its levels are 0 to {})", s.name, id,
                              level, info.levels.size());
     }
+    if (level > 0) {
+        const LevelInfo& l = info.levels[level - 1];
+        const std::string what =
+            fmt::format("{} brick {} level {} @0x{:x}", s.name, id, level, l.mesh.offset);
+        NAVE_ASSIGN_OR_RETURN(std::string bytes,
+                              s.ReadSection(id, fmt::format("level {} mesh", level), l.mesh));
+        NAVE_ASSIGN_OR_RETURN(BrickMesh mesh, codec::DecodeMeshSection(bytes, s.header.grid,
+                                                                       s.materials.size(), what));
+        NAVE_RETURN_IF_ERROR(CheckCounts(mesh, what, "levels table", l.triangle_count,
+                                         l.vertex_count, l.has_normals, l.has_uvs));
+        return mesh;
+    }
     const std::string what = fmt::format("{} brick {} @0x{:x}", s.name, id, info.mesh.offset);
     if (info.side.length > 0) {
         // Format 1.0 defines no side-section content; verify it so corruption never passes
@@ -159,14 +194,8 @@ StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
     NAVE_ASSIGN_OR_RETURN(std::string bytes, s.ReadSection(id, "mesh", info.mesh));
     NAVE_ASSIGN_OR_RETURN(BrickMesh mesh,
                           codec::DecodeMeshSection(bytes, s.header.grid, s.materials.size(), what));
-    if (mesh.TriangleCount() != info.triangle_count || mesh.VertexCount() != info.vertex_count ||
-        mesh.HasNormals() != info.has_normals || mesh.HasUvs() != info.has_uvs) {
-        return DataLossError(
-            "{}: decoded {} triangles, {} vertices{}{} but the directory says {}, {}{}{}", what,
-            mesh.TriangleCount(), mesh.VertexCount(), mesh.HasNormals() ? ", normals" : "",
-            mesh.HasUvs() ? ", uvs" : "", info.triangle_count, info.vertex_count,
-            info.has_normals ? ", normals" : "", info.has_uvs ? ", uvs" : "");
-    }
+    NAVE_RETURN_IF_ERROR(CheckCounts(mesh, what, "directory", info.triangle_count,
+                                     info.vertex_count, info.has_normals, info.has_uvs));
     return mesh;
 }
 
@@ -179,6 +208,20 @@ Status Store::VerifyBrick(uint32_t id) const {
         return DataLossError("{} brick {} @0x{:x}: decoded geometry box {} != directory's {}",
                              impl_->name, id, info.mesh.offset, fmt::streamed(box),
                              fmt::streamed(info.geometry_bounds));
+    }
+    // A level's vertices are vertices of the brick (edge collapse moves none), snapped to the same
+    // grid: its box lies inside the brick's.
+    for (uint32_t k = 1; k <= info.levels.size(); ++k) {
+        NAVE_ASSIGN_OR_RETURN(BrickMesh level, ReadBrick(id, k));
+        Bounds3f level_box;
+        for (const Vec3f& p : level.positions) level_box.Extend(p);
+        if (!info.geometry_bounds.Contains(level_box.min) ||
+            !info.geometry_bounds.Contains(level_box.max)) {
+            return DataLossError(
+                "{} brick {} level {} @0x{:x}: decoded geometry box {} lies outside the brick's {}",
+                impl_->name, id, k, info.levels[k - 1].mesh.offset, fmt::streamed(level_box),
+                fmt::streamed(info.geometry_bounds));
+        }
     }
     return Status::Ok();
 }

@@ -2,6 +2,8 @@
 
 #include <fmt/ostream.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -96,6 +98,28 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     brick.has_uvs = encoded.has_uvs;
     brick.max_material_id = encoded.max_material_id;
     brick.dropped_triangle_count = encoded.dropped_triangle_count;
+    if (options.levels.triangle_ratios.empty()) return brick;
+
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<BrickLevel> levels = MakeBrickLevels(mesh, options.levels);
+    brick.simplify_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (size_t k = 0; k < levels.size(); ++k) {
+        auto level = codec::EncodeMeshSection(levels[k].mesh, grid, options, cell);
+        if (!level.ok()) return level.status().WithContext(fmt::format("level {}", k + 1));
+        // Every triangle collapsed on the grid: this level and the coarser ones have nothing to
+        // show.
+        if (level->triangle_count == 0) break;
+        EncodedLevel& out = brick.levels.emplace_back();
+        out.mesh_bytes = std::move(level->bytes);
+        out.error = levels[k].error;
+        out.triangle_count = level->triangle_count;
+        out.vertex_count = level->vertex_count;
+        out.decoded_bytes = level->decoded_bytes;
+        out.has_normals = level->has_normals;
+        out.has_uvs = level->has_uvs;
+        out.max_material_id = level->max_material_id;
+    }
     return brick;
 }
 
@@ -113,6 +137,10 @@ Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
     NAVE_RETURN_IF_ERROR(write_table(format::EncodeDirectory(entries), &h.directory));
     NAVE_RETURN_IF_ERROR(write_table(format::EncodeTree(tree), &h.tree));
     NAVE_RETURN_IF_ERROR(write_table(format::EncodeMaterials(materials), &h.materials));
+    // A store without levels has no levels table (its header's section stays zero, as in 3.0).
+    const bool any_levels = std::any_of(entries.begin(), entries.end(),
+                                        [](const auto& e) { return !e.info.levels.empty(); });
+    if (any_levels) NAVE_RETURN_IF_ERROR(write_table(format::EncodeLevels(entries), &h.levels));
     h.file_bytes = file.size();
     const std::string header = format::EncodeHeader(h);
     NAVE_RETURN_IF_ERROR(file.WriteAt(0, header.data(), header.size()));
@@ -170,6 +198,35 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
             "{}: brick {}: decoded_bytes {} does not match its counts; use EncodeBrick", name, id,
             brick.decoded_bytes);
     }
+    for (size_t k = 0; k < brick.levels.size(); ++k) {
+        const EncodedLevel& l = brick.levels[k];
+        const float finer_error = k == 0 ? 0.f : brick.levels[k - 1].error;
+        const uint64_t finer_triangles =
+            k == 0 ? brick.triangle_count : brick.levels[k - 1].triangle_count;
+        if (l.mesh_bytes.size() < codec::kMeshPrefixBytes ||
+            l.decoded_bytes !=
+                BrickMesh::BytesFor(l.vertex_count, l.triangle_count, l.has_normals, l.has_uvs)) {
+            return InvalidArgumentError(
+                "{}: brick {} level {}: a mesh section of {} bytes, or decoded_bytes {} that does "
+                "not match its counts; use EncodeBrick",
+                name, id, k + 1, l.mesh_bytes.size(), l.decoded_bytes);
+        }
+        if (!std::isfinite(l.error) || l.error < 0 || (k > 0 && !(l.error > finer_error))) {
+            return InvalidArgumentError(
+                "{}: brick {} level {}: error {} (expected finite, >= 0 and larger than level "
+                "{}'s {})",
+                name, id, k + 1, l.error, k, finer_error);
+        }
+        if (l.triangle_count == 0 || l.triangle_count > finer_triangles) {
+            return InvalidArgumentError(
+                "{}: brick {} level {}: {} triangles (expected 1 to level {}'s {})", name, id,
+                k + 1, l.triangle_count, k, finer_triangles);
+        }
+    }
+    if (brick.levels.size() > format::kMaxLevels) {
+        return InvalidArgumentError("{}: brick {} has {} levels (at most {})", name, id,
+                                    brick.levels.size(), format::kMaxLevels);
+    }
     format::RawBrickEntry e;
     e.info.id = id;
     e.info.cell = brick.cell;
@@ -184,13 +241,27 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
     e.info.mesh = {impl_->file.size(), brick.mesh_bytes.size(),
                    Checksum64(brick.mesh_bytes.data(), brick.mesh_bytes.size())};
     NAVE_RETURN_IF_ERROR(impl_->file.Write(brick.mesh_bytes));
+    uint32_t max_material_id = brick.max_material_id;
+    for (const EncodedLevel& l : brick.levels) {
+        LevelInfo& level = e.info.levels.emplace_back();
+        level.error = l.error;
+        level.triangle_count = l.triangle_count;
+        level.vertex_count = l.vertex_count;
+        level.decoded_bytes = l.decoded_bytes;
+        level.has_normals = l.has_normals;
+        level.has_uvs = l.has_uvs;
+        level.mesh = {impl_->file.size(), l.mesh_bytes.size(),
+                      Checksum64(l.mesh_bytes.data(), l.mesh_bytes.size())};
+        NAVE_RETURN_IF_ERROR(impl_->file.Write(l.mesh_bytes));
+        max_material_id = std::max(max_material_id, l.max_material_id);
+    }
     if (!brick.side_bytes.empty()) {
         e.info.side = {impl_->file.size(), brick.side_bytes.size(),
                        Checksum64(brick.side_bytes.data(), brick.side_bytes.size())};
         NAVE_RETURN_IF_ERROR(impl_->file.Write(brick.side_bytes));
     }
     impl_->entries.push_back(e);
-    impl_->max_material_ids.push_back(brick.triangle_count > 0 ? brick.max_material_id : 0);
+    impl_->max_material_ids.push_back(brick.triangle_count > 0 ? max_material_id : 0);
     return id;
 }
 

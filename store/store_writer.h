@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "src/core/status.h"
+#include "store/brick_levels.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
@@ -33,6 +34,21 @@ struct EncodeOptions {
     /// what was encoded. Off, encoding is about a third faster and the counts come from Draco's
     /// encoder (docs/preprocess.md, "Verification").
     bool verify = true;
+    /// Coarser levels of each brick to make and store beside it (brick_levels.h); no ratios, the
+    /// default here, makes none. `nave preprocess` makes LevelOptions' defaults.
+    LevelOptions levels = {.triangle_ratios = {}};
+};
+
+/// A level of a brick ready to be appended (format 3.1): its mesh section and table fields.
+struct EncodedLevel {
+    std::string mesh_bytes;  ///< mesh section, as EncodedBrick::mesh_bytes
+    float error = 0;         ///< BrickLevel::error: estimated distance from the full surface
+    uint64_t triangle_count = 0;
+    uint64_t vertex_count = 0;
+    uint64_t decoded_bytes = 0;
+    bool has_normals = false;
+    bool has_uvs = false;
+    uint32_t max_material_id = 0;
 };
 
 /// A brick ready to be appended: encoded bytes and the directory fields known before writing.
@@ -51,12 +67,17 @@ struct EncodedBrick {
         0;  ///< largest material id used (Finish checks it against the table)
     uint64_t dropped_triangle_count =
         0;  ///< input triangles whose corners collapsed onto <= 2 grid points
+    /// Coarser levels, finest first, each with a larger error (EncodeOptions::levels).
+    std::vector<EncodedLevel> levels;
+    double simplify_seconds = 0;  ///< time spent making the levels (statistics; not stored)
 };
 
 /// Checks BrickMesh invariants; errors say which index or count is wrong.
 Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count);
 
-/// Snaps positions to `grid` and encodes, then decodes the result once to check it. Thread-safe.
+/// Snaps positions to `grid` and encodes, then decodes the result once to check it (when
+/// options.verify); makes and encodes the levels options.levels asks for the same way (a level
+/// whose triangles all collapse on the grid is not kept, nor any coarser one). Thread-safe.
 /// Triangles that collapse on the grid (two corners on one grid point: zero area) are dropped and
 /// counted. Fails (InvalidArgument) on a mesh that breaks the invariants, a position outside the
 /// grid's int32 range or a brick spanning more than 2^29 grid steps.
@@ -71,11 +92,12 @@ class StoreWriter {
                                                          StoreProvenance provenance);
     ~StoreWriter();  // abandons the temporary file unless Finish() succeeded
 
-    /// Appends a brick and returns its id (ids count from 0 in append order). Not thread-safe.
+    /// Appends a brick (its mesh section, then its levels', then its side section) and returns its
+    /// id (ids count from 0 in append order). Not thread-safe.
     StatusOr<uint32_t> Append(const EncodedBrick& brick);
-    /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory
-    /// and the header, then commits the file. `source_triangle_count` is the input's count before
-    /// duplication.
+    /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory,
+    /// the levels table and the header, then commits the file. `source_triangle_count` is the
+    /// input's count before duplication.
     Status Finish(const std::vector<MaterialRecord>& materials, const BrickTree& tree,
                   uint64_t source_triangle_count);
 

@@ -21,6 +21,8 @@ struct Layout {
     size_t brick_count = 0;
     size_t entry_bytes = 0;
     size_t section_checksum[2] = {};  // mesh, side (within an entry); offset and length precede
+    size_t levels_checksum = 0;       // the levels table's (3.1), in the header
+    size_t level_checksum = 0;        // a level's mesh section's, within its levels-table entry
 };
 
 size_t Find(const std::string& bytes, uint64_t marker, size_t size) {
@@ -41,6 +43,8 @@ Layout Learn() {
     l.file_bytes = Find(header, h.file_bytes, 8);
     for (int t = 0; t < 4; ++t) l.table_checksum[t] = Find(header, tables[t]->checksum, 8);
     l.brick_count = Find(header, h.brick_count, 4);
+    h.levels.checksum = 0x5eed0000000000ffull;
+    l.levels_checksum = Find(store::format::EncodeHeader(h), h.levels.checksum, 8);
     l.entry_bytes = Find(header, h.directory_entry_bytes, 4);
     store::format::RawBrickEntry e;
     e.info.mesh.checksum = 0xc0de000000000001ull;
@@ -48,6 +52,12 @@ Layout Learn() {
     const std::string entry = store::format::EncodeDirectory({e});
     l.section_checksum[0] = Find(entry, e.info.mesh.checksum, 8);
     l.section_checksum[1] = Find(entry, e.info.side.checksum, 8);
+    store::format::RawBrickEntry with_level;
+    with_level.info.levels.emplace_back().mesh.checksum = 0xc0de000000000003ull;
+    const std::string levels = store::format::EncodeLevels({with_level});
+    // The table's prefix, then the brick's level count, then its entry.
+    l.level_checksum = Find(levels, with_level.info.levels[0].mesh.checksum, 8) -
+                       store::format::kLevelsPrefixBytes - 4;
     return l;
 }
 
@@ -93,7 +103,24 @@ void ResealStore(std::string& bytes) {
             for (size_t s : l.section_checksum) Seal(bytes, entry + s);
         }
     }
+    // Level sections: their checksums live in the levels table, sealed next.
+    const uint64_t levels_offset = Load<uint64_t>(bytes, l.levels_checksum - 16);
+    const uint64_t levels_length = Load<uint64_t>(bytes, l.levels_checksum - 8);
+    if (levels_length >= store::format::kLevelsPrefixBytes && levels_offset <= bytes.size() &&
+        levels_length <= bytes.size() - levels_offset) {
+        const uint32_t level_bytes = Load<uint32_t>(bytes, levels_offset);
+        const uint64_t end = levels_offset + levels_length;
+        uint64_t at = levels_offset + store::format::kLevelsPrefixBytes;
+        while (level_bytes >= l.level_checksum + 8 && at + 4 <= end) {
+            const uint32_t count = Load<uint32_t>(bytes, at);
+            at += 4;
+            for (uint32_t k = 0; k < count && at + level_bytes <= end; ++k, at += level_bytes)
+                Seal(bytes, at + l.level_checksum);
+            if (count > 0 && at + level_bytes > end) break;
+        }
+    }
     for (size_t t : l.table_checksum) Seal(bytes, t);
+    Seal(bytes, l.levels_checksum);
     Store(bytes, header_bytes - 8, Checksum64(bytes.data(), header_bytes - 8));
 }
 
