@@ -1,6 +1,7 @@
 #include "preprocess/preprocess.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -21,6 +22,7 @@
 #include "src/core/log.h"
 #include "src/core/memory.h"
 #include "src/core/progress.h"
+#include "store/brick_levels.h"
 #include "store/store_writer.h"
 
 namespace nave::preprocess {
@@ -33,11 +35,13 @@ double Since(Clock::time_point t) {
 
 std::string OptionsText(const PreprocessOptions& o, const PreprocessPlan& plan, double step,
                         const std::string& units) {
+    const std::vector<double>& ratios = o.encode.levels.triangle_ratios;
     return fmt::format(
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} "
-        "derived-normal-error={} verify-every={} units={}",
+        "derived-normal-error={} verify-every={} level-ratios={} units={}",
         plan.brick_triangles, plan.memory_budget, step, plan.threads, o.encode.draco_speed,
-        o.encode.derived_normal_error_deg, o.verify_every, units);
+        o.encode.derived_normal_error_deg, o.verify_every,
+        ratios.empty() ? std::string("none") : fmt::format("{}", fmt::join(ratios, ",")), units);
 }
 
 /// Removes the texture folder of a run that fails, unless it existed before the run (it may hold
@@ -249,6 +253,16 @@ Status EncodeBricks(const std::vector<LeafBin>& leaves, const EncodePlan& plan, 
             nodes[leaves[leaf->index].node].brick = id;
             stats->stored_triangles += leaf->brick->triangle_count;
             stats->collapsed_triangles += leaf->brick->dropped_triangle_count;
+            stats->simplify_seconds += leaf->brick->simplify_seconds;
+            const auto& levels = leaf->brick->levels;
+            if (stats->level_triangles.size() < levels.size()) {
+                stats->level_triangles.resize(levels.size(), 0);
+                stats->level_bytes.resize(levels.size(), 0);
+            }
+            for (size_t k = 0; k < levels.size(); ++k) {
+                stats->level_triangles[k] += levels[k].triangle_count;
+                stats->level_bytes[k] += levels[k].mesh_bytes.size();
+            }
             ++stats->bricks;
             return Status::Ok();
         }();
@@ -280,6 +294,8 @@ double DefaultGridStep(double diagonal) { return diagonal > 0 ? diagonal / doubl
 
 StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     const auto start = Clock::now();
+    if (!options.encode.levels.triangle_ratios.empty())
+        NAVE_RETURN_IF_ERROR(store::ValidateLevelOptions(options.encode.levels));
     NAVE_ASSIGN_OR_RETURN(const PreprocessPlan plan,
                           PlanPreprocess(options, QueryMachineResources()));
     if (plan.brick_triangles_fitted) {
@@ -357,6 +373,30 @@ std::string FormatSummary(const PreprocessStats& s) {
         FormatDuration(s.split_seconds), FormatDuration(s.encode_seconds),
         FormatCount(double(s.source_triangles) / std::max(s.seconds, 1e-9)), s.threads,
         FormatBytes(s.peak_rss), FormatBytes(s.memory_budget), FormatBytes(s.source_memory));
+    if (!s.level_triangles.empty()) {
+        uint64_t level_bytes = 0;
+        std::string each;
+        for (size_t k = 0; k < s.level_triangles.size(); ++k) {
+            level_bytes += s.level_bytes[k];
+            each += fmt::format("{}level {}: {} triangles ({:.2f} % of the bricks'), {}",
+                                k ? "; " : "", k + 1, FormatCount(double(s.level_triangles[k])),
+                                s.stored_triangles ? 100.0 * double(s.level_triangles[k]) /
+                                                         double(s.stored_triangles)
+                                                   : 0.0,
+                                FormatBytes(s.level_bytes[k]));
+        }
+        const uint64_t without = s.output_bytes - std::min(level_bytes, s.output_bytes);
+        out += fmt::format(
+            "\nlevels:      {}; {:+.2f} % on disk; simplifying took {} of thread time ({:.0f} % of "
+            "the encode threads')",
+            each, without ? 100.0 * double(level_bytes) / double(without) : 0.0,
+            FormatDuration(s.simplify_seconds),
+            s.encode_seconds > 0
+                ? 100.0 * s.simplify_seconds / (s.encode_seconds * std::max(s.threads, 1))
+                : 0.0);
+    } else {
+        out += "\nlevels:      none";
+    }
     if (s.collapsed_triangles > 0) {
         out += fmt::format("\nnote:        {} triangles smaller than the grid step were dropped",
                            s.collapsed_triangles);

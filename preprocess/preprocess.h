@@ -36,7 +36,9 @@ struct PreprocessOptions {
     double precision = 0;            ///< grid step in model units; 0: bounds diagonal / 2^20
     int threads = 0;                 ///< 0: all hardware threads
     std::filesystem::path temp_dir;  ///< parent of the temporary directory; empty: beside output
-    store::EncodeOptions encode;
+    /// Encoder settings; unlike EncodeOptions' own defaults, preprocess makes levels of detail
+    /// (store::LevelOptions' default ratios) unless `encode.levels.triangle_ratios` is empty.
+    store::EncodeOptions encode = {.levels = store::LevelOptions{}};
     /// Decode every n-th brick (and the first) after encoding to check it (EncodeOptions::verify);
     /// 1 checks them all, 0 none. `nave verify` checks a whole store later.
     uint32_t verify_every = 1;
@@ -57,6 +59,10 @@ struct PreprocessStats {
     uint64_t bricks = 0, empty_cells = 0, oversized_bricks = 0;
     uint64_t verified_bricks = 0;  ///< decoded and compared after encoding (verify_every)
     uint64_t output_bytes = 0, peak_temp_bytes = 0;
+    /// Per level of detail (index k - 1 for level k): triangles and mesh-section bytes over all
+    /// bricks.
+    std::vector<uint64_t> level_triangles, level_bytes;
+    double simplify_seconds = 0;  ///< thread time spent making levels (part of encode's)
     double grid_step = 0, max_error = 0;
     uint64_t memory_budget = 0, peak_rss = 0, source_memory = 0;
     int threads = 1;

@@ -106,6 +106,23 @@ void CompactVertices(const BrickMesh& source, BrickMesh* level) {
 
 }  // namespace
 
+Status ValidateLevelOptions(const LevelOptions& options) {
+    const std::vector<double>& r = options.triangle_ratios;
+    for (size_t k = 0; k < r.size(); ++k) {
+        if (!(r[k] > 0 && r[k] < 1) || (k > 0 && !(r[k] < r[k - 1]))) {
+            return InvalidArgumentError(
+                "level {} triangle ratio {}: expected a fraction in (0, 1) smaller than the level "
+                "before's",
+                k + 1, r[k]);
+        }
+    }
+    if (!(options.max_kept_fraction > 0 && options.max_kept_fraction <= 1)) {
+        return InvalidArgumentError("largest kept fraction {} out of range (0, 1]",
+                                    options.max_kept_fraction);
+    }
+    return Status::Ok();
+}
+
 std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options) {
     std::vector<BrickLevel> levels;
     // Each level is simplified from the one before, by reference: no reallocation.

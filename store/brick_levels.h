@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "src/core/status.h"
 #include "store/brick_mesh.h"
 
 namespace nave::store {
@@ -26,6 +27,10 @@ struct BrickLevel {
     /// mesh's (meshoptimizer's error, made absolute).
     float error = 0;
 };
+
+/// Checks `options`: every ratio in (0, 1), each smaller than the one before, max_kept_fraction in
+/// (0, 1]. InvalidArgument naming the bad value otherwise.
+Status ValidateLevelOptions(const LevelOptions& options);
 
 /// Meshes with fewer triangles than this get no levels.
 inline constexpr size_t kMinLevelSourceTriangles = 64;

@@ -99,6 +99,7 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     brick.max_material_id = encoded.max_material_id;
     brick.dropped_triangle_count = encoded.dropped_triangle_count;
     if (options.levels.triangle_ratios.empty()) return brick;
+    NAVE_RETURN_IF_ERROR(ValidateLevelOptions(options.levels));
 
     const auto start = std::chrono::steady_clock::now();
     std::vector<BrickLevel> levels = MakeBrickLevels(mesh, options.levels);

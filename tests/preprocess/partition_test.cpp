@@ -230,6 +230,12 @@ TEST_F(PartitionedSphere, BrickIdsDoNotDependOnTheThreadCount) {
         EXPECT_EQ(a[i].triangle_count, b[i].triangle_count) << "brick " << i;
         EXPECT_EQ(a[i].mesh.checksum, b[i].mesh.checksum) << "brick " << i;
         EXPECT_EQ(a[i].mesh.offset, b[i].mesh.offset) << "brick " << i;
+        ASSERT_EQ(a[i].levels.size(), b[i].levels.size()) << "brick " << i;
+        for (size_t k = 0; k < a[i].levels.size(); ++k) {
+            EXPECT_EQ(a[i].levels[k].mesh.checksum, b[i].levels[k].mesh.checksum)
+                << "brick " << i << " level " << k + 1;
+            EXPECT_EQ(a[i].levels[k].error, b[i].levels[k].error);
+        }
     }
     for (int k = 0; k < 100; ++k) {
         const Vec3f p =
@@ -237,6 +243,46 @@ TEST_F(PartitionedSphere, BrickIdsDoNotDependOnTheThreadCount) {
             ((*one)->header().bounds.max - (*one)->header().bounds.min) * (float(k) / 100.f);
         EXPECT_EQ((*one)->tree().Locate(p), (*two)->tree().Locate(p));
     }
+}
+
+// Preprocess stores levels of detail by default (each brick of about 1000 triangles gets two) and
+// none when asked for none; the summary and the provenance say so.
+TEST_F(PartitionedSphere, LevelsByDefaultNoneWhenAskedForNone) {
+    const PreprocessStats with = Run(dir_ / "levels.nave", 0, 2);
+    auto store = store::Store::Open(dir_ / "levels.nave");
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    uint64_t level_triangles = 0;
+    for (const store::BrickInfo& b : (*store)->bricks()) {
+        ASSERT_EQ(b.levels.size(), 2u) << "brick " << b.id;
+        EXPECT_LT(b.levels[0].triangle_count, b.triangle_count / 5) << "brick " << b.id;
+        EXPECT_GT(b.levels[1].error, b.levels[0].error) << "brick " << b.id;
+        EXPECT_TRUE((*store)->VerifyBrick(b.id).ok());
+        level_triangles += b.levels[0].triangle_count;
+    }
+    ASSERT_EQ(with.level_triangles.size(), 2u);
+    EXPECT_EQ(with.level_triangles[0], level_triangles);
+    EXPECT_THAT(FormatSummary(with), HasSubstr("level 1: "));
+    EXPECT_THAT((*store)->header().provenance.options, HasSubstr("level-ratios=0.1,0.01"));
+
+    PreprocessOptions o;
+    o.inputs = {dir_ / "sphere.obj"};
+    o.output = dir_ / "none.nave";
+    o.brick_triangles = 1000;
+    o.encode.levels.triangle_ratios.clear();
+    auto without = RunPreprocess(o);
+    ASSERT_TRUE(without.ok()) << without.status().ToString();
+    EXPECT_TRUE(without->level_triangles.empty());
+    EXPECT_THAT(FormatSummary(*without), HasSubstr("levels:      none"));
+    store = store::Store::Open(dir_ / "none.nave");
+    ASSERT_TRUE(store.ok());
+    for (const store::BrickInfo& b : (*store)->bricks()) EXPECT_TRUE(b.levels.empty());
+    EXPECT_THAT((*store)->header().provenance.options, HasSubstr("level-ratios=none"));
+    EXPECT_LT(without->output_bytes, with.output_bytes);
+
+    o.encode.levels.triangle_ratios = {0.1, 0.2};
+    EXPECT_EQ(RunPreprocess(o).status().code(), StatusCode::kInvalidArgument);
+    std::filesystem::remove(dir_ / "levels.nave");
+    std::filesystem::remove(dir_ / "none.nave");
 }
 
 TEST_F(PartitionedSphere, ManyBricksHoldExactlyTheInputTriangles) {
