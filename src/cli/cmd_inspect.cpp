@@ -1,12 +1,13 @@
 // `nave inspect FILE [--json] [--bricks]`: what a brick store holds, read from its header and
 // tables only (no brick is decoded): bricks, triangles, bytes, bounds, grid and error bound,
-// materials, provenance.
+// levels of detail, materials, provenance.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "src/cli/commands.h"
 #include "src/core/json_string.h"
@@ -35,6 +36,47 @@ struct Summary {
     uint32_t largest = store::kNoBrick;  // by triangles
     uint32_t empty = 0;                  // bricks with no triangle
 };
+
+/// Levels of detail at one depth (level k of every brick that has one).
+struct LevelSummary {
+    uint64_t bricks = 0, triangles = 0, bytes = 0, decoded_bytes = 0;
+    float max_error = 0, median_error = 0;
+};
+
+/// Per level k (index k - 1), over the bricks that have it.
+std::vector<LevelSummary> SummarizeLevels(const store::Store& s, uint64_t* level_bytes) {
+    std::vector<LevelSummary> out;
+    std::vector<std::vector<float>> errors;
+    *level_bytes = 0;
+    for (const store::BrickInfo& b : s.bricks()) {
+        if (b.levels.size() > out.size()) {
+            out.resize(b.levels.size());
+            errors.resize(b.levels.size());
+        }
+        for (size_t k = 0; k < b.levels.size(); ++k) {
+            const store::LevelInfo& l = b.levels[k];
+            ++out[k].bricks;
+            out[k].triangles += l.triangle_count;
+            out[k].bytes += l.mesh.length;
+            out[k].decoded_bytes += l.decoded_bytes;
+            out[k].max_error = std::max(out[k].max_error, l.error);
+            errors[k].push_back(l.error);
+            *level_bytes += l.mesh.length;
+        }
+    }
+    for (size_t k = 0; k < out.size(); ++k) {
+        auto mid = errors[k].begin() + errors[k].size() / 2;
+        std::nth_element(errors[k].begin(), mid, errors[k].end());
+        out[k].median_error = *mid;
+    }
+    return out;
+}
+
+/// Percent the levels add to the store's bytes without them.
+double LevelGrowthPercent(const store::Store& s, uint64_t level_bytes) {
+    const uint64_t without = s.file_size() - std::min(level_bytes, s.file_size());
+    return without ? 100.0 * double(level_bytes) / double(without) : 0.0;
+}
 
 Summary Summarize(const store::Store& s) {
     Summary sum;
@@ -83,6 +125,20 @@ void PrintJson(const store::Store& s, bool list_bricks) {
             "\"decoded_bytes\": {}}},\n",
             b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(), b.decoded_bytes);
     }
+    uint64_t level_bytes = 0;
+    const std::vector<LevelSummary> levels = SummarizeLevels(s, &level_bytes);
+    out += "  \"levels\": [";
+    for (size_t k = 0; k < levels.size(); ++k) {
+        const LevelSummary& l = levels[k];
+        out += fmt::format(
+            "{}\n    {{\"level\": {}, \"bricks\": {}, \"triangles\": {}, \"bytes\": {}, "
+            "\"decoded_bytes\": {}, \"max_error\": {}, \"median_error\": {}}}",
+            k ? "," : "", k + 1, l.bricks, l.triangles, l.bytes, l.decoded_bytes, l.max_error,
+            l.median_error);
+    }
+    out += levels.empty() ? "],\n" : "\n  ],\n";
+    out += fmt::format("  \"level_bytes\": {},\n", level_bytes);
+    out += fmt::format("  \"level_growth_percent\": {:.4f},\n", LevelGrowthPercent(s, level_bytes));
     out += "  \"materials\": [";
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
@@ -156,6 +212,24 @@ void PrintText(const store::Store& s, bool list_bricks) {
             FormatCount(double(b.triangle_count)), FormatCount(double(b.vertex_count)),
             FormatBytes(b.BytesOnDisk()), FormatBytes(b.decoded_bytes));
     }
+    uint64_t level_bytes = 0;
+    const std::vector<LevelSummary> levels = SummarizeLevels(s, &level_bytes);
+    if (levels.empty()) {
+        out += "  levels       none\n";
+    } else {
+        out += fmt::format("  levels       {} on disk, {:+.2f} % to the store without them\n",
+                           FormatBytes(level_bytes), LevelGrowthPercent(s, level_bytes));
+        for (size_t k = 0; k < levels.size(); ++k) {
+            const LevelSummary& l = levels[k];
+            out += fmt::format(
+                "    level {}: {} bricks, {} triangles ({:.2f} % of the bricks'), {} on disk, {} "
+                "decoded; error max {}, median {}\n",
+                k + 1, l.bricks, FormatCount(double(l.triangles)),
+                h.triangle_count ? 100.0 * double(l.triangles) / double(h.triangle_count) : 0.0,
+                FormatBytes(l.bytes), FormatBytes(l.decoded_bytes), Length(l.max_error),
+                Length(l.median_error));
+        }
+    }
     out += fmt::format("  materials    {}\n", s.materials().size());
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
@@ -178,6 +252,12 @@ void PrintText(const store::Store& s, bool list_bricks) {
             out += fmt::format("  {:<8} {:>10} {:>11} {:>11}  0x{:<10x} {} - {}\n", b.id,
                                b.triangle_count, b.vertex_count, b.BytesOnDisk(), b.mesh.offset,
                                Vec(b.cell.min), Vec(b.cell.max));
+            for (size_t k = 0; k < b.levels.size(); ++k) {
+                const store::LevelInfo& l = b.levels[k];
+                out += fmt::format("    level {} {:>10} {:>11} {:>11}  0x{:<10x} error {}\n", k + 1,
+                                   l.triangle_count, l.vertex_count, l.mesh.length, l.mesh.offset,
+                                   Length(l.error));
+            }
         }
     }
     std::fputs(out.c_str(), stdout);

@@ -10,6 +10,7 @@
 #include "common/run_nave.h"
 #include "src/core/file.h"
 #include "store/store_reader.h"
+#include "store/store_writer.h"
 #include "store/testing/store_testing.h"
 #include "test_util.h"
 
@@ -95,6 +96,47 @@ TEST_F(NaveCli, VerifyDamagedStoreFailsNamingTheBrick) {
     EXPECT_NE(json.output.find("\"ok\": false"), std::string::npos) << json.output;
     EXPECT_NE(json.output.find("{\"id\": 2, \"error\": \"data loss:"), std::string::npos)
         << json.output;
+}
+
+TEST_F(NaveCli, InspectAndVerifyCoverTheLevels) {
+    const std::filesystem::path with_levels = dir_ / "levels.nave";
+    EncodeOptions options;
+    options.levels = LevelOptions{};
+    ASSERT_TRUE(testing::WriteGridStore(
+                    with_levels, testing::MakeSurface({.quads_x = 40, .quads_y = 40}),
+                    testing::MakeMaterials(3), {2, 2, 1}, GlobalGrid{{0, 0, 0}, 1e-3}, options)
+                    .ok());
+    const CommandResult text = RunNave("inspect --bricks " + with_levels.string());
+    ASSERT_EQ(text.exit_code, 0) << text.output;
+    for (const std::string& part : {"% to the store without them", "level 1: 4 bricks",
+                                    "level 2: 4 bricks", "error max", "    level 2 "}) {
+        EXPECT_NE(text.output.find(part), std::string::npos) << "missing " << part << " in\n"
+                                                             << text.output;
+    }
+    const CommandResult json = RunNave("inspect --json " + with_levels.string());
+    ASSERT_EQ(json.exit_code, 0);
+    EXPECT_NE(json.output.find("{\"level\": 2, \"bricks\": 4, \"triangles\": "), std::string::npos)
+        << json.output;
+    EXPECT_NE(json.output.find("\"level_growth_percent\": "), std::string::npos) << json.output;
+    EXPECT_NE(RunNave("inspect " + store_.string()).output.find("levels       none"),
+              std::string::npos);
+
+    EXPECT_EQ(RunNave("-q verify " + with_levels.string()).exit_code, 0);
+    auto store = Store::Open(with_levels);
+    ASSERT_TRUE(store.ok());
+    const LevelInfo level = (*store)->bricks()[1].levels[0];
+    store->reset();
+    std::string bytes = ReadFileToString(with_levels).value();
+    bytes[level.mesh.offset + 20] ^= 0x01;
+    const std::filesystem::path damaged = dir_ / "damaged_level.nave";
+    std::ofstream(damaged, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    const CommandResult run = RunNave("-q verify " + damaged.string(), true);
+    EXPECT_EQ(run.exit_code, 1) << run.output;
+    EXPECT_NE(
+        run.output.find(fmt::format("brick 1 @0x{:x}: level 1 mesh checksum", level.mesh.offset)),
+        std::string::npos)
+        << run.output;
+    EXPECT_NE(run.output.find("3 of 4 bricks intact"), std::string::npos) << run.output;
 }
 
 TEST_F(NaveCli, MissingOrForeignFilesFailCleanly) {
