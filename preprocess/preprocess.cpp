@@ -394,6 +394,11 @@ std::string FormatSummary(const PreprocessStats& s) {
             s.encode_seconds > 0
                 ? 100.0 * s.simplify_seconds / (s.encode_seconds * std::max(s.threads, 1))
                 : 0.0);
+    } else if (s.simplify_seconds > 0) {
+        out += fmt::format(
+            "\nlevels:      none: no brick simplified far enough (simplifying took {} of thread "
+            "time)",
+            FormatDuration(s.simplify_seconds));
     } else {
         out += "\nlevels:      none";
     }
