@@ -35,10 +35,10 @@ double Since(Clock::time_point t) {
 
 std::string OptionsText(const PreprocessOptions& o, const PreprocessPlan& plan, double step,
                         const std::string& units) {
-    const std::vector<double>& ratios = o.encode.levels.triangle_ratios;
+    const std::vector<double>& ratios = o.encode.levels.relative_errors;
     return fmt::format(
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} "
-        "derived-normal-error={} verify-every={} level-ratios={} units={}",
+        "derived-normal-error={} verify-every={} level-errors={} units={}",
         plan.brick_triangles, plan.memory_budget, step, plan.threads, o.encode.draco_speed,
         o.encode.derived_normal_error_deg, o.verify_every,
         ratios.empty() ? std::string("none") : fmt::format("{}", fmt::join(ratios, ",")), units);
@@ -294,7 +294,7 @@ double DefaultGridStep(double diagonal) { return diagonal > 0 ? diagonal / doubl
 
 StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     const auto start = Clock::now();
-    if (!options.encode.levels.triangle_ratios.empty())
+    if (!options.encode.levels.relative_errors.empty())
         NAVE_RETURN_IF_ERROR(store::ValidateLevelOptions(options.encode.levels));
     NAVE_ASSIGN_OR_RETURN(const PreprocessPlan plan,
                           PlanPreprocess(options, QueryMachineResources()));

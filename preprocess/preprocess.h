@@ -36,9 +36,10 @@ struct PreprocessOptions {
     double precision = 0;            ///< grid step in model units; 0: bounds diagonal / 2^20
     int threads = 0;                 ///< 0: all hardware threads
     std::filesystem::path temp_dir;  ///< parent of the temporary directory; empty: beside output
-    /// Encoder settings; unlike EncodeOptions' own defaults, preprocess makes levels of detail
-    /// (store::LevelOptions' default ratios) unless `encode.levels.triangle_ratios` is empty.
-    store::EncodeOptions encode = {.levels = store::LevelOptions{}};
+    /// Encoder settings. Levels of detail are made only when `encode.levels.relative_errors` is
+    /// not empty (`nave preprocess --levels`): docs/render.md, "Levels of detail", says why they
+    /// are not made by default yet.
+    store::EncodeOptions encode;
     /// Decode every n-th brick (and the first) after encoding to check it (EncodeOptions::verify);
     /// 1 checks them all, 0 none. `nave verify` checks a whole store later.
     uint32_t verify_every = 1;

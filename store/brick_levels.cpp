@@ -14,9 +14,11 @@ static_assert(sizeof(Vec3f) == 3 * sizeof(float), "meshoptimizer reads positions
 
 constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
 
-/// meshopt_simplify's target_error is relative to the mesh's extent; 1 (the whole extent) lets the
-/// triangle target alone decide how far a level goes, and the error it reaches is what we record.
-constexpr float kTargetErrorRelative = 1.f;
+/// meshoptimizer's error is an estimate from its quadrics, not a bound: on curved test sheets the
+/// centres of coarse triangles lay up to 1.47 times as far from the full surface. The renderer
+/// chooses levels and keeps rays clear of the other levels' surfaces by the recorded error, so the
+/// store records twice the estimate.
+constexpr float kErrorSafety = 2.f;
 
 /// The triangles of one material, as indices into the mesh's vertices.
 struct Submesh {
@@ -50,11 +52,12 @@ struct Scratch {
     std::vector<uint32_t> simplified;
 };
 
-/// Simplifies one material's triangles of `mesh` toward `target_triangles`, appending the kept
-/// triangles (indices into `mesh`'s vertices) to `out`. Returns the absolute error: meshoptimizer's
-/// relative error times its scale (the submesh's extent), since the submesh alone is simplified.
-float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, size_t target_triangles,
-                      Scratch& s, BrickMesh* out) {
+/// Simplifies one material's triangles of `mesh` as far as `target_error` (model units) allows,
+/// appending the kept triangles (indices into `mesh`'s vertices) to `out`. Returns the absolute
+/// error reached: meshoptimizer's relative error times its scale (the submesh's extent), since the
+/// submesh alone is simplified.
+float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, float target_error,
+                      bool lock_borders, Scratch& s, BrickMesh* out) {
     // A compact copy of the submesh's vertices: meshoptimizer's work and its scale then depend on
     // this material's vertices only.
     s.global_of.clear();
@@ -74,12 +77,20 @@ float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, size_t target_t
     for (uint32_t v : s.global_of) s.local_of[v] = kUnused;
 
     s.simplified.resize(s.indices.size());  // meshoptimizer's worst case: every index kept
-    float relative_error = 0;
-    const size_t kept = meshopt_simplify(s.simplified.data(), s.indices.data(), s.indices.size(),
-                                         &s.positions[0].x, s.positions.size(), sizeof(Vec3f),
-                                         3 * target_triangles, kTargetErrorRelative,
-                                         /*options=*/0, &relative_error);
     const float scale = meshopt_simplifyScale(&s.positions[0].x, s.positions.size(), sizeof(Vec3f));
+    if (!(scale > 0)) {  // every vertex at one point: nothing to simplify
+        for (uint32_t t : sub.triangles)
+            for (int c = 0; c < 3; ++c) out->indices.push_back(mesh.indices[3 * size_t(t) + c]);
+        out->material_ids.insert(out->material_ids.end(), sub.triangles.size(), sub.material);
+        return 0;
+    }
+    float relative_error = 0;
+    // No triangle target (0): the error alone stops the collapses.
+    const size_t kept =
+        meshopt_simplify(s.simplified.data(), s.indices.data(), s.indices.size(), &s.positions[0].x,
+                         s.positions.size(), sizeof(Vec3f),
+                         /*target_index_count=*/0, target_error / scale,
+                         lock_borders ? unsigned(meshopt_SimplifyLockBorder) : 0u, &relative_error);
     for (size_t i = 0; i < kept; ++i) out->indices.push_back(s.global_of[s.simplified[i]]);
     out->material_ids.insert(out->material_ids.end(), kept / 3, sub.material);
     return relative_error * scale;
@@ -107,12 +118,12 @@ void CompactVertices(const BrickMesh& source, BrickMesh* level) {
 }  // namespace
 
 Status ValidateLevelOptions(const LevelOptions& options) {
-    const std::vector<double>& r = options.triangle_ratios;
+    const std::vector<double>& r = options.relative_errors;
     for (size_t k = 0; k < r.size(); ++k) {
-        if (!(r[k] > 0 && r[k] < 1) || (k > 0 && !(r[k] < r[k - 1]))) {
+        if (!(r[k] > 0 && r[k] < 1) || (k > 0 && !(r[k] > r[k - 1]))) {
             return InvalidArgumentError(
-                "level {} triangle ratio {}: expected a fraction in (0, 1) smaller than the level "
-                "before's",
+                "level {} error {}: expected a fraction of the brick's extent in (0, 1), larger "
+                "than the level before's",
                 k + 1, r[k]);
         }
     }
@@ -126,29 +137,27 @@ Status ValidateLevelOptions(const LevelOptions& options) {
 std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options) {
     std::vector<BrickLevel> levels;
     // Each level is simplified from the one before, by reference: no reallocation.
-    levels.reserve(options.triangle_ratios.size());
+    levels.reserve(options.relative_errors.size());
     if (full.TriangleCount() < kMinLevelSourceTriangles || full.VertexCount() == 0) return levels;
 
-    // Targets count from the full mesh's triangles of each material, so that every material keeps
-    // its share and the ratios mean the same whichever level a level is simplified from.
-    std::vector<size_t> full_triangles_of;  // by material id
-    for (uint32_t m : full.material_ids) {
-        if (m >= full_triangles_of.size()) full_triangles_of.resize(size_t(m) + 1, 0);
-        ++full_triangles_of[m];
-    }
+    Bounds3f box;
+    for (const Vec3f& p : full.positions) box.Extend(p);
+    const double extent = double(Length(box.Diagonal()));
     Scratch scratch;
     const BrickMesh* source = &full;
     float source_error = 0;  // the error `source` already carries
-    for (const double ratio : options.triangle_ratios) {
-        if (!(ratio > 0 && ratio < 1)) break;
+    for (const double relative : options.relative_errors) {
+        if (!(relative > 0 && relative < 1)) break;
+        // Each step simplifies from the level before, whose error counts toward this one's.
+        const float step_target = float(relative * extent) - source_error;
+        if (!(step_target > 0)) break;
         scratch.local_of.assign(source->VertexCount(), kUnused);
         BrickLevel level;
         float step_error = 0;
         for (const Submesh& sub : SplitByMaterial(*source)) {
-            const size_t target =
-                size_t(std::llround(ratio * double(full_triangles_of[sub.material])));
             step_error =
-                std::max(step_error, SimplifySubmesh(*source, sub, target, scratch, &level.mesh));
+                std::max(step_error, SimplifySubmesh(*source, sub, step_target,
+                                                     options.lock_borders, scratch, &level.mesh));
         }
         const size_t triangles = level.mesh.TriangleCount();
         if (triangles == 0 ||
@@ -159,7 +168,7 @@ std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOption
         // A level simplified from the one before differs from the full mesh by at most both
         // errors (triangle inequality): conservative, and larger than the previous level's. A
         // flat region simplifies without error; the next float keeps the errors increasing.
-        level.error = source_error + step_error;
+        level.error = source_error + kErrorSafety * step_error;
         if (!levels.empty() && !(level.error > source_error))
             level.error = std::nextafter(source_error, std::numeric_limits<float>::infinity());
         levels.push_back(std::move(level));

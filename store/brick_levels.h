@@ -13,11 +13,21 @@ namespace nave::store {
 /// Coarser versions of a brick's mesh: what preprocess stores beside each brick, and what tests and
 /// procedural scenes build in memory.
 struct LevelOptions {
-    /// Triangles of each coarser level as a fraction of the full mesh's, coarsest last.
-    std::vector<double> triangle_ratios = {0.1, 0.01};
+    /// The error each coarser level aims at, as a fraction of the brick's extent (the diagonal of
+    /// its geometry's box), finest first, each larger than the one before. Each level simplifies
+    /// until the next collapse would pass its error: a level is as coarse as its error allows,
+    /// wherever the brick's detail lies. Why 0.001 and 0.004 (a few cm and about 10 cm in the
+    /// abbey's bricks): docs/store-format.md, "Levels".
+    std::vector<double> relative_errors = {0.001, 0.004};
     /// A level that keeps more than this fraction of the previous level's triangles is not made
-    /// (nor any coarser one).
+    /// (nor any coarser one): it would cost nearly as much to load as the level before.
     double max_kept_fraction = 0.5;
+    /// Keep the vertices on the borders of each material's surface where they are: the borders
+    /// where the brick was cut from its neighbours (which lie outside its cell, since a brick
+    /// holds every triangle overlapping it) and those between materials. Without, a level's border
+    /// recedes by up to its error, which opens holes inside the cell at its faces (a wall cut by a
+    /// cell face then lets light through at the coarse level: tests/render/levels_of_detail_test).
+    bool lock_borders = true;
 };
 
 /// One coarser version of a brick's mesh.
@@ -28,8 +38,8 @@ struct BrickLevel {
     float error = 0;
 };
 
-/// Checks `options`: every ratio in (0, 1), each smaller than the one before, max_kept_fraction in
-/// (0, 1]. InvalidArgument naming the bad value otherwise.
+/// Checks `options`: every relative error in (0, 1), each larger than the one before,
+/// max_kept_fraction in (0, 1]. InvalidArgument naming the bad value otherwise.
 Status ValidateLevelOptions(const LevelOptions& options);
 
 /// Meshes with fewer triangles than this get no levels.
@@ -38,9 +48,10 @@ inline constexpr size_t kMinLevelSourceTriangles = 64;
 /// The levels of `full`, finest first, each with a larger error than the one before. Thread-safe.
 /// Empty when the mesh does not simplify (fewer than kMinLevelSourceTriangles triangles, or the
 /// first level keeps too much). Every triangle keeps its material (edges collapse only within one
-/// material's triangles); normals and texture coordinates are those of the vertices kept; borders,
-/// those of the brick and those between materials, are not locked and move by up to the level's
-/// error. `full` must satisfy ValidateBrickMesh; so does every level.
+/// material's triangles); normals and texture coordinates are those of the vertices kept; with
+/// options.lock_borders (the default) the borders, those of the brick and those between
+/// materials, stay where they are, so a level has no hole its brick's full mesh lacks. `full`
+/// must satisfy ValidateBrickMesh; so does every level.
 std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options = {});
 
 }  // namespace nave::store

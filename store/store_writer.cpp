@@ -98,11 +98,18 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     brick.has_uvs = encoded.has_uvs;
     brick.max_material_id = encoded.max_material_id;
     brick.dropped_triangle_count = encoded.dropped_triangle_count;
-    if (options.levels.triangle_ratios.empty()) return brick;
+    if (options.levels.relative_errors.empty()) return brick;
     NAVE_RETURN_IF_ERROR(ValidateLevelOptions(options.levels));
 
     const auto start = std::chrono::steady_clock::now();
-    std::vector<BrickLevel> levels = MakeBrickLevels(mesh, options.levels);
+    // The levels simplify the brick as it decodes: snapped to the grid, and with the vertices
+    // Draco splits where the surface is not a manifold (parts touching at an edge or a corner),
+    // which meshoptimizer would otherwise lock and keep.
+    NAVE_ASSIGN_OR_RETURN(
+        BrickMesh decoded,
+        codec::DecodeMeshSection(brick.mesh_bytes, grid, uint64_t(codec::kMaxMaterialId) + 1,
+                                 "the brick just encoded"));
+    std::vector<BrickLevel> levels = MakeBrickLevels(decoded, options.levels);
     brick.simplify_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (size_t k = 0; k < levels.size(); ++k) {

@@ -34,9 +34,9 @@ struct EncodeOptions {
     /// what was encoded. Off, encoding is about a third faster and the counts come from Draco's
     /// encoder (docs/preprocess.md, "Verification").
     bool verify = true;
-    /// Coarser levels of each brick to make and store beside it (brick_levels.h); no ratios, the
+    /// Coarser levels of each brick to make and store beside it (brick_levels.h); no errors, the
     /// default here, makes none. `nave preprocess` makes LevelOptions' defaults.
-    LevelOptions levels = {.triangle_ratios = {}};
+    LevelOptions levels = {.relative_errors = {}};
 };
 
 /// A level of a brick ready to be appended (format 3.1): its mesh section and table fields.

@@ -47,6 +47,7 @@ struct RenderOptions {
     std::string trace;       // --trace FILE.json
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     bool no_textures = false;
+    bool no_lod = false;
     CheckpointFlags checkpoint;  // --checkpoint, --checkpoint-every, --resume, --stop-after
 };
 
@@ -102,6 +103,7 @@ StatusOr<render::SceneConfig> BuildConfig(const RenderOptions& o) {
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
+    if (o.no_lod) config.render.lod = render::RenderSettings::Lod::kFull;
     return config;
 }
 
@@ -288,7 +290,10 @@ Status RunRender(const RenderOptions& o) {
     NAVE_ASSIGN_OR_RETURN(render::RenderScene scene, render::BuildRenderScene(config, source));
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<render::TextureCache> textures,
                           AttachModelTextures(o, config, source, memory_bytes, &scene));
-    log::Info("render: {} bricks, {} materials, {}x{}, mode {}{}", source.brick_count(),
+    log::Info("render: {} bricks{}, {} materials, {}x{}, mode {}{}", source.brick_count(),
+              source.level_count() > 1
+                  ? fmt::format(" at up to {} levels of detail", source.level_count())
+                  : std::string(),
               scene.materials.size(), config.camera.width, config.camera.height,
               ModeName(config.render.mode),
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
@@ -310,7 +315,7 @@ Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(CheckNotInterrupted(*session, scene.settings, stats, out));
     // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),
     // so that the two never add up (the allocator keeps freed pages a while otherwise).
-    for (uint32_t b = 0; b < source.brick_count(); ++b) source.Evict(b);
+    for (uint32_t b = 0; b < source.slot_count(); ++b) source.Evict(b);
     ReturnFreeMemory();
 
     render::RenderSummary summary(scene.settings, stats, TextureFacts(textures.get()));
@@ -381,6 +386,9 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
         "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures,
                   "Ignore the model's textures (textures.enabled = false)");
+    cmd->add_flag("--no-lod", opts->no_lod,
+                  "Trace full detail everywhere, ignoring the store's coarser levels of detail "
+                  "(render.lod = \"full\"; docs/render.md, \"Levels of detail\")");
     cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
                     "Write the render's state to FILE between passes (photon mode: iterations), at "
                     "most every "

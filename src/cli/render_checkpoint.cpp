@@ -46,9 +46,10 @@ render::CheckpointIdentity RenderIdentity(uint64_t model_id, const std::string& 
     // spp, iterations, noise or time limits, which only say when to stop, so that a resumed
     // render may go on further.
     const std::string resolved = fmt::format(
-        "{}\n--resolution {}x{} --seed {} --photons {} --mode {} --textures {}", config_text,
-        config.camera.width, config.camera.height, config.render.seed,
-        config.render.photons_per_iteration, int(config.render.mode), config.textures.enabled);
+        "{}\n--resolution {}x{} --seed {} --photons {} --mode {} --textures {} --lod {}",
+        config_text, config.camera.width, config.camera.height, config.render.seed,
+        config.render.photons_per_iteration, int(config.render.mode), config.textures.enabled,
+        int(config.render.lod));
     render::CheckpointIdentity id;
     id.model = model_id;
     id.model_name = model_name;

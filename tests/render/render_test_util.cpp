@@ -28,6 +28,21 @@ std::unique_ptr<BrickSource> GridSource(const store::BrickMesh& mesh,
                                                std::move(grid.meshes), std::move(materials));
 }
 
+std::unique_ptr<BrickSource> GridSourceWithLevels(const store::BrickMesh& mesh,
+                                                  std::vector<store::MaterialRecord> materials,
+                                                  Vec3i cells, const store::LevelOptions& levels) {
+    auto device = EmbreeDevice::Create();
+    EXPECT_TRUE(device.ok()) << device.status().ToString();
+    if (!device.ok()) return nullptr;
+    GridBricks grid = SplitIntoGridBricks(mesh, cells.x, cells.y, cells.z);
+    std::vector<std::vector<store::BrickLevel>> coarser;
+    for (const store::BrickMesh& m : grid.meshes)
+        coarser.push_back(store::MakeBrickLevels(m, levels));
+    return std::make_unique<MemoryBrickSource>(*device, std::move(grid.tree),
+                                               std::move(grid.meshes), std::move(materials),
+                                               std::move(coarser));
+}
+
 Status WriteGridBricksStore(const std::filesystem::path& path, const store::BrickMesh& mesh,
                             const std::vector<std::string>& names, Vec3i cells,
                             const store::EncodeOptions& options) {

@@ -22,6 +22,7 @@
 #include "src/render/scene/scene.h"
 #include "src/render/scene/scene_config.h"
 #include "src/render/stream/pager.h"
+#include "store/brick_levels.h"
 #include "store/brick_mesh.h"
 #include "store/material_record.h"
 #include "store/store_writer.h"
@@ -38,6 +39,13 @@ std::vector<store::MaterialRecord> NamedMaterials(const std::vector<std::string>
 /// fresh Embree device (a failure to create one fails the test and returns null).
 std::unique_ptr<BrickSource> GridSource(const store::BrickMesh& mesh,
                                         std::vector<store::MaterialRecord> materials, Vec3i cells);
+
+/// GridSource with each brick's coarser levels of detail (store::MakeBrickLevels with `levels`),
+/// which renders use unless render.lod = "full".
+std::unique_ptr<BrickSource> GridSourceWithLevels(const store::BrickMesh& mesh,
+                                                  std::vector<store::MaterialRecord> materials,
+                                                  Vec3i cells,
+                                                  const store::LevelOptions& levels = {});
 
 /// Writes `mesh` to a store at `path` cut as GridSource cuts it (every triangle in every cell its
 /// box overlaps), each brick encoded with `options`, materials named `names`.

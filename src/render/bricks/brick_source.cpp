@@ -35,17 +35,52 @@ BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree 
       tree_(std::move(tree)),
       cells_(std::move(cells)),
       materials_(std::move(materials)),
-      bounds_(bounds) {
+      bounds_(bounds),
+      brick_count_(uint32_t(cells_.size())),
+      level_errors_(cells_.size(), 0.f) {
     slots_.reserve(cells_.size());
     for (size_t i = 0; i < cells_.size(); ++i) slots_.push_back(std::make_unique<Slot>());
+}
+
+uint32_t BrickSource::LevelsOf(uint32_t brick) const {
+    const float* errors = LevelErrors(brick);
+    uint32_t n = 1;
+    while (n < level_count_ && std::isfinite(errors[n])) ++n;
+    return n;
+}
+
+Status BrickSource::UseLevels(uint32_t max_levels) {
+    {
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        if (stats_.resident_bytes != 0) {
+            return InvalidArgumentError(
+                "levels of detail cannot change while {} of bricks are resident",
+                stats_.resident_bytes);
+        }
+    }
+    uint32_t levels = 1;
+    for (uint32_t b = 0; b < brick_count_; ++b)
+        levels = std::max(levels, std::min(std::max(max_levels, 1u), StoredLevels(b)));
+    level_count_ = levels;
+    level_errors_.assign(size_t(brick_count_) * levels, std::numeric_limits<float>::infinity());
+    for (uint32_t b = 0; b < brick_count_; ++b) {
+        const uint32_t n = std::min(levels, StoredLevels(b));
+        for (uint32_t l = 0; l < n; ++l)
+            level_errors_[size_t(b) * levels + l] = l == 0 ? 0.f : StoredLevelError(b, l);
+    }
+    slots_.clear();
+    for (size_t i = 0; i < size_t(brick_count_) * levels; ++i)
+        slots_.push_back(std::make_unique<Slot>());
+    return Status::Ok();
 }
 
 BrickSource::~BrickSource() = default;
 
 StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     if (id >= slots_.size()) {
-        return InvalidArgumentError("brick {} requested but the model has {} bricks", id,
-                                    slots_.size());
+        return InvalidArgumentError(
+            "brick slot {} requested but the model has {} (bricks x levels of detail)", id,
+            slots_.size());
     }
     acquires_.fetch_add(1, std::memory_order_relaxed);
     Slot& slot = *slots_[id];
@@ -98,14 +133,19 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     load.AddArg({"bytes_read", bytes});
     TraceSpan build(trace_, "bvh build", "pager");
     StatusOr<std::unique_ptr<ResidentBrick>> built =
-        mesh.ok() ? ResidentBrick::Build(*device_, id, cells_[id], std::move(mesh).value(),
-                                         &alpha_masks_, bvh_)
-                  : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
+        mesh.ok()
+            ? ResidentBrick::Build(*device_, id, cells_[BrickOfSlot(id)], std::move(mesh).value(),
+                                   &alpha_masks_, bvh_,
+                                   {LevelOfSlot(id), LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)]})
+            : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     build.End();
     double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
-        slot.error = built.status().WithContext(fmt::format("loading brick {}", id));
+        slot.error = built.status().WithContext(
+            LevelOfSlot(id) == 0
+                ? fmt::format("loading brick {}", id)
+                : fmt::format("loading brick {} at level {}", BrickOfSlot(id), LevelOfSlot(id)));
         slot.pins.fetch_sub(1, std::memory_order_acq_rel);
         return slot.error;
     }

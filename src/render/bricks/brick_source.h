@@ -73,16 +73,39 @@ class BrickSource {
   public:
     virtual ~BrickSource();
 
-    uint32_t brick_count() const { return uint32_t(slots_.size()); }
+    /// Bricks: the leaves of the brick tree, each a cell of space.
+    uint32_t brick_count() const { return brick_count_; }
     const store::BrickTree& tree() const { return tree_; }
+
+    /// Levels of detail (docs/render.md, "Levels of detail"). Level 0 of a brick is its full mesh;
+    /// a store may hold coarser ones, each with its error (store::LevelInfo). The stream layer
+    /// sees each level of each brick as a slot of its own, with its own queue and residency:
+    /// slot = level * brick_count() + brick. Without levels (UseLevels(1), the default) slots are
+    /// bricks. Everything that takes a brick id below (Acquire, Evict, IsResident, the estimates)
+    /// takes a slot.
+    uint32_t slot_count() const { return uint32_t(slots_.size()); }
+    /// Levels per brick in use (1: full detail only).
+    uint32_t level_count() const { return level_count_; }
+    uint32_t BrickOfSlot(uint32_t slot) const { return slot % brick_count_; }
+    uint32_t LevelOfSlot(uint32_t slot) const { return slot / brick_count_; }
+    uint32_t SlotOf(uint32_t brick, uint32_t level) const { return level * brick_count_ + brick; }
+    /// The errors of brick `brick`'s levels in use, finest first: level_count() values, 0 for level
+    /// 0 and +infinity for a level the brick lacks (so that no footprint chooses it).
+    const float* LevelErrors(uint32_t brick) const { return &level_errors_[brick * level_count_]; }
+    /// Levels brick `brick` has in use (1 to level_count()).
+    uint32_t LevelsOf(uint32_t brick) const;
+    /// Uses up to `max_levels` levels of each brick (1: full detail everywhere; more than the
+    /// model has: all it has). InvalidArgument if any brick is resident.
+    Status UseLevels(uint32_t max_levels);
     /// The cell of every brick, by id.
     const std::vector<Bounds3f>& cells() const { return cells_; }
     const std::vector<store::MaterialRecord>& materials() const { return materials_; }
     /// Box of all geometry.
     const Bounds3f& bounds() const { return bounds_; }
 
-    /// Pins brick `id`, loading it first if it is not resident. Errors (corrupt brick, Embree
-    /// failure) name the brick and are returned to every caller that asks for it.
+    /// Pins slot `id` (a brick at one of its levels), loading it first if it is not resident.
+    /// Errors (corrupt brick, Embree failure) name the brick and are returned to every caller that
+    /// asks for it.
     StatusOr<BrickHandle> Acquire(uint32_t id);
     /// Whether brick `id` is in memory now (a hint: it may be evicted right after unless pinned).
     bool IsResident(uint32_t id) const;
@@ -124,8 +147,19 @@ class BrickSource {
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
                 std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
                 Bounds3f bounds);
-    /// Reads and decodes brick `id` (no caching: the base class caches). Adds to `bytes_read`.
+    /// Reads and decodes slot `id` (no caching: the base class caches). Adds to `bytes_read`.
     virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
+    /// Levels brick `brick` has, level 0 included (1: no coarser level).
+    virtual uint32_t StoredLevels(uint32_t brick) const {
+        (void)brick;
+        return 1;
+    }
+    /// The error of brick `brick`'s level `level` (< StoredLevels), in model units.
+    virtual float StoredLevelError(uint32_t brick, uint32_t level) const {
+        (void)brick;
+        (void)level;
+        return 0;
+    }
 
   private:
     friend class BrickHandle;
@@ -151,6 +185,9 @@ class BrickSource {
     std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
     std::condition_variable decode_cv_;
     int decodes_ = 0;
+    uint32_t brick_count_ = 0;
+    uint32_t level_count_ = 1;
+    std::vector<float> level_errors_;  // level_count_ per brick
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;

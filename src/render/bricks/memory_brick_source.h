@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "src/render/bricks/brick_source.h"
+#include "store/brick_levels.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
@@ -18,13 +19,23 @@ class MemoryBrickSource final : public BrickSource {
     MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, const store::BrickTree& tree,
                       std::vector<store::BrickMesh> meshes,
                       std::vector<store::MaterialRecord> materials);
+    /// With coarser levels of each brick (store::MakeBrickLevels), used once UseLevels asks.
+    MemoryBrickSource(std::shared_ptr<EmbreeDevice> device, const store::BrickTree& tree,
+                      std::vector<store::BrickMesh> meshes,
+                      std::vector<store::MaterialRecord> materials,
+                      std::vector<std::vector<store::BrickLevel>> levels);
     uint64_t EstimatedResidentBytes(uint32_t id) const override;
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+    uint32_t StoredLevels(uint32_t brick) const override;
+    float StoredLevelError(uint32_t brick, uint32_t level) const override;
 
   private:
+    /// Slot `id`'s mesh, or null for a level its brick lacks.
+    const store::BrickMesh* MeshOf(uint32_t id) const;
     std::vector<store::BrickMesh> meshes_;
+    std::vector<std::vector<store::BrickLevel>> levels_;  // per brick, coarser levels
 };
 
 }  // namespace nave::render

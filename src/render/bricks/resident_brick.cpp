@@ -100,8 +100,10 @@ bool ResidentBrick::SurfacePresent(uint32_t triangle, float u, float v) const {
 StatusOr<std::unique_ptr<ResidentBrick>> ResidentBrick::Build(EmbreeDevice& device, uint32_t id,
                                                               Bounds3f cell, ResidentMesh mesh,
                                                               const AlphaMasks* masks,
-                                                              const BvhSettings& bvh) {
+                                                              const BvhSettings& bvh,
+                                                              LevelOfDetail lod) {
     std::unique_ptr<ResidentBrick> brick(new ResidentBrick(id, cell, std::move(mesh)));
+    brick->lod_ = lod;
     const ResidentMesh& m = brick->mesh_;
     RTCDevice dev = static_cast<RTCDevice>(device.handle());
     RTCScene scene = rtcNewScene(dev);

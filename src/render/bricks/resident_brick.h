@@ -54,6 +54,12 @@ struct BrickHit {
     Vec3f ng;  ///< geometric normal, unnormalised, (v1 - v0) x (v2 - v0): front side is CCW
 };
 
+/// Which level of detail of its brick a resident brick holds (BrickSource, "Levels of detail").
+struct LevelOfDetail {
+    uint32_t level = 0;  ///< 0: the full mesh
+    float error = 0;     ///< the level's largest distance from the full surface, model units
+};
+
 /// A brick in memory: its cell, its mesh (shading data) and its Embree scene. Immutable once built,
 /// so any number of threads may trace it at once. Built and destroyed only by a BrickSource.
 class ResidentBrick {
@@ -69,7 +75,8 @@ class ResidentBrick {
     static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id,
                                                           Bounds3f cell, ResidentMesh mesh,
                                                           const AlphaMasks* masks = nullptr,
-                                                          const BvhSettings& bvh = {});
+                                                          const BvhSettings& bvh = {},
+                                                          LevelOfDetail lod = {});
     /// The same over a copy of `mesh`.
     static StatusOr<std::unique_ptr<ResidentBrick>> Build(EmbreeDevice& device, uint32_t id,
                                                           Bounds3f cell,
@@ -77,7 +84,9 @@ class ResidentBrick {
                                                           const AlphaMasks* masks = nullptr,
                                                           const BvhSettings& bvh = {});
 
+    /// The brick's slot in its source (BrickSource::SlotOf: the brick id at level 0).
     uint32_t id() const { return id_; }
+    const LevelOfDetail& lod() const { return lod_; }
     const Bounds3f& cell() const { return cell_; }
     const ResidentMesh& mesh() const { return mesh_; }
     /// Bytes of the mesh plus an estimate of Embree's BVH (for budgets and statistics).
@@ -100,6 +109,7 @@ class ResidentBrick {
   private:
     ResidentBrick(uint32_t id, Bounds3f cell, ResidentMesh mesh);
     uint32_t id_;
+    LevelOfDetail lod_;
     const AlphaMasks* masks_ = nullptr;
     Bounds3f cell_;
     ResidentMesh mesh_;

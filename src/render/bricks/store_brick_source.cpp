@@ -20,10 +20,37 @@ StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(
         new StoreBrickSource(std::move(st), std::move(device)));
 }
 
+namespace {
+/// The counts of brick `info` at `level` (0: the brick itself).
+struct LevelCounts {
+    uint64_t vertices, triangles;
+    bool normals, uvs;
+    uint64_t disk_bytes;
+};
+LevelCounts CountsOf(const store::BrickInfo& info, uint32_t level) {
+    if (level == 0) {
+        return {info.vertex_count, info.triangle_count, info.has_normals, info.has_uvs,
+                info.BytesOnDisk()};
+    }
+    const store::LevelInfo& l = info.levels[level - 1];
+    return {l.vertex_count, l.triangle_count, l.has_normals, l.has_uvs, l.mesh.length};
+}
+}  // namespace
+
+uint32_t StoreBrickSource::StoredLevels(uint32_t brick) const {
+    return 1 + uint32_t(store_->bricks()[brick].levels.size());
+}
+
+float StoreBrickSource::StoredLevelError(uint32_t brick, uint32_t level) const {
+    return level == 0 ? 0.f : store_->bricks()[brick].levels[level - 1].error;
+}
+
 uint64_t StoreBrickSource::EstimatedResidentBytes(uint32_t id) const {
-    const store::BrickInfo& b = store_->bricks()[id];
-    return ResidentBrick::EstimateMemoryBytes(b.vertex_count, b.triangle_count, b.has_normals,
-                                              b.has_uvs, bvh_settings());
+    const uint32_t brick = BrickOfSlot(id), level = LevelOfSlot(id);
+    if (level >= LevelsOf(brick)) return 0;  // a level this brick lacks: never loaded
+    const LevelCounts c = CountsOf(store_->bricks()[brick], level);
+    return ResidentBrick::EstimateMemoryBytes(c.vertices, c.triangles, c.normals, c.uvs,
+                                              bvh_settings());
 }
 
 uint64_t StoreBrickSource::LoadScratchBytes(uint32_t id) const {
@@ -31,12 +58,15 @@ uint64_t StoreBrickSource::LoadScratchBytes(uint32_t id) const {
     // verify --threads 1` of the detail-110 abbey (bricks of up to 780 k triangles) peaks 114 MiB
     // above the process's size, 28 MiB of it the decoded brick: about 110 bytes per triangle.
     constexpr uint64_t kDecodeScratchBytesPerTriangle = 112;
-    return kDecodeScratchBytesPerTriangle * store_->bricks()[id].triangle_count;
+    const uint32_t brick = BrickOfSlot(id), level = LevelOfSlot(id);
+    if (level >= LevelsOf(brick)) return 0;
+    return kDecodeScratchBytesPerTriangle * CountsOf(store_->bricks()[brick], level).triangles;
 }
 
 StatusOr<store::BrickMesh> StoreBrickSource::LoadMesh(uint32_t id, uint64_t* bytes_read) {
-    NAVE_ASSIGN_OR_RETURN(store::BrickMesh mesh, store_->ReadBrick(id));
-    *bytes_read += store_->bricks()[id].BytesOnDisk();
+    const uint32_t brick = BrickOfSlot(id), level = LevelOfSlot(id);
+    NAVE_ASSIGN_OR_RETURN(store::BrickMesh mesh, store_->ReadBrick(brick, level));
+    *bytes_read += CountsOf(store_->bricks()[brick], level).disk_bytes;
     return mesh;
 }
 

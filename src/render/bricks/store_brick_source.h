@@ -14,7 +14,8 @@ class Store;
 
 namespace nave::render {
 
-/// Bricks read from a store file on first touch and kept resident.
+/// Bricks read from a store file on first touch and kept resident; their levels of detail are the
+/// store's (store::LevelInfo).
 class StoreBrickSource final : public BrickSource {
   public:
     static StatusOr<std::unique_ptr<StoreBrickSource>> Open(const std::filesystem::path& path,
@@ -26,6 +27,8 @@ class StoreBrickSource final : public BrickSource {
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+    uint32_t StoredLevels(uint32_t brick) const override;
+    float StoredLevelError(uint32_t brick, uint32_t level) const override;
 
   private:
     StoreBrickSource(std::unique_ptr<store::Store> store, std::shared_ptr<EmbreeDevice> device);

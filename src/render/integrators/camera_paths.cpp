@@ -54,6 +54,8 @@ void CameraPaths::GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sa
             r.lambda = SampledWavelengths::SampleVisible(rng.Uniform(kDimLambda));
             r.beta = SampledSpectrum(1.f);
             r.t_max = kInfinity;
+            // A pinhole's cone: no width at the camera, one pixel's angle of spread.
+            r.cone_spread = camera.PixelSpreadAngle();
             Spawn(r, store::kNoBrick, nullptr, out);
         }
         scheduler_.Flush(out);
@@ -67,7 +69,7 @@ void CameraPaths::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
 
 void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, RayOutbox& out) {
     if (r.kind == kShadowRay) {
-        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        const float t1 = SegmentEnd(r, brick);
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
         if (next == store::kNoBrick) {
@@ -134,7 +136,7 @@ void CameraPaths::AddShadowContribution(const RayRecord& r) {
 
 bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1,
                                      RayCounts& c) const {
-    float t0 = r.t_enter;
+    float t0 = SegmentStart(r, brick);
     for (;;) {
         ++c.shadow_segments;
         if (!has_thin_glass_) return !brick.Occluded(r.origin, r.dir, t0, t1);
@@ -237,7 +239,7 @@ bool CameraPaths::Continue(RayRecord& r, const SurfaceHit& h, const GuidedBsdf& 
             r.beta /= 1 - q;
         }
     }
-    return Bounce(r, h, bs->wi);
+    return Bounce(r, h, bs->wi, bs->IsSpecular());
 }
 
 }  // namespace nave::render

@@ -117,12 +117,12 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
                                 }));
     visible_->BuildBrickGrids(scheduler_.tree());
     deposited_.assign(emitters_->learned_photons(), 0.f);
-    NAVE_RETURN_IF_ERROR(
-        scheduler_.DrainInWaves(*this, photons, wave, StreamScheduler::LastWave::kDrained,
-                                [&](uint64_t first, uint64_t last) {
-                                    emitters_->EmitPhotons(first, last, iteration_, scheduler_);
-                                    return Status::Ok();
-                                }));
+    NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
+        *this, photons, wave, StreamScheduler::LastWave::kDrained,
+        [&](uint64_t first, uint64_t last) {
+            emitters_->EmitPhotons(first, last, iteration_, visible_->radius(), scheduler_);
+            return Status::Ok();
+        }));
     emitters_->Learn(deposited_);
     if (SkyWindows* windows = lights_->sky_windows()) windows->Update();
     if (gather_guide_) {
@@ -216,7 +216,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
          ((r.flags & kFromSky) && sky_direct_photons_)) &&
         (flags & kBxdfDiffuse)) {
         const float added = visible_->Deposit(
-            b, h.p, h.ng, wo, r.beta, r.lambda,
+            scheduler_.source().BrickOfSlot(b), h.p, h.ng, wo, r.beta, r.lambda,
             VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)),
             (r.flags & kSpecularChain) != 0);
         // One writer per photon: a photon is traced by one thread at a time.
@@ -257,7 +257,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     if (rng.Uniform(kDimRoulette) < q) return false;
     r.beta = beta / (1 - q);
     r.flags = ExtendSpecularChain(r.flags, bs->IsSpecular() && mat.MakesCaustics());
-    return Bounce(r, h, bs->wi);
+    return Bounce(r, h, bs->wi, bs->IsSpecular());
 }
 
 }  // namespace nave::render

@@ -212,6 +212,9 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
 }
 
 StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source) {
+    // First, before anything loads a brick: the levels in use decide the slots the pager sees.
+    NAVE_RETURN_IF_ERROR(
+        source.UseLevels(config.render.lod == RenderSettings::Lod::kFull ? 1 : ~uint32_t(0)));
     RenderScene scene;
     scene.source = &source;
     scene.camera = std::make_unique<Camera>(config.camera);

@@ -591,6 +591,9 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
             r.WhereTable());
     }
     NAVE_RETURN_IF_ERROR(r.Bool("path_guiding", &s->path_guiding));
+    NAVE_RETURN_IF_ERROR(r.Choice(
+        "lod", {{"auto", RenderSettings::Lod::kAuto}, {"full", RenderSettings::Lod::kFull}},
+        &s->lod));
     return r.Finish();
 }
 

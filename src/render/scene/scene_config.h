@@ -170,6 +170,11 @@ struct RenderSettings {
     /// Path mode: paths learn where the light reflected toward each part of the model comes from
     /// and draw half of their continuations from it (PathGuide).
     bool path_guiding = false;
+    /// Levels of detail (docs/render.md, "Levels of detail"): "auto" traces each ray against the
+    /// coarsest level of each brick its footprint allows, where the store has levels; "full"
+    /// traces full detail everywhere.
+    enum class Lod { kAuto, kFull };
+    Lod lod = Lod::kAuto;
 };
 
 struct OutputConfig {

@@ -14,7 +14,9 @@ SurfaceHit MakeSurfaceHit(const RenderScene& scene, const ResidentBrick& brick, 
     h.p = m.positions[i0] * w0 + m.positions[i1] * hit.u + m.positions[i2] * hit.v;
     h.ng = Normalize(Cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
     h.ns = h.ng;
-    if (m.HasNormals()) {
+    // Coarse levels shade with their facets' normals: the full mesh's vertex normals, kept on a
+    // level's vertices, bend far from its larger facets and would send light under them.
+    if (m.HasNormals() && brick.lod().level == 0) {
         Vec3f n = m.normals[i0] * w0 + m.normals[i1] * hit.u + m.normals[i2] * hit.v;
         float len = Length(n);
         if (len > 0) h.ns = n / len;
@@ -32,6 +34,7 @@ SurfaceHit MakeSurfaceHit(const RenderScene& scene, const ResidentBrick& brick, 
         return s;
     }();
     h.material = mat < scene.materials.size() ? &scene.materials[mat] : &kBlack;
+    h.lod = brick.lod();
     if (h.has_uv && h.material->textures) {
         // The texture filter footprint as the camera would see this point (pbrt-v4's approximation
         // for every vertex of a path, Camera::Approximate_dp_dxy): a cone of one pixel's spread

@@ -22,6 +22,8 @@ struct SurfaceHit {
     TextureFootprint footprint;
     /// Points into the scene's materials, or to a static black one for an unmapped id.
     const SurfaceMaterial* material = nullptr;
+    /// The level of detail of the mesh hit (level 0: full detail).
+    LevelOfDetail lod;
 };
 
 /// The geometry of `hit` on the mesh of `brick`, its material from `scene` (a material id the scene

@@ -83,10 +83,10 @@ RenderMemoryInputs RenderMemoryInputs::Measure(const BrickSource& source,
                                                const PagerOptions& pager) {
     RenderMemoryInputs inputs;
     inputs.pager = pager;
-    inputs.brick_count = source.brick_count();
+    inputs.brick_count = source.slot_count();
     inputs.bricks = MinimumBrickBudget(source, pager.prefetch);
     // One decode at a time under a budget: the largest load's scratch is the most beside bricks.
-    for (uint32_t b = 0; b < source.brick_count(); ++b) {
+    for (uint32_t b = 0; b < source.slot_count(); ++b) {
         inputs.load_scratch_bytes = std::max(inputs.load_scratch_bytes, source.LoadScratchBytes(b));
     }
     inputs.process_bytes = CurrentRssBytes();

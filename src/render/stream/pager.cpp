@@ -120,27 +120,48 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
     return Status::Ok();
 }
 
+bool KeepsCoarseLevels(const BrickBudgetMinimum& m, uint64_t brick_budget_bytes) {
+    return m.kept_bytes > 0 && m.kept_bytes <= brick_budget_bytes / 2 &&
+           m.kept_bytes + m.min_bytes <= brick_budget_bytes;
+}
+
+bool KeptResident(const BrickSource& source, uint32_t slot) {
+    const uint32_t level = source.LevelOfSlot(slot);
+    return level > 0 && level + 1 == source.LevelsOf(source.BrickOfSlot(slot));
+}
+
 BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch) {
     BrickBudgetMinimum m;
-    for (uint32_t b = 0; b < source.brick_count(); ++b) {
+    bool first = true, second = true;
+    for (uint32_t b = 0; b < source.slot_count(); ++b) {
         uint64_t bytes = source.EstimatedResidentBytes(b);
         m.total_bytes += bytes;
-        if (b == 0 || bytes > m.largest_bytes) {
-            if (b > 0) {
+        if (KeptResident(source, b)) {
+            m.kept_bytes += bytes;
+            continue;
+        }
+        if (bytes == 0) continue;  // a level its brick lacks
+        if (first || bytes > m.largest_bytes) {
+            if (!first) {
                 m.second_brick = m.largest_brick;
                 m.second_bytes = m.largest_bytes;
+                second = false;
             }
             m.largest_brick = b;
             m.largest_bytes = bytes;
-        } else if (b == 1 || bytes > m.second_bytes) {
+            first = false;
+        } else if (second || bytes > m.second_bytes) {
             m.second_brick = b;
             m.second_bytes = bytes;
+            second = false;
         }
     }
-    if (source.brick_count() < 2) {
+    if (second) {
         m.second_brick = m.largest_brick;
         m.second_bytes = 0;
     }
+    // The kept levels stay resident only where they fit (KeepsCoarseLevels); without them the
+    // largest bricks are what any budget must hold.
     m.min_bytes = m.largest_bytes + (prefetch ? m.second_bytes : 0);
     return m;
 }
@@ -150,15 +171,21 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       options_(options),
       waiting_(std::move(waiting)),
       resident_guard_(options.memory_bytes),
-      state_(source.brick_count(), State::kAbsent),
-      bytes_(source.brick_count(), 0),
-      last_used_(source.brick_count(), 0),
-      traffic_(source.brick_count(), 0),
-      load_count_(source.brick_count(), 0),
+      state_(source.slot_count(), State::kAbsent),
+      bytes_(source.slot_count(), 0),
+      last_used_(source.slot_count(), 0),
+      traffic_(source.slot_count(), 0),
+      load_count_(source.slot_count(), 0),
+      kept_(source.slot_count(), false),
       prefetch_current_(store::kNoBrick) {
-    estimate_.reserve(source.brick_count());
-    for (uint32_t b = 0; b < source.brick_count(); ++b)
+    estimate_.reserve(source.slot_count());
+    for (uint32_t b = 0; b < source.slot_count(); ++b) {
         estimate_.push_back(source.EstimatedResidentBytes(b));
+    }
+    const BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
+    if (KeepsCoarseLevels(need, options.brick_budget_bytes)) {
+        for (uint32_t b = 0; b < source.slot_count(); ++b) kept_[b] = KeptResident(source, b);
+    }
     stats_.brick_budget_bytes = options.brick_budget_bytes;
 }
 
@@ -169,13 +196,14 @@ std::string BrickBudgetMinimum::DescribeLargest(bool prefetch) const {
                            ? fmt::format(", and prefetching needs room for the next-largest, "
                                          "brick {} ({})",
                                          second_brick, FormatBytes(second_bytes))
-                           : std::string());
+                           : std::string(),
+                       std::string());
 }
 
 StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerOptions& options,
                                                WaitingFn waiting) {
     BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
-    if (source.brick_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
+    if (source.slot_count() > 0 && options.brick_budget_bytes < need.min_bytes) {
         return ResourceExhaustedError(
             "brick memory budget {} ({} bytes) is too small for this model: {}; the minimum brick "
             "budget is {} ({} bytes)",
@@ -184,7 +212,7 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
     }
     std::unique_ptr<Pager> pager(new Pager(source, options, std::move(waiting)));
     // Bricks an earlier render left resident: keep those that fit, drop the rest.
-    for (uint32_t b = 0; b < source.brick_count(); ++b) {
+    for (uint32_t b = 0; b < source.slot_count(); ++b) {
         if (!source.IsResident(b)) continue;
         uint64_t bytes = 0;
         {
@@ -300,7 +328,7 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
     };
     std::vector<Candidate> candidates;
     for (uint32_t b = 0; b < state_.size(); ++b) {
-        if (state_[b] != State::kResident || b == exclude) continue;
+        if (state_[b] != State::kResident || b == exclude || kept_[b]) continue;
         size_t w = waiting_ ? waiting_(b) : 0;
         if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
         // Nearly empty queues count as empty when traffic decides: their few rays matter less than

@@ -106,13 +106,25 @@ struct BrickBudgetMinimum {
         0;  ///< the next-largest brick (prefetch room); equal to largest if one brick
     uint64_t second_bytes = 0;
     uint64_t total_bytes = 0;  ///< all bricks resident at once (the in-core size)
+    /// The coarsest level of every brick that has levels (KeptResident): never evicted when they
+    /// take at most half the budget (KeepsCoarseLevels), so that the rays with wide footprints,
+    /// most of those past the first bounce, never wait for a load; paged like the rest otherwise.
+    uint64_t kept_bytes = 0;
 
     /// "its largest brick, brick 12, takes 40.1 MiB (42049536 bytes) when resident[, and
     /// prefetching needs room for the next-largest, brick 3 (38.0 MiB)]": why a budget is too
     /// small, for the refusals of the pager and of `nave render --memory`.
     std::string DescribeLargest(bool prefetch) const;
 };
+/// The minimum budget: the largest brick and, with prefetching, the next.
+/// Bricks here are the source's slots (a brick at a level of detail).
 BrickBudgetMinimum MinimumBrickBudget(const BrickSource& source, bool prefetch);
+/// Whether the pager keeps slot `slot` resident once loaded: the coarsest level of a brick that
+/// has coarser levels than its full mesh (docs/pager.md, "Levels of detail").
+bool KeptResident(const BrickSource& source, uint32_t slot);
+/// Whether a pager with `brick_budget_bytes` keeps the coarsest levels resident: when they take
+/// at most half of it, and leave room for the largest bricks.
+bool KeepsCoarseLevels(const BrickBudgetMinimum& m, uint64_t brick_budget_bytes);
 
 /// What the pager did during one render.
 struct PagerStats {
@@ -201,6 +213,7 @@ class Pager {
     std::vector<uint64_t> last_used_;  // tick of the last pick or load
     std::vector<uint64_t> traffic_;    // rays taken from the brick's queue so far
     std::vector<uint32_t> load_count_;
+    std::vector<bool> kept_;  // KeptResident: never evicted
     uint64_t tick_ = 0;
     uint64_t committed_bytes_ = 0;
     // The last Prefetch call's view: rays waiting per brick and the brick being traced. Loaders

@@ -55,6 +55,9 @@ struct RayRecord {
         0;  ///< surfaces met so far, passes through thin glass included (keys the random numbers)
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
                              ///< surface; kSkyShadow rays: that of their own vertex
+    /// The level of detail of the surface the ray starts on (0: full detail, or a ray from the
+    /// camera or a light).
+    uint8_t origin_level = 0;
     union {
         /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky).
         float prev_pdf = 0;
@@ -71,12 +74,22 @@ struct RayRecord {
     float guide_scale =
         0;  ///< shadow rays of guided paths: the contribution's luminance times this is the
             ///< credit (1 / (throughput at the vertex * pdf of the direction from the previous))
+    /// The ray's cone (Amanatides 1984; Akenine-Möller et al. 2019, "Improved shader and texture
+    /// level of detail using ray cones"): its footprint is cone_width + cone_spread * t wide at t.
+    /// It chooses the level of detail of each brick the ray crosses (level_choice.h).
+    float cone_width = 0;
+    float cone_spread = 0;
+    /// The error of the level the ray left (ResidentBrick::lod), and 1 / |cos| of its angle to
+    /// that surface's normal: near its origin, the surface the ray leaves may lie on either side
+    /// of the ray at another level (LevelClearance).
+    float origin_error = 0;
+    float clearance_per_error = 0;
     SampledSpectrum
         beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };
 // docs/render.md and docs/pager.md give this size (queue memory per ray in flight): change them
 // with it.
-static_assert(sizeof(RayRecord) == 116, "RayRecord's size is documented in docs/render.md");
+static_assert(sizeof(RayRecord) == 132, "RayRecord's size is documented in docs/render.md");
 
 }  // namespace nave::render

@@ -8,6 +8,7 @@
 #include "src/core/check.h"
 #include "src/core/trace.h"
 #include "src/render/bricks/brick_walk.h"
+#include "src/render/stream/level_choice.h"
 #include "src/render/stream/memory_plan.h"
 
 namespace nave::render {
@@ -23,7 +24,7 @@ StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64
       tree_(source.tree()),
       picker_(std::move(picker)),
       wave_paths_(wave_paths),
-      queues_(source.brick_count()),
+      queues_(source.slot_count()),
       max_batch_(MaxBatchRays(0)) {}
 
 StreamScheduler::~StreamScheduler() {
@@ -57,7 +58,7 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
             const std::filesystem::space_info space = std::filesystem::space(file->dir(), ec);
             limit = ec ? 0 : space.available / 2;
         }
-        brick_cache_ = std::make_unique<BrickCache>(std::move(file), source_.brick_count(), limit);
+        brick_cache_ = std::make_unique<BrickCache>(std::move(file), source_.slot_count(), limit);
         source_.SetBrickCache(brick_cache_.get());
     }
     const uint64_t queue_memory = QueueMemoryBytes(paging);
@@ -77,10 +78,21 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
 StatusOr<BrickHandle> StreamScheduler::Acquire(uint32_t brick) { return pager_->Acquire(brick); }
 
 uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) const {
-    BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current);
+    const uint32_t current_brick =
+        current == store::kNoBrick ? current : source_.BrickOfSlot(current);
+    BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current_brick);
     r.t_enter = s.t_enter;
     r.t_exit = s.t_exit;
-    return s.brick;
+    if (s.brick == store::kNoBrick || source_.level_count() == 1) return s.brick;
+    // In the brick it starts in, a ray keeps the level of the surface it leaves: that level's
+    // copy of the surface is the one it is offset from, and another level's could lie on either
+    // side of it. Elsewhere its footprint chooses, where it enters the cell: the footprint is
+    // narrowest there, so every hit inside is at least as wide.
+    const uint32_t level = s.t_enter == 0
+                               ? std::min<uint32_t>(r.origin_level, source_.LevelsOf(s.brick) - 1)
+                               : ChooseLevel(source_.LevelErrors(s.brick), source_.level_count(),
+                                             ConeWidthAt(r, s.t_enter));
+    return source_.SlotOf(s.brick, level);
 }
 
 void StreamScheduler::Flush(RayOutbox& out) {

@@ -89,8 +89,9 @@ class StreamScheduler {
     /// Pins brick `brick` for a batch or a pass over the bricks, through the pager. Load errors
     /// name the brick.
     StatusOr<BrickHandle> Acquire(uint32_t brick);
-    /// Sets r's segment to the first brick after `from_t` other than `current`; returns it or
-    /// store::kNoBrick (the ray leaves the model, or reaches t_max, first).
+    /// Sets r's segment to the first brick after `from_t` other than `current`'s; returns its slot
+    /// at the level of detail r's footprint there chooses (level_choice.h), or store::kNoBrick
+    /// (the ray leaves the model, or reaches t_max, first). `current` is a slot.
     uint32_t Route(RayRecord& r, float from_t, uint32_t current) const;
     /// Sends the rays of `out` to the exchange, grouped by brick, adds its counts to the render's
     /// and empties it.
@@ -123,6 +124,8 @@ class StreamScheduler {
     /// bytes, brick cache, spilling). `before`: the source's counters when the render started.
     void FillStats(const BrickSourceStats& before, StreamStats* stats) const;
 
+    /// The bricks the rays are scheduled over (slots: bricks at their levels of detail).
+    const BrickSource& source() const { return source_; }
     /// The source's brick tree, along which rays are routed.
     const store::BrickTree& tree() const { return tree_; }
 

@@ -112,6 +112,7 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
         w = PowerHeuristic(ls->pdf, continuation->Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
+    LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = ls->t_max;
@@ -156,6 +157,7 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                   : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
+    LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
     s.origin = OffsetOrigin(h.p, h.ng, wi);
     s.dir = wi;
     s.t_max = kInfinity;

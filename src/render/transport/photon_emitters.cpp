@@ -210,7 +210,7 @@ Status PhotonEmitters::LoadState(ByteReader* in) {
     return in->ExpectEnd();
 }
 
-void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration,
+void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, float footprint,
                                  StreamScheduler& scheduler) {
     const float disk_area = kPi * scene_radius_ * scene_radius_;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
@@ -220,6 +220,7 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
             r.kind = kPhotonRay;
             r.pixel = uint32_t(i);
             r.t_max = kInfinity;
+            r.cone_width = footprint;
             VertexRng rng(RayKey(scene_.settings.seed, r, iteration, kStreamEmit));
             // Each photon its own wavelengths, but one in kSharedWavelengthEvery the iteration's
             // (visible_points.h).

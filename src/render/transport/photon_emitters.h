@@ -36,8 +36,10 @@ class PhotonEmitters {
                                                            StreamScheduler& scheduler);
 
     /// Queues photons [first, last) of SPPM iteration `iteration` through `scheduler`, on all
-    /// threads; each photon carries its own wavelengths.
-    void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, StreamScheduler& scheduler);
+    /// threads; each photon carries its own wavelengths. `footprint`: the width of each photon's
+    /// cone (ray.h), the iteration's gather radius: a photon stands for the light within it.
+    void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, float footprint,
+                     StreamScheduler& scheduler);
     /// After a photon pass: learns where the sun's photons are worth starting (photon_guide.h) from
     /// deposited[k], the luminance photon k brought to the visible points, for the first
     /// learned_photons() photons of the pass.

@@ -13,6 +13,7 @@
 #include "src/render/bricks/brick_walk.h"
 #include "src/render/scene/scene.h"
 #include "src/render/scene/surface_hit.h"
+#include "src/render/stream/level_choice.h"
 #include "src/render/stream/ray.h"
 #include "src/render/stream/stream_scheduler.h"
 #include "src/render/transport/rng.h"
@@ -75,20 +76,37 @@ inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, Ray
     r->beta *= glass->Transmittance(r->since_vertex + Length(h.p - r->origin), r->lambda);
 }
 
+/// The cone of `r` (ray.h) as it leaves `h`, `t` from its origin, into `wi`: as wide as it arrived;
+/// a non-specular (`scattered`) bounce widens its spread to at least kScatteredConeSpread, a
+/// specular one or a straight pass keeps it (a mirror or a pane does not blur; the surfaces'
+/// curvature, which Akenine-Möller et al. 2019 add, is left out). Its origin's level and the
+/// clearance from the other levels' surfaces (LevelClearance) come with it.
+inline void LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, float t,
+                         bool scattered) {
+    r.cone_width = ConeWidthAt(r, t);
+    if (scattered) r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
+    r.origin_level = uint8_t(h.lod.level);
+    r.origin_error = h.lod.error;
+    r.clearance_per_error = ClearancePerError(Dot(wi, Normalize(h.ng)));
+}
+
 /// Moves path or photon `r` on through the pass-through surface at `h` (thin glass: not a bounce,
 /// so neither its depth nor its direction changes), toward `wi`. False if nothing is left of it.
 inline bool PassThrough(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
     if (r.beta.IsZero()) return false;
-    r.since_vertex += Length(h.p - r.origin);
+    const float t = Length(h.p - r.origin);
+    r.since_vertex += t;
+    LeaveSurface(r, h, wi, t, /*scattered=*/false);
     r.origin = OffsetOrigin(h.p, h.ng, wi);
     r.t_max = kInfinity;
     return true;
 }
 
-/// Bounces path or photon `r` at `h` into direction `wi`: its next vertex. False if nothing is
-/// left of it.
-inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
+/// Bounces path or photon `r` at `h` into direction `wi` (sampled from a `specular` lobe or not):
+/// its next vertex. False if nothing is left of it.
+inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, bool specular) {
     if (r.beta.IsZero()) return false;
+    LeaveSurface(r, h, wi, Length(h.p - r.origin), !specular);
     r.origin = OffsetOrigin(h.p, h.ng, wi);
     r.since_vertex = 0;
     r.dir = wi;
@@ -107,6 +125,28 @@ Status ForEachOwnedTriangle(
     const std::function<bool(const SurfaceMaterial&)>& want,
     const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit);
 
+/// Where `r`'s segment in `brick` starts. At a coarse level the segment reaches back past the
+/// cell's face by kLevelOverlap times the level's error: where the ray crossed from a brick at
+/// another level, the two levels' copies of a surface cut by the face lie up to their errors apart,
+/// and a ray passing between them would slip through the surface. Hits there are only looked for
+/// once the brick before missed (bricks are traced in order), so a surface is never met twice. Near
+/// the ray's origin the reach back stops at the clearance from the surface it left
+/// (LevelClearance), so that it does not meet that surface's copy at this level. In the brick it
+/// starts in, the ray is at its origin's level (StreamScheduler::Route): no overlap there.
+inline float SegmentStart(const RayRecord& r, const ResidentBrick& brick) {
+    const LevelOfDetail& lod = brick.lod();
+    if (r.t_enter == 0 || lod.level == 0) return r.t_enter;
+    const float clearance = LevelClearance(r.origin_error, lod.error, r.clearance_per_error);
+    return std::max(r.t_enter - kLevelOverlap * lod.error, std::min(r.t_enter, clearance));
+}
+
+/// Where `r`'s segment in `brick` ends: past the cell's face by the slack of SegmentEndWithSlack
+/// and, at a coarse level, kLevelOverlap times its error (SegmentStart: the same crossing seen
+/// from the brick before).
+inline float SegmentEnd(const RayRecord& r, const ResidentBrick& brick) {
+    return std::min(SegmentEndWithSlack(r.t_exit) + kLevelOverlap * brick.lod().error, r.t_max);
+}
+
 /// Traces a path or photon ray `r` inside brick `b` (pinned as `brick`) from its segment there. At
 /// each hit, `shade(r, hit)` scatters the ray in place and returns whether it goes on. A ray that
 /// goes on inside the cell is traced on at once, without queueing; one whose next segment lies in
@@ -116,10 +156,10 @@ void TraceInBrick(RayRecord& r, uint32_t b, const ResidentBrick& brick,
                   const StreamScheduler& scheduler, RayOutbox& out, Shade&& shade,
                   Escape&& escape) {
     for (;;) {
-        const float t1 = std::min(SegmentEndWithSlack(r.t_exit), r.t_max);
+        const float t1 = SegmentEnd(r, brick);
         ++out.counts.segments_traced;
         BrickHit hit;
-        if (!brick.Intersect(r.origin, r.dir, r.t_enter, t1, &hit)) {
+        if (!brick.Intersect(r.origin, r.dir, SegmentStart(r, brick), t1, &hit)) {
             const uint32_t next = scheduler.Route(r, r.t_exit, b);
             if (next == store::kNoBrick) {
                 escape(r);
