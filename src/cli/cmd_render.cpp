@@ -47,7 +47,7 @@ struct RenderOptions {
     std::string trace;       // --trace FILE.json
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     bool no_textures = false;
-    bool no_lod = false;
+    std::string lod;
     CheckpointFlags checkpoint;  // --checkpoint, --checkpoint-every, --resume, --stop-after
 };
 
@@ -103,7 +103,8 @@ StatusOr<render::SceneConfig> BuildConfig(const RenderOptions& o) {
     if (o.mode == "path") config.render.mode = render::RenderSettings::Mode::kPath;
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
-    if (o.no_lod) config.render.lod = render::RenderSettings::Lod::kFull;
+    if (o.lod == "auto") config.render.lod = render::RenderSettings::Lod::kAuto;
+    if (o.lod == "full") config.render.lod = render::RenderSettings::Lod::kFull;
     return config;
 }
 
@@ -386,9 +387,13 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
         "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures,
                   "Ignore the model's textures (textures.enabled = false)");
-    cmd->add_flag("--no-lod", opts->no_lod,
-                  "Trace full detail everywhere, ignoring the store's coarser levels of detail "
-                  "(render.lod = \"full\"; docs/render.md, \"Levels of detail\")");
+    cmd->add_option(
+           "--lod", opts->lod,
+           "Levels of detail (render.lod): auto traces each ray against the coarsest level "
+           "of each brick its footprint allows, in stores made with `nave preprocess "
+           "--levels`; full (the default) traces full detail everywhere. Levels still "
+           "bias the image (docs/render.md, \"Levels of detail\")")
+        ->check(CLI::IsMember({"auto", "full"}));
     cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
                     "Write the render's state to FILE between passes (photon mode: iterations), at "
                     "most every "

@@ -63,10 +63,13 @@ Status BrickSource::UseLevels(uint32_t max_levels) {
         levels = std::max(levels, std::min(std::max(max_levels, 1u), StoredLevels(b)));
     level_count_ = levels;
     level_errors_.assign(size_t(brick_count_) * levels, std::numeric_limits<float>::infinity());
+    coarsest_error_ = 0;
     for (uint32_t b = 0; b < brick_count_; ++b) {
         const uint32_t n = std::min(levels, StoredLevels(b));
-        for (uint32_t l = 0; l < n; ++l)
+        for (uint32_t l = 0; l < n; ++l) {
             level_errors_[size_t(b) * levels + l] = l == 0 ? 0.f : StoredLevelError(b, l);
+            coarsest_error_ = std::max(coarsest_error_, level_errors_[size_t(b) * levels + l]);
+        }
     }
     slots_.clear();
     for (size_t i = 0; i < size_t(brick_count_) * levels; ++i)
@@ -136,7 +139,8 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         mesh.ok()
             ? ResidentBrick::Build(*device_, id, cells_[BrickOfSlot(id)], std::move(mesh).value(),
                                    &alpha_masks_, bvh_,
-                                   {LevelOfSlot(id), LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)]})
+                                   {BrickOfSlot(id), LevelOfSlot(id),
+                                    LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)], coarsest_error_})
             : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     build.End();
     double seconds =

@@ -188,6 +188,7 @@ class BrickSource {
     uint32_t brick_count_ = 0;
     uint32_t level_count_ = 1;
     std::vector<float> level_errors_;  // level_count_ per brick
+    float coarsest_error_ = 0;         // the largest of level_errors_
     std::vector<std::unique_ptr<Slot>> slots_;
     mutable std::mutex stats_mutex_;
     BrickSourceStats stats_;

@@ -172,9 +172,9 @@ struct RenderSettings {
     bool path_guiding = false;
     /// Levels of detail (docs/render.md, "Levels of detail"): "auto" traces each ray against the
     /// coarsest level of each brick its footprint allows, where the store has levels; "full"
-    /// traces full detail everywhere.
+    /// (the default while levels bias the image) traces full detail everywhere.
     enum class Lod { kAuto, kFull };
-    Lod lod = Lod::kAuto;
+    Lod lod = Lod::kFull;
 };
 
 struct OutputConfig {

@@ -45,19 +45,16 @@ inline constexpr float kLevelOverlap = 4.f;
 /// The footprint of `r` at ray parameter t.
 inline float ConeWidthAt(const RayRecord& r, float t) { return r.cone_width + r.cone_spread * t; }
 
-/// Where a ray may start meeting a level other than the one it left (or the same level of another
-/// brick, simplified on its own): each level's surface lies within its error of the full one, so
-/// near the origin the other level's copy of the surface just left may lie on either side of the
-/// ray, up to the sum of both errors away along the normal; the ray, leaving at angle theta to
-/// it, clears that sum once t |cos theta| exceeds it. `clearance_per_error` is 1 / |cos theta|,
-/// at most kMaxClearancePerError (grazing rays). Whatever lies nearer than the two errors is
-/// below what both levels resolve anyway.
-inline constexpr float kMaxClearancePerError = 10.f;
-inline float ClearancePerError(float cos_theta) {
-    return 1.f / std::max(std::abs(cos_theta), 1.f / kMaxClearancePerError);
-}
-inline float LevelClearance(float origin_error, float level_error, float clearance_per_error) {
-    return (origin_error + level_error) * clearance_per_error;
+/// How far off its surface, along the normal, a ray leaving a level of detail starts. Each level's
+/// copy of that surface lies within its error of the full one; the ray's origin surface is within
+/// `origin_error`, and the levels its footprint chooses near the origin within width /
+/// kFootprintPerLevelError (at most the model's coarsest error). Started that far off, the ray
+/// passes every copy in front of it; as it goes on, it rises t |cos theta| while the levels' errors
+/// grow by spread t / kFootprintPerLevelError, which it outruns unless it leaves within 4 degrees
+/// of grazing (kScatteredConeSpread / 2). Whatever lies nearer to the surface than that goes unseen
+/// by this ray: detail below what its levels resolve. 0 without levels.
+inline float LevelOffset(float origin_error, float width, float coarsest_error) {
+    return origin_error + std::min(width / kFootprintPerLevelError, coarsest_error);
 }
 
 }  // namespace nave::render

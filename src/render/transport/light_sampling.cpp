@@ -112,8 +112,7 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
         w = PowerHeuristic(ls->pdf, continuation->Pdf(wo, wi, r.lambda));
     RayRecord s = r;
     s.kind = kShadowRay;
-    LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
-    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.origin = LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
     s.dir = wi;
     s.t_max = ls->t_max;
     s.beta = r.beta * f * ls->weight * w;
@@ -157,8 +156,7 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                   : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
-    LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
-    s.origin = OffsetOrigin(h.p, h.ng, wi);
+    s.origin = LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
     s.dir = wi;
     s.t_max = kInfinity;
     const SampledSpectrum radiance = scene_.sky->Radiance(wi, r.lambda);

@@ -79,15 +79,17 @@ inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, Ray
 /// The cone of `r` (ray.h) as it leaves `h`, `t` from its origin, into `wi`: as wide as it arrived;
 /// a non-specular (`scattered`) bounce widens its spread to at least kScatteredConeSpread, a
 /// specular one or a straight pass keeps it (a mirror or a pane does not blur; the surfaces'
-/// curvature, which Akenine-Möller et al. 2019 add, is left out). Its origin's level and the
-/// clearance from the other levels' surfaces (LevelClearance) come with it.
-inline void LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, float t,
-                         bool scattered) {
+/// curvature, which Akenine-Möller et al. 2019 add, is left out). Returns where the ray starts:
+/// off the surface by OffsetOrigin and, with levels of detail, by LevelOffset along its normal.
+inline Vec3f LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, float t,
+                          bool scattered) {
     r.cone_width = ConeWidthAt(r, t);
     if (scattered) r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
     r.origin_level = uint8_t(h.lod.level);
-    r.origin_error = h.lod.error;
-    r.clearance_per_error = ClearancePerError(Dot(wi, Normalize(h.ng)));
+    r.origin_brick = h.lod.brick;
+    const Vec3f n = Normalize(h.ng);
+    const float offset = LevelOffset(h.lod.error, r.cone_width, h.lod.coarsest_error);
+    return OffsetOrigin(h.p, h.ng, wi) + (Dot(n, wi) >= 0 ? n : -n) * offset;
 }
 
 /// Moves path or photon `r` on through the pass-through surface at `h` (thin glass: not a bounce,
@@ -96,8 +98,7 @@ inline bool PassThrough(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
     if (r.beta.IsZero()) return false;
     const float t = Length(h.p - r.origin);
     r.since_vertex += t;
-    LeaveSurface(r, h, wi, t, /*scattered=*/false);
-    r.origin = OffsetOrigin(h.p, h.ng, wi);
+    r.origin = LeaveSurface(r, h, wi, t, /*scattered=*/false);
     r.t_max = kInfinity;
     return true;
 }
@@ -106,8 +107,7 @@ inline bool PassThrough(RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
 /// its next vertex. False if nothing is left of it.
 inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, bool specular) {
     if (r.beta.IsZero()) return false;
-    LeaveSurface(r, h, wi, Length(h.p - r.origin), !specular);
-    r.origin = OffsetOrigin(h.p, h.ng, wi);
+    r.origin = LeaveSurface(r, h, wi, Length(h.p - r.origin), !specular);
     r.since_vertex = 0;
     r.dir = wi;
     r.t_max = kInfinity;
@@ -129,15 +129,11 @@ Status ForEachOwnedTriangle(
 /// cell's face by kLevelOverlap times the level's error: where the ray crossed from a brick at
 /// another level, the two levels' copies of a surface cut by the face lie up to their errors apart,
 /// and a ray passing between them would slip through the surface. Hits there are only looked for
-/// once the brick before missed (bricks are traced in order), so a surface is never met twice. Near
-/// the ray's origin the reach back stops at the clearance from the surface it left
-/// (LevelClearance), so that it does not meet that surface's copy at this level. In the brick it
-/// starts in, the ray is at its origin's level (StreamScheduler::Route): no overlap there.
+/// once the brick before missed (bricks are traced in order), so a surface is never met twice.
 inline float SegmentStart(const RayRecord& r, const ResidentBrick& brick) {
     const LevelOfDetail& lod = brick.lod();
     if (r.t_enter == 0 || lod.level == 0) return r.t_enter;
-    const float clearance = LevelClearance(r.origin_error, lod.error, r.clearance_per_error);
-    return std::max(r.t_enter - kLevelOverlap * lod.error, std::min(r.t_enter, clearance));
+    return std::max(r.t_enter - kLevelOverlap * lod.error, 0.f);
 }
 
 /// Where `r`'s segment in `brick` ends: past the cell's face by the slack of SegmentEndWithSlack
