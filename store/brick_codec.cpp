@@ -440,6 +440,7 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         return InternalError("Draco round trip moved the brick's bounds: encoded {}, decoded {}",
                              fmt::streamed(out.geometry_bounds), fmt::streamed(decoded_bounds));
     }
+    out.decoded = std::move(decoded);
     return out;
 }
 

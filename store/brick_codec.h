@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -47,6 +48,9 @@ struct EncodedMesh {
     uint32_t max_material_id = 0;
     bool has_normals = false;
     bool has_uvs = false;
+    /// The section decoded, when options.verify decoded it to check it (else empty): what the
+    /// store's reader will return for it.
+    std::optional<BrickMesh> decoded;
 };
 
 /// Snaps, encodes, then decodes the result once to check it and to learn the decoded counts.

@@ -104,12 +104,15 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     const auto start = std::chrono::steady_clock::now();
     // The levels simplify the brick as it decodes: snapped to the grid, and with the vertices
     // Draco splits where the surface is not a manifold (parts touching at an edge or a corner),
-    // which meshoptimizer would otherwise lock and keep.
-    NAVE_ASSIGN_OR_RETURN(
-        BrickMesh decoded,
-        codec::DecodeMeshSection(brick.mesh_bytes, grid, uint64_t(codec::kMaxMaterialId) + 1,
-                                 "the brick just encoded"));
-    std::vector<BrickLevel> levels = MakeBrickLevels(decoded, options.levels);
+    // which meshoptimizer would otherwise lock and keep. The verification decoded it already when
+    // options.verify asked.
+    if (!encoded.decoded) {
+        NAVE_ASSIGN_OR_RETURN(
+            encoded.decoded,
+            codec::DecodeMeshSection(brick.mesh_bytes, grid, uint64_t(codec::kMaxMaterialId) + 1,
+                                     "the brick just encoded"));
+    }
+    std::vector<BrickLevel> levels = MakeBrickLevels(*encoded.decoded, options.levels);
     brick.simplify_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (size_t k = 0; k < levels.size(); ++k) {

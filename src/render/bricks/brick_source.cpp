@@ -137,10 +137,10 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     TraceSpan build(trace_, "bvh build", "pager");
     StatusOr<std::unique_ptr<ResidentBrick>> built =
         mesh.ok()
-            ? ResidentBrick::Build(*device_, id, cells_[BrickOfSlot(id)], std::move(mesh).value(),
-                                   &alpha_masks_, bvh_,
-                                   {BrickOfSlot(id), LevelOfSlot(id),
-                                    LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)], coarsest_error_})
+            ? ResidentBrick::Build(
+                  *device_, id, cells_[BrickOfSlot(id)], std::move(mesh).value(), &alpha_masks_,
+                  bvh_,
+                  {LevelOfSlot(id), LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)], coarsest_error_})
             : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     build.End();
     double seconds =

@@ -56,7 +56,6 @@ struct BrickHit {
 
 /// Which level of detail of its brick a resident brick holds (BrickSource, "Levels of detail").
 struct LevelOfDetail {
-    uint32_t brick = 0;  ///< the brick (a leaf of the brick tree) this is a level of
     uint32_t level = 0;  ///< 0: the full mesh
     float error = 0;     ///< the level's largest distance from the full surface, model units
     /// The largest error of any level of the model in use (0 without levels): how far off a

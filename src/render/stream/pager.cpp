@@ -179,13 +179,8 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       kept_(source.slot_count(), false),
       prefetch_current_(store::kNoBrick) {
     estimate_.reserve(source.slot_count());
-    for (uint32_t b = 0; b < source.slot_count(); ++b) {
+    for (uint32_t b = 0; b < source.slot_count(); ++b)
         estimate_.push_back(source.EstimatedResidentBytes(b));
-    }
-    const BrickBudgetMinimum need = MinimumBrickBudget(source, options.prefetch);
-    if (KeepsCoarseLevels(need, options.brick_budget_bytes)) {
-        for (uint32_t b = 0; b < source.slot_count(); ++b) kept_[b] = KeptResident(source, b);
-    }
     stats_.brick_budget_bytes = options.brick_budget_bytes;
 }
 
@@ -196,8 +191,7 @@ std::string BrickBudgetMinimum::DescribeLargest(bool prefetch) const {
                            ? fmt::format(", and prefetching needs room for the next-largest, "
                                          "brick {} ({})",
                                          second_brick, FormatBytes(second_bytes))
-                           : std::string(),
-                       std::string());
+                           : std::string());
 }
 
 StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerOptions& options,
@@ -211,6 +205,10 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
             need.DescribeLargest(options.prefetch), FormatBytes(need.min_bytes), need.min_bytes);
     }
     std::unique_ptr<Pager> pager(new Pager(source, options, std::move(waiting)));
+    if (KeepsCoarseLevels(need, options.brick_budget_bytes)) {
+        for (uint32_t b = 0; b < source.slot_count(); ++b)
+            pager->kept_[b] = KeptResident(source, b);
+    }
     // Bricks an earlier render left resident: keep those that fit, drop the rest.
     for (uint32_t b = 0; b < source.slot_count(); ++b) {
         if (!source.IsResident(b)) continue;

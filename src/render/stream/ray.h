@@ -56,7 +56,7 @@ struct RayRecord {
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
                              ///< surface; kSkyShadow rays: that of their own vertex
     /// The level of detail of the surface the ray starts on (0: full detail, or a ray from the
-    /// camera or a light): in that surface's brick the ray keeps it (StreamScheduler::Route).
+    /// camera or a light): in the brick it starts in, the ray keeps it (StreamScheduler::Route).
     uint8_t origin_level = 0;
     union {
         /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky).
@@ -79,16 +79,12 @@ struct RayRecord {
     /// It chooses the level of detail of each brick the ray crosses (level_choice.h).
     float cone_width = 0;
     float cone_spread = 0;
-    /// The brick whose mesh (at origin_level) holds the surface the ray leaves; kNoOriginBrick for
-    /// rays from the camera or a light. A hit may lie just outside its brick's cell (coarse levels
-    /// overlap their neighbours), so this is not always the brick the origin lies in.
-    uint32_t origin_brick = 0xffffffffu;
     SampledSpectrum
         beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };
 // docs/render.md and docs/pager.md give this size (queue memory per ray in flight): change them
 // with it.
-static_assert(sizeof(RayRecord) == 128, "RayRecord's size is documented in docs/render.md");
+static_assert(sizeof(RayRecord) == 124, "RayRecord's size is documented in docs/render.md");
 
 }  // namespace nave::render

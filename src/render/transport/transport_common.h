@@ -86,10 +86,11 @@ inline Vec3f LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, fl
     r.cone_width = ConeWidthAt(r, t);
     if (scattered) r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
     r.origin_level = uint8_t(h.lod.level);
-    r.origin_brick = h.lod.brick;
-    const Vec3f n = Normalize(h.ng);
+    const Vec3f origin = OffsetOrigin(h.p, h.ng, wi);
     const float offset = LevelOffset(h.lod.error, r.cone_width, h.lod.coarsest_error);
-    return OffsetOrigin(h.p, h.ng, wi) + (Dot(n, wi) >= 0 ? n : -n) * offset;
+    if (offset == 0) return origin;  // a model without levels
+    const Vec3f n = Normalize(h.ng);
+    return origin + (Dot(n, wi) >= 0 ? n : -n) * offset;
 }
 
 /// Moves path or photon `r` on through the pass-through surface at `h` (thin glass: not a bounce,
