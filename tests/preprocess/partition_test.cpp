@@ -259,8 +259,9 @@ TEST_F(PartitionedSphere, LevelsWhenAskedNoneByDefault) {
     for (const store::BrickInfo& b : (*store)->bricks()) {
         ASSERT_GE(b.levels.size(), 1u) << "brick " << b.id;
         EXPECT_LT(b.levels[0].triangle_count, b.triangle_count / 2) << "brick " << b.id;
-        if (b.levels.size() > 1)
+        if (b.levels.size() > 1) {
             EXPECT_GT(b.levels[1].error, b.levels[0].error) << "brick " << b.id;
+        }
         EXPECT_TRUE((*store)->VerifyBrick(b.id).ok());
         level_triangles += b.levels[0].triangle_count;
     }

@@ -86,7 +86,9 @@ TEST(BrickLevels, FineSheetSimplifiesAsFarAsItsErrorTargetsAllow) {
         EXPECT_LE(levels[k].mesh.TriangleCount(), finer / 2) << "level " << k + 1;
         EXPECT_GT(levels[k].error, 0.f);
         EXPECT_LE(levels[k].error, 2 * options.relative_errors[k] * extent * 1.001f);
-        if (k > 0) EXPECT_GT(levels[k].error, levels[k - 1].error);
+        if (k > 0) {
+            EXPECT_GT(levels[k].error, levels[k - 1].error);
+        }
         finer = levels[k].mesh.TriangleCount();
     }
 

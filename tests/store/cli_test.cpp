@@ -109,8 +109,8 @@ TEST_F(NaveCli, InspectAndVerifyCoverTheLevels) {
                     .ok());
     const CommandResult text = RunNave("inspect --bricks " + with_levels.string());
     ASSERT_EQ(text.exit_code, 0) << text.output;
-    for (const std::string& part : {"% to the store without them", "level 1: 4 bricks",
-                                    "level 2: 4 bricks", "error max", "    level 2 "}) {
+    for (const char* part : {"% to the store without them", "level 1: 4 bricks",
+                             "level 2: 4 bricks", "error max", "    level 2 "}) {
         EXPECT_NE(text.output.find(part), std::string::npos) << "missing " << part << " in\n"
                                                              << text.output;
     }
