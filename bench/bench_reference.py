@@ -26,54 +26,10 @@ hours of path tracing on two cores reaches about 0.005 on RGB at 960x640 on the 
 """
 
 import argparse
-import json
 import os
-import re
 import sys
 
 import nave_bench
-
-# The abbey's camera spots (docs/abbey.md, "Camera spots"): eye, look-at, vertical field of view.
-VIEWS = {
-    "nave": ((4.0, 0.0, 1.7), (60.0, 0.0, 12.0), 65),
-    "crossing_vault": ((62.5, -4.0, 1.7), (62.5, 0.5, 28.0), 90),
-    "north_aisle": ((2.0, 10.0, 1.7), (50.0, 10.0, 6.0), 70),
-    "choir": ((70.0, 3.0, 1.7), (92.0, 0.0, 9.0), 75),
-}
-
-CSV_FIELDS = ["view", "mode", "seconds", "relmse_rgb", "relmse_rgb_blurred", "relmse_pair_rgb",
-              "mean_ratio", "worst_region_ratio", "reference_relmse_rgb", "reference_relmse_rgb_blurred"]
-
-
-def config_for_view(base_text, view):
-    """configs/abbey.toml's text with its [camera] position, look_at and fov_deg set to `view`'s."""
-    eye, at, fov = VIEWS[view]
-    text = base_text
-    for key, value in (("position", f"[{eye[0]}, {eye[1]}, {eye[2]}]"),
-                       ("look_at", f"[{at[0]}, {at[1]}, {at[2]}]"), ("fov_deg", str(fov))):
-        text, n = re.subn(rf"(?m)^{key}\s*=.*$", f"{key} = {value}", text, count=1)
-        if n != 1:
-            sys.exit(f"the config has no [camera] {key} to replace")
-    return text
-
-
-def compare(nave, a, b, reference, log):
-    """`nave compare A B [--reference] --json` as a dict."""
-    cmd = [nave, "compare", a, b, "--json"] + (["--reference"] if reference else [])
-    p = nave_bench.run_logged(cmd, log)
-    if p.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed: {p.stdout.strip()}")
-    return json.loads(p.stdout.strip().splitlines()[-1])
-
-
-def worst_region_ratio(result):
-    """The region whose mean luminance is furthest from the reference's, as A / reference."""
-    worst = 1.0
-    for a, ref in result["region_mean_luminance"]:
-        if ref > 0 and abs(a / ref - 1) > abs(worst - 1):
-            worst = a / ref
-    return worst
-
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -82,7 +38,7 @@ def main():
     ap.add_argument("--store", help="the abbey store (default: DIR/abbey1.nave, generated at detail 1)")
     ap.add_argument("--config", default="configs/abbey.toml")
     ap.add_argument("--views", default="nave,crossing_vault,north_aisle",
-                    help=f"comma-separated camera spots: {', '.join(VIEWS)}")
+                    help=f"comma-separated camera spots: {', '.join(nave_bench.VIEWS)}")
     ap.add_argument("--modes", default="photon,path", help="render modes to measure")
     ap.add_argument("--resolution", default="960x640")
     ap.add_argument("--time", type=float, default=120, help="seconds of each measured render")
@@ -92,10 +48,7 @@ def main():
                     help="more nave render arguments, given with '=': --render-args='--threads 2'")
     args = ap.parse_args()
 
-    views = [v.strip() for v in args.views.split(",") if v.strip()]
-    for v in views:
-        if v not in VIEWS:
-            sys.exit(f"--views: unknown view '{v}' (known: {', '.join(VIEWS)})")
+    views = nave_bench.parse_views(args.views)
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     os.makedirs(args.dir, exist_ok=True)
     log = open(os.path.join(args.dir, "runs.log"), "w")
@@ -122,27 +75,27 @@ def main():
     for view in views:
         config = os.path.join(args.dir, f"abbey_{view}.toml")
         with open(config, "w") as f:
-            f.write(config_for_view(base_text, view))
+            f.write(nave_bench.config_for_view(base_text, view))
         ref = [os.path.join(args.dir, f"{view}_reference_seed{s}.exr") for s in (1, 2)]
         for seed, out in zip((1, 2), ref):
             if not os.path.exists(out):
                 print(f"{view}: reference seed {seed}, {args.ref_time:.0f} s of path tracing", file=sys.stderr)
                 render(config, out, "path", 1000 + seed, args.ref_time)
-        ref_pair = compare(args.nave, ref[0], ref[1], False, log)
+        ref_pair = nave_bench.compare(args.nave, ref[0], ref[1], False, log)
         for mode in modes:
             outs = [os.path.join(args.dir, f"{view}_{mode}_{args.time:.0f}s_seed{s}.exr") for s in (1, 2)]
             for seed, out in zip((1, 2), outs):
                 print(f"{view}: {mode}, seed {seed}, {args.time:.0f} s", file=sys.stderr)
                 render(config, out, mode, seed, args.time)
-            against = compare(args.nave, outs[0], ref[0], True, log)
-            pair = compare(args.nave, outs[0], outs[1], False, log)
+            against = nave_bench.compare(args.nave, outs[0], ref[0], True, log)
+            pair = nave_bench.compare(args.nave, outs[0], outs[1], False, log)
             rows.append({
                 "view": view, "mode": mode, "seconds": args.time,
                 "relmse_rgb": against["relmse_against_reference_rgb"],
                 "relmse_rgb_blurred": against["relmse_against_reference_rgb_blurred"],
                 "relmse_pair_rgb": pair["relmse_of_one_rgb"],
                 "mean_ratio": against["ratio_b_to_a"] and 1 / against["ratio_b_to_a"],
-                "worst_region_ratio": worst_region_ratio(against),
+                "worst_region_ratio": nave_bench.worst_region_ratio(against),
                 "reference_relmse_rgb": ref_pair["relmse_of_one_rgb"],
                 "reference_relmse_rgb_blurred": ref_pair["relmse_of_one_rgb_blurred"],
             })

@@ -1,4 +1,4 @@
-"""Helpers shared by nave's benchmark scripts (bench_pager_budget.py, bench_pager_scale.py).
+"""Helpers shared by nave's benchmark scripts (bench_pager_budget.py, bench_pager_scale.py, bench_reference.py).
 
 Running nave under /usr/bin/time -v, telling a refused budget from a failure, reading the "nave:statistics"
 metadata of a rendered EXR, parsing budgets as nave does, writing CSV and Markdown tables, loading pyplot.
@@ -6,6 +6,7 @@ Needs the Debian packages installed by bench/setup-bench.sh (python3-openimageio
 """
 
 import csv
+import json
 import os
 import re
 import subprocess
@@ -199,3 +200,52 @@ def pyplot():
 def default_nave():
     """The release build's nave binary."""
     return "build/release/src/cli/nave"
+
+
+# The abbey's camera spots (docs/abbey.md, "Camera spots"): eye, look-at, vertical field of view.
+VIEWS = {
+    "nave": ((4.0, 0.0, 1.7), (60.0, 0.0, 12.0), 65),
+    "crossing_vault": ((62.5, -4.0, 1.7), (62.5, 0.5, 28.0), 90),
+    "north_aisle": ((2.0, 10.0, 1.7), (50.0, 10.0, 6.0), 70),
+    "choir": ((70.0, 3.0, 1.7), (92.0, 0.0, 9.0), 75),
+}
+
+
+def parse_views(text):
+    """'nave,north_aisle' -> ['nave', 'north_aisle']; exits naming an unknown view."""
+    views = [v.strip() for v in text.split(",") if v.strip()]
+    for v in views:
+        if v not in VIEWS:
+            raise SystemExit(f"--views: unknown view '{v}' (known: {', '.join(VIEWS)})")
+    return views
+
+
+def config_for_view(base_text, view):
+    """A config's text (configs/abbey.toml's) with its [camera] position, look_at and fov_deg set to `view`'s."""
+    eye, at, fov = VIEWS[view]
+    text = base_text
+    for key, value in (("position", f"[{eye[0]}, {eye[1]}, {eye[2]}]"),
+                       ("look_at", f"[{at[0]}, {at[1]}, {at[2]}]"), ("fov_deg", str(fov))):
+        text, n = re.subn(rf"(?m)^{key}\s*=.*$", f"{key} = {value}", text, count=1)
+        if n != 1:
+            raise SystemExit(f"the config has no [camera] {key} to replace")
+    return text
+
+
+def compare(nave, a, b, reference, log):
+    """`nave compare A B [--reference] --json` as a dict."""
+    cmd = [nave, "compare", a, b, "--json"] + (["--reference"] if reference else [])
+    p = run_logged(cmd, log)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed: {p.stdout.strip()}")
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def worst_region_ratio(result):
+    """From `nave compare A REF --json`: the region whose mean luminance is furthest from the reference's,
+    as A / reference."""
+    worst = 1.0
+    for a, ref in result["region_mean_luminance"]:
+        if ref > 0 and abs(a / ref - 1) > abs(worst - 1):
+            worst = a / ref
+    return worst

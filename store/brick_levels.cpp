@@ -52,12 +52,27 @@ struct Scratch {
     std::vector<uint32_t> simplified;
 };
 
-/// Simplifies one material's triangles of `mesh` as far as `target_error` (model units) allows,
-/// appending the kept triangles (indices into `mesh`'s vertices) to `out`. Returns the absolute
-/// error reached: meshoptimizer's relative error times its scale (the submesh's extent), since the
-/// submesh alone is simplified.
+/// The area of the triangles `indices` (into `positions`) form.
+double SurfaceArea(const std::vector<Vec3f>& positions, const uint32_t* indices, size_t count) {
+    double area = 0;
+    for (size_t i = 0; i + 2 < count; i += 3) {
+        const Vec3f& a = positions[indices[i]];
+        area += 0.5 *
+                double(Length(Cross(positions[indices[i + 1]] - a, positions[indices[i + 2]] - a)));
+    }
+    return area;
+}
+
+/// How many times a material whose area a level changes too much is simplified again, each time
+/// toward half the error before, before it is kept whole.
+constexpr int kAreaRetries = 3;
+
+/// Simplifies one material's triangles of `mesh` as far as `target_error` (model units) allows
+/// while their area changes by at most `max_area_change`, appending the kept triangles (indices
+/// into `mesh`'s vertices) to `out`. Returns the absolute error reached: meshoptimizer's relative
+/// error times its scale (the submesh's extent), since the submesh alone is simplified.
 float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, float target_error,
-                      bool lock_borders, Scratch& s, BrickMesh* out) {
+                      bool lock_borders, double max_area_change, Scratch& s, BrickMesh* out) {
     // A compact copy of the submesh's vertices: meshoptimizer's work and its scale then depend on
     // this material's vertices only.
     s.global_of.clear();
@@ -76,40 +91,53 @@ float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, float target_er
     }
     for (uint32_t v : s.global_of) s.local_of[v] = kUnused;
 
-    s.simplified.resize(s.indices.size());  // meshoptimizer's worst case: every index kept
-    const float scale = meshopt_simplifyScale(&s.positions[0].x, s.positions.size(), sizeof(Vec3f));
-    if (!(scale > 0)) {  // every vertex at one point: nothing to simplify
+    const auto keep_whole = [&] {
         for (uint32_t t : sub.triangles)
             for (int c = 0; c < 3; ++c) out->indices.push_back(mesh.indices[3 * size_t(t) + c]);
         out->material_ids.insert(out->material_ids.end(), sub.triangles.size(), sub.material);
+    };
+    s.simplified.resize(s.indices.size());  // meshoptimizer's worst case: every index kept
+    const float scale = meshopt_simplifyScale(&s.positions[0].x, s.positions.size(), sizeof(Vec3f));
+    if (!(scale > 0)) {  // every vertex at one point: nothing to simplify
+        keep_whole();
         return 0;
     }
-    float relative_error = 0;
-    // No triangle target (0): the error alone stops the collapses.
-    const size_t kept =
-        meshopt_simplify(s.simplified.data(), s.indices.data(), s.indices.size(), &s.positions[0].x,
-                         s.positions.size(), sizeof(Vec3f),
-                         /*target_index_count=*/0, target_error / scale,
-                         lock_borders ? unsigned(meshopt_SimplifyLockBorder) : 0u, &relative_error);
-    for (size_t i = 0; i < kept; ++i) out->indices.push_back(s.global_of[s.simplified[i]]);
-    out->material_ids.insert(out->material_ids.end(), kept / 3, sub.material);
-    return relative_error * scale;
+    const double area = SurfaceArea(s.positions, s.indices.data(), s.indices.size());
+    float target = target_error;
+    for (int attempt = 0; attempt <= kAreaRetries; ++attempt, target *= 0.5f) {
+        float relative_error = 0;
+        // No triangle target (0): the error alone stops the collapses.
+        const size_t kept = meshopt_simplify(
+            s.simplified.data(), s.indices.data(), s.indices.size(), &s.positions[0].x,
+            s.positions.size(), sizeof(Vec3f),
+            /*target_index_count=*/0, target / scale,
+            lock_borders ? unsigned(meshopt_SimplifyLockBorder) : 0u, &relative_error);
+        const double kept_area = SurfaceArea(s.positions, s.simplified.data(), kept);
+        if (!(std::abs(kept_area - area) > max_area_change * area)) {
+            for (size_t i = 0; i < kept; ++i) out->indices.push_back(s.global_of[s.simplified[i]]);
+            out->material_ids.insert(out->material_ids.end(), kept / 3, sub.material);
+            return relative_error * scale;
+        }
+    }
+    keep_whole();
+    return 0;
 }
 
-/// Keeps only the vertices `level` references, in the order of their first use, with their normals
-/// and texture coordinates from `source`.
-void CompactVertices(const BrickMesh& source, BrickMesh* level) {
+/// Keeps only the vertices `level` references, in the order of their first use, with their texture
+/// coordinates and, if `keep_normals`, their normals from `source`.
+void CompactVertices(const BrickMesh& source, bool keep_normals, BrickMesh* level) {
     std::vector<uint32_t> remap(source.VertexCount());
     const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), level->indices.data(),
                                                          level->indices.size(), remap.size());
+    const bool normals = keep_normals && source.HasNormals();
     level->positions.resize(used);
-    if (source.HasNormals()) level->normals.resize(used);
+    if (normals) level->normals.resize(used);
     if (source.HasUvs()) level->uvs.resize(used);
     for (size_t v = 0; v < remap.size(); ++v) {
         const uint32_t to = remap[v];
         if (to == kUnused) continue;
         level->positions[to] = source.positions[v];
-        if (source.HasNormals()) level->normals[to] = source.normals[v];
+        if (normals) level->normals[to] = source.normals[v];
         if (source.HasUvs()) level->uvs[to] = source.uvs[v];
     }
     for (uint32_t& i : level->indices) i = remap[i];
@@ -130,6 +158,10 @@ Status ValidateLevelOptions(const LevelOptions& options) {
     if (!(options.max_kept_fraction > 0 && options.max_kept_fraction <= 1)) {
         return InvalidArgumentError("largest kept fraction {} out of range (0, 1]",
                                     options.max_kept_fraction);
+    }
+    if (!(options.max_area_change >= 0 && options.max_area_change < 1)) {
+        return InvalidArgumentError("largest area change {} out of range [0, 1)",
+                                    options.max_area_change);
     }
     return Status::Ok();
 }
@@ -155,16 +187,16 @@ std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOption
         BrickLevel level;
         float step_error = 0;
         for (const Submesh& sub : SplitByMaterial(*source)) {
-            step_error =
-                std::max(step_error, SimplifySubmesh(*source, sub, step_target,
-                                                     options.lock_borders, scratch, &level.mesh));
+            step_error = std::max(step_error,
+                                  SimplifySubmesh(*source, sub, step_target, options.lock_borders,
+                                                  options.max_area_change, scratch, &level.mesh));
         }
         const size_t triangles = level.mesh.TriangleCount();
         if (triangles == 0 ||
             double(triangles) > options.max_kept_fraction * double(source->TriangleCount())) {
             break;
         }
-        CompactVertices(*source, &level.mesh);
+        CompactVertices(*source, options.keep_normals, &level.mesh);
         // A level simplified from the one before differs from the full mesh by at most both
         // errors (triangle inequality): conservative, and larger than the previous level's. A
         // flat region simplifies without error; the next float keeps the errors increasing.

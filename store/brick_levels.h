@@ -28,6 +28,16 @@ struct LevelOptions {
     /// recedes by up to its error, which opens holes inside the cell at its faces (a wall cut by a
     /// cell face then lets light through at the coarse level: tests/render/levels_of_detail_test).
     bool lock_borders = true;
+    /// The largest change, as a fraction, of a material's surface area in a brick that a level may
+    /// make. Collapsing a part smaller than the error (a stud, a crocket, a finial) keeps the
+    /// error small but takes the whole part's area away, and with it the light it stops: such a
+    /// material is simplified toward halved errors until its area holds, or kept whole.
+    double max_area_change = 0.02;
+    /// Whether a level keeps its vertices' normals. A level's facets are larger than the full
+    /// mesh's, and the full mesh's vertex normals, interpolated over them, bend far from them: a
+    /// level is shaded with its facets' normals (docs/render.md, "Levels of detail"), and normals
+    /// it stored would only take room (a third of a level's bytes on the abbey).
+    bool keep_normals = false;
 };
 
 /// One coarser version of a brick's mesh.
@@ -39,7 +49,8 @@ struct BrickLevel {
 };
 
 /// Checks `options`: every relative error in (0, 1), each larger than the one before,
-/// max_kept_fraction in (0, 1]. InvalidArgument naming the bad value otherwise.
+/// max_kept_fraction in (0, 1], max_area_change in [0, 1). InvalidArgument naming the bad value
+/// otherwise.
 Status ValidateLevelOptions(const LevelOptions& options);
 
 /// Meshes with fewer triangles than this get no levels.

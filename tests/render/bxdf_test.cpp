@@ -211,6 +211,40 @@ TEST(BxdfTest, SampleAgreesWithEvalAndPdf) {
         }
 }
 
+// A shading normal bent 30 degrees from the geometric one (a coarse mesh's vertex normals): no
+// reflection may leave through the surface, though the shading frame sees it above (Veach 1997,
+// §5.3.2). Without the geometric normal, the bent frame lets some through.
+TEST(BsdfTest, ReflectionsStayOnTheSideTheyArrivedFrom) {
+    const Vec3f ng(0, 0, 1);
+    const Vec3f ns = Normalize(Vec3f(std::sin(0.5236f), 0, std::cos(0.5236f)));
+    Bsdf bent(ns, Vec3f(0, 0, 0), DiffuseBxdf(SampledSpectrum(0.8f)));
+    Bsdf held = bent;
+    held.SetGeometricNormal(ng);
+    const Vec3f wo = Normalize(Vec3f(-0.2f, 0.1f, 1));  // above both
+    const Vec3f under = Normalize(Vec3f(1, 0, -0.2f));  // below ng, above ns
+    ASSERT_GT(Dot(under, ns), 0.f);
+    EXPECT_GT(bent.Eval(wo, under, kLambda)[0], 0.f);
+    EXPECT_EQ(held.Eval(wo, under, kLambda)[0], 0.f);
+    const Vec3f above = Normalize(Vec3f(0.3f, 0.2f, 1));
+    EXPECT_EQ(held.Eval(wo, above, kLambda)[0], bent.Eval(wo, above, kLambda)[0]);
+    Pcg32 rng(11);
+    int through_bent = 0, through_held = 0, kept = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const float uc = rng.NextFloat();
+        const Point2f u(rng.NextFloat(), rng.NextFloat());
+        const std::optional<BsdfSample> a = bent.Sample(wo, uc, u, kLambda);
+        const std::optional<BsdfSample> b = held.Sample(wo, uc, u, kLambda);
+        if (a && Dot(a->wi, ng) < 0) ++through_bent;
+        if (b) {
+            ++kept;
+            if (Dot(b->wi, ng) < 0) ++through_held;
+        }
+    }
+    EXPECT_GT(through_bent, 100);
+    EXPECT_EQ(through_held, 0);
+    EXPECT_GT(kept, 3000);
+}
+
 // White furnace: the directional albedo ∫ f cosθi dωi of an albedo-1 Lambertian is exactly 1; a
 // perfect (R = 1) rough mirror reflects at most 1 (single-scattering microfacets lose energy to
 // masking, more at high roughness and grazing angles: Heitz 2016, Kulla & Conty 2017).

@@ -36,14 +36,14 @@ TEST(LevelChoice, TheCoarsestLevelWhoseErrorTheFootprintHides) {
     EXPECT_EQ(ChooseLevel(errors, 1, 1e30f), 0u);  // without levels
 }
 
-TEST(LevelChoice, RaysStartPastEveryCopyOfTheirSurface) {
+TEST(LevelChoice, RaysKeepTheirOriginsLevelUntilPastEveryCopyOfTheirSurface) {
     // Off a level with a 1 cm error, with a footprint of 6 cm (levels of up to 3 cm near the
-    // origin): 4 cm off the surface.
-    EXPECT_NEAR(LevelOffset(0.01f, 0.06f, 1.f), 0.04f, 1e-6f);
-    // Never more than the model's coarsest level.
-    EXPECT_NEAR(LevelOffset(0.01f, 10.f, 0.05f), 0.06f, 1e-6f);
-    // Without levels, none: full detail renders as without them.
-    EXPECT_EQ(LevelOffset(0, 0.5f, 0), 0.f);
+    // origin): copies up to 4 cm apart, kept for four times that.
+    EXPECT_NEAR(LevelReach(0.01f, 0.06f, 1.f), 0.16f, 1e-6f);
+    // The levels near the origin are never coarser than the model's coarsest.
+    EXPECT_NEAR(LevelReach(0.01f, 10.f, 0.05f), 0.24f, 1e-6f);
+    // Without levels, nothing to keep: full detail renders as without them.
+    EXPECT_EQ(LevelReach(0, 0.5f, 0), 0.f);
 }
 
 /// Levels of a few cm and a decimetre on these metre-sized test bricks.
@@ -164,7 +164,7 @@ store::BrickMesh ThinWalledRoom() {
     return m;
 }
 
-SceneConfig RoomConfig(const std::string& lod, float lamp) {
+SceneConfig RoomConfig(const std::string& lod, float lamp, int spp, int seed) {
     const std::string text = fmt::format(R"(
 [camera]
 position = [-1.2, -1.0, -0.3]
@@ -182,27 +182,31 @@ reflectance = 0.5
 emission = {}
 [render]
 mode = "path"
-spp = 24
+spp = {}
 max_depth = 6
-seed = 9
+seed = {}
 lod = "{}"
 )",
-                                         lamp, lod);
+                                         lamp, spp, seed, lod);
     auto config = ParseSceneConfig(text, "room.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     return config.ok() ? *config : SceneConfig();
 }
 
-std::unique_ptr<testing::TestRender> RenderRoom(const std::string& lod, float lamp) {
+std::unique_ptr<testing::TestRender> RenderRoom(const std::string& lod, float lamp, int spp,
+                                                int seed) {
     return BuildAndRender(
         GridSourceWithLevels(ThinWalledRoom(), NamedMaterials({"wall", "ball", "lamp"}), {2, 2, 2},
                              RoomLevels()),
-        RoomConfig(lod, lamp));
+        RoomConfig(lod, lamp, spp, seed));
 }
 
 TEST_F(LevelsOfDetail, AThinWalledRoomLetsNoSunlightIn) {
-    auto full = RenderRoom("full", 0);
-    auto lod = RenderRoom("auto", 0);
+    // 240 000 paths: rays started on a coarse facet (no LevelOffset) let some in at this count,
+    // and so did reflections that a bent shading normal sent through the wall at full detail
+    // (Bsdf::SetGeometricNormal).
+    auto full = RenderRoom("full", 0, 200, 9);
+    auto lod = RenderRoom("auto", 0, 200, 9);
     ASSERT_TRUE(full != nullptr && lod != nullptr);
     ASSERT_TRUE(full->status.ok() && lod->status.ok());
     EXPECT_TRUE(SomeCoarseLevelResident(*lod->source));
@@ -212,31 +216,38 @@ TEST_F(LevelsOfDetail, AThinWalledRoomLetsNoSunlightIn) {
 }
 
 TEST_F(LevelsOfDetail, AThinWalledRoomLitFromInsideAgreesWithFullDetail) {
-    auto full = RenderRoom("full", 20);
-    auto lod = RenderRoom("auto", 20);
-    ASSERT_TRUE(full != nullptr && lod != nullptr);
-    ASSERT_TRUE(full->status.ok() && lod->status.ok());
     // Rays meeting a coarse copy of the surface they left from behind would darken the room;
     // rays slipping through the walls would lose light; rays started too far off the walls would
-    // brighten it. Same seed, so the two differ by the geometry only.
-    const double mean_full = MeanY(*full->film), mean_lod = MeanY(*lod->film);
-    ASSERT_GT(mean_full, 0.0);
-    EXPECT_NEAR(mean_lod / mean_full, 1.0, 0.03);
-    // Per quarter of the image as well.
-    const Film& a = *full->film;
-    const Film& b = *lod->film;
-    for (int qy = 0; qy < 2; ++qy) {
-        for (int qx = 0; qx < 2; ++qx) {
-            double sa = 0, sb = 0;
-            for (int y = qy * 15; y < qy * 15 + 15; ++y) {
-                for (int x = qx * 20; x < qx * 20 + 20; ++x) {
-                    sa += a.PixelXYZ(uint32_t(y * 40 + x)).y;
-                    sb += b.PixelXYZ(uint32_t(y * 40 + x)).y;
+    // brighten it. The lamp is small and found by paths alone, so one render's mean varies by a
+    // few percent from seed to seed: four seeds' sums, per quarter of the image and in all.
+    double full_sum[2][2] = {}, lod_sum[2][2] = {};
+    for (int seed = 1; seed <= 4; ++seed) {
+        auto full = RenderRoom("full", 20, 100, seed);
+        auto lod = RenderRoom("auto", 20, 100, seed);
+        ASSERT_TRUE(full != nullptr && lod != nullptr);
+        ASSERT_TRUE(full->status.ok() && lod->status.ok());
+        for (int qy = 0; qy < 2; ++qy) {
+            for (int qx = 0; qx < 2; ++qx) {
+                for (int y = qy * 15; y < qy * 15 + 15; ++y) {
+                    for (int x = qx * 20; x < qx * 20 + 20; ++x) {
+                        full_sum[qy][qx] += full->film->PixelXYZ(uint32_t(y * 40 + x)).y;
+                        lod_sum[qy][qx] += lod->film->PixelXYZ(uint32_t(y * 40 + x)).y;
+                    }
                 }
             }
-            EXPECT_NEAR(sb / sa, 1.0, 0.06) << "quarter " << qx << ", " << qy;
         }
     }
+    double full_total = 0, lod_total = 0;
+    for (int qy = 0; qy < 2; ++qy) {
+        for (int qx = 0; qx < 2; ++qx) {
+            ASSERT_GT(full_sum[qy][qx], 0.0);
+            EXPECT_NEAR(lod_sum[qy][qx] / full_sum[qy][qx], 1.0, 0.05)
+                << "quarter " << qx << ", " << qy;
+            full_total += full_sum[qy][qx];
+            lod_total += lod_sum[qy][qx];
+        }
+    }
+    EXPECT_NEAR(lod_total / full_total, 1.0, 0.025);
 }
 
 }  // namespace

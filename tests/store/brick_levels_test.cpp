@@ -71,6 +71,7 @@ TEST(BrickLevels, FineSheetSimplifiesAsFarAsItsErrorTargetsAllow) {
     ASSERT_EQ(full.TriangleCount(), 20000u);
     LevelOptions options;
     options.relative_errors = {0.002, 0.01};
+    options.keep_normals = true;  // to check below that they are the full mesh's
     const std::vector<BrickLevel> levels = MakeBrickLevels(full, options);
     // The sheet's border stays (locked), so the second level may keep more than half of the
     // first's and not be made.
@@ -91,6 +92,13 @@ TEST(BrickLevels, FineSheetSimplifiesAsFarAsItsErrorTargetsAllow) {
         }
         finer = levels[k].mesh.TriangleCount();
     }
+    // By default levels store no normals (they are shaded with their facets'), and keep the rest.
+    options.keep_normals = false;
+    const std::vector<BrickLevel> plain = MakeBrickLevels(full, options);
+    ASSERT_EQ(plain.size(), levels.size());
+    EXPECT_FALSE(plain[0].mesh.HasNormals());
+    EXPECT_TRUE(plain[0].mesh.HasUvs());
+    EXPECT_EQ(plain[0].mesh.indices, levels[0].mesh.indices);
 
     // The positions each material's triangles use in the full mesh.
     std::map<uint32_t, std::set<PositionKey>> positions_of_material;
@@ -182,6 +190,84 @@ TEST(BrickLevels, FlatSheetSimplifiesWithoutError) {
     EXPECT_LT(levels[0].mesh.TriangleCount(), testing::MakeSurface(flat).TriangleCount() / 4);
     EXPECT_FALSE(levels[0].mesh.HasNormals());
     EXPECT_FALSE(levels[0].mesh.HasUvs());
+}
+
+// Appends 40 balls of material `material`, 5 mm in radius (studs, crockets: small closed parts),
+// 20 cm apart in a row at height 1 m over the sheet.
+void AppendSmallBalls(BrickMesh* mesh, uint32_t material) {
+    constexpr int kBalls = 40, kRings = 8, kSegments = 12;
+    constexpr float kRadius = 0.005f;
+    for (int k = 0; k < kBalls; ++k) {
+        const Vec3f centre(-4.f + 0.2f * float(k), 0.5f, 1.f);
+        const uint32_t base = uint32_t(mesh->positions.size());
+        // The poles, then the rings between them.
+        for (int i = 0; i <= kRings; ++i) {
+            const float theta = 3.14159265f * float(i) / kRings;
+            const int count = (i == 0 || i == kRings) ? 1 : kSegments;
+            for (int j = 0; j < count; ++j) {
+                const float phi = 2 * 3.14159265f * float(j) / kSegments;
+                const Vec3f n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                              std::cos(theta));
+                mesh->positions.push_back(centre + n * kRadius);
+                if (!mesh->normals.empty()) mesh->normals.push_back(n);
+                if (!mesh->uvs.empty())
+                    mesh->uvs.push_back({float(j) / kSegments, float(i) / kRings});
+            }
+        }
+        const auto at = [&](int i, int j) -> uint32_t {
+            if (i == 0) return base;
+            if (i == kRings) return base + 1 + uint32_t((kRings - 1) * kSegments);
+            return base + 1 + uint32_t((i - 1) * kSegments + j % kSegments);
+        };
+        for (int i = 0; i < kRings; ++i) {
+            for (int j = 0; j < kSegments; ++j) {
+                if (i > 0) {
+                    mesh->indices.insert(mesh->indices.end(),
+                                         {at(i, j), at(i + 1, j), at(i, j + 1)});
+                    mesh->material_ids.push_back(material);
+                }
+                if (i + 1 < kRings) {
+                    mesh->indices.insert(mesh->indices.end(),
+                                         {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+                    mesh->material_ids.push_back(material);
+                }
+            }
+        }
+    }
+}
+
+double MaterialArea(const BrickMesh& mesh, uint32_t material) {
+    double area = 0;
+    for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
+        if (mesh.material_ids[t] != material) continue;
+        const auto c = mesh.TrianglePositions(t);
+        area += 0.5 * double(Length(Cross(c[1] - c[0], c[2] - c[0])));
+    }
+    return area;
+}
+
+TEST(BrickLevels, SmallPartsKeepTheirArea) {
+    BrickMesh full = FineSheet();
+    AppendSmallBalls(&full, 2);
+    ASSERT_TRUE(ValidateBrickMesh(full, 3).ok());
+    const double balls_area = MaterialArea(full, 2);
+    // Balls 1 cm across are smaller than either level's error (several cm on this 14 m brick).
+    LevelOptions options;
+    const std::vector<BrickLevel> held = MakeBrickLevels(full, options);
+    ASSERT_FALSE(held.empty());
+    for (size_t k = 0; k < held.size(); ++k) {
+        EXPECT_NEAR(MaterialArea(held[k].mesh, 2) / balls_area, 1.0, options.max_area_change)
+            << "level " << k + 1;
+    }
+    // Without the area check, the first level shrinks the balls to a fraction of their surface.
+    options.max_area_change = 0.999;
+    const std::vector<BrickLevel> free = MakeBrickLevels(full, options);
+    ASSERT_FALSE(free.empty());
+    EXPECT_LT(MaterialArea(free[0].mesh, 2), 0.5 * balls_area);
+    options.max_area_change = 1.5;
+    const Status bad = ValidateLevelOptions(options);
+    EXPECT_FALSE(bad.ok());
+    EXPECT_NE(bad.ToString().find("area change 1.5"), std::string::npos) << bad.ToString();
 }
 
 TEST(BrickLevels, SameMeshSameLevels) {

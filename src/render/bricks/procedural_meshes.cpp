@@ -11,11 +11,14 @@ void AppendSphere(store::BrickMesh* mesh, Vec3f center, float radius, int rings,
     const uint32_t base = uint32_t(mesh->positions.size());
     const bool with_normals = mesh->positions.empty() || mesh->HasNormals();
     for (int i = 0; i <= rings; ++i) {
-        float theta = kPi * float(i) / float(rings);
+        // The poles and the seam exactly where their neighbours are (sin(pi) and sin(2 pi) are not
+        // 0 in float): a crack of 1e-7 radii there lets rays through a closed sphere.
+        const float theta = kPi * float(i) / float(rings);
+        const float sin_theta = (i == 0 || i == rings) ? 0.f : std::sin(theta);
+        const float cos_theta = i == 0 ? 1.f : i == rings ? -1.f : std::cos(theta);
         for (int j = 0; j <= segments; ++j) {
-            float phi = 2 * kPi * float(j) / float(segments);
-            Vec3f n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                    std::cos(theta));
+            const float phi = 2 * kPi * float(j % segments) / float(segments);
+            Vec3f n(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
             mesh->positions.push_back(center + n * radius);
             if (with_normals) mesh->normals.push_back(inward ? -n : n);
         }

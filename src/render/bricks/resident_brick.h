@@ -59,7 +59,7 @@ struct LevelOfDetail {
     uint32_t level = 0;  ///< 0: the full mesh
     float error = 0;     ///< the level's largest distance from the full surface, model units
     /// The largest error of any level of the model in use (0 without levels): how far off a
-    /// surface a ray may meet another level's copy of it (LevelOffset).
+    /// surface a ray may meet another level's copy of it (LevelReach).
     float coarsest_error = 0;
 };
 

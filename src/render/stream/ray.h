@@ -56,7 +56,7 @@ struct RayRecord {
     uint8_t guide_side = 0;  ///< path rays: PathGuide::SideOf the last scattering vertex's
                              ///< surface; kSkyShadow rays: that of their own vertex
     /// The level of detail of the surface the ray starts on (0: full detail, or a ray from the
-    /// camera or a light): in the brick it starts in, the ray keeps it (StreamScheduler::Route).
+    /// camera or a light): up to level_reach, the ray keeps it (StreamScheduler::Route).
     uint8_t origin_level = 0;
     union {
         /// Path rays: the solid-angle pdf of the last BSDF sample (MIS against the sun and sky).
@@ -79,12 +79,15 @@ struct RayRecord {
     /// It chooses the level of detail of each brick the ray crosses (level_choice.h).
     float cone_width = 0;
     float cone_spread = 0;
+    /// How far along the ray it keeps origin_level in every brick it enters (LevelReach): past it,
+    /// the copies of its surface at other levels lie behind it. 0: only in the brick it starts in.
+    float level_reach = 0;
     SampledSpectrum
         beta;  ///< throughput; for shadow rays the contribution itself; for photons the power
     SampledWavelengths lambda;
 };
 // docs/render.md and docs/pager.md give this size (queue memory per ray in flight): change them
 // with it.
-static_assert(sizeof(RayRecord) == 124, "RayRecord's size is documented in docs/render.md");
+static_assert(sizeof(RayRecord) == 128, "RayRecord's size is documented in docs/render.md");
 
 }  // namespace nave::render

@@ -84,11 +84,12 @@ uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) co
     r.t_enter = s.t_enter;
     r.t_exit = s.t_exit;
     if (s.brick == store::kNoBrick || source_.level_count() == 1) return s.brick;
-    // In the brick it starts in, a ray keeps the level of the surface it leaves: that level's
-    // copy of the surface is the one it is offset from, and another level's could lie on either
-    // side of it. Elsewhere its footprint chooses, where it enters the cell: the footprint is
-    // narrowest there, so every hit inside is at least as wide.
-    const uint32_t level = s.t_enter == 0
+    // Near its origin, and in the whole brick it starts in, a ray keeps the level of the surface
+    // it leaves: that level's copy of the surface is the one it leaves, and another level's could
+    // lie on either side of it (LevelReach). Elsewhere its footprint chooses, where it enters the
+    // cell: the footprint is narrowest there, so every hit inside is at least as wide.
+    const bool near_origin = s.t_enter == 0 || s.t_enter < r.level_reach;
+    const uint32_t level = near_origin
                                ? std::min<uint32_t>(r.origin_level, source_.LevelsOf(s.brick) - 1)
                                : ChooseLevel(source_.LevelErrors(s.brick), source_.level_count(),
                                              ConeWidthAt(r, s.t_enter));

@@ -80,15 +80,17 @@ inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, Ray
 /// a non-specular (`scattered`) bounce widens its spread to at least kScatteredConeSpread, a
 /// specular one or a straight pass keeps it (a mirror or a pane does not blur; the surfaces'
 /// curvature, which Akenine-Möller et al. 2019 add, is left out). Returns where the ray starts:
-/// off the surface by OffsetOrigin and, with levels of detail, by LevelOffset along its normal.
+/// off the surface by OffsetOrigin and, from a coarse level, by LevelOffset along its normal; with
+/// levels of detail, it keeps the surface's level up to LevelReach.
 inline Vec3f LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, float t,
                           bool scattered) {
     r.cone_width = ConeWidthAt(r, t);
     if (scattered) r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
     r.origin_level = uint8_t(h.lod.level);
+    r.level_reach = LevelReach(h.lod.error, r.cone_width, h.lod.coarsest_error);
     const Vec3f origin = OffsetOrigin(h.p, h.ng, wi);
-    const float offset = LevelOffset(h.lod.error, r.cone_width, h.lod.coarsest_error);
-    if (offset == 0) return origin;  // a model without levels
+    const float offset = LevelOffset(h.lod.error);
+    if (offset == 0) return origin;  // full detail
     const Vec3f n = Normalize(h.ng);
     return origin + (Dot(n, wi) >= 0 ? n : -n) * offset;
 }

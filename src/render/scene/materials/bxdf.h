@@ -294,11 +294,19 @@ class Bsdf {
         : frame_(Frame::FromZTangent(shading_normal, tangent)), bxdf_(bxdf) {}
     Bsdf(const Frame& frame, const Bxdf& bxdf) : frame_(frame), bxdf_(bxdf) {}
 
+    /// The surface's geometric normal (not necessarily unit length). Where it and the shading
+    /// normal disagree on whether a direction pair is a reflection or a transmission, the BSDF is
+    /// zero (Veach 1997, "Robust Monte Carlo methods for light transport simulation", §5.3.2):
+    /// otherwise a reflection the bent normal allows would pass through the surface, and light
+    /// through a closed wall.
+    void SetGeometricNormal(const Vec3f& ng) { ng_ = ng; }
+
     SampledSpectrum Eval(const Vec3f& wo_world, const Vec3f& wi_world,
                          const SampledWavelengths& lambda,
                          TransportMode mode = TransportMode::kRadiance) const {
         Vec3f wo = frame_.ToLocal(wo_world), wi = frame_.ToLocal(wi_world);
         if (wo.z == 0.f) return {};
+        if (!SidesAgree(wo_world, wi_world, wo, wi)) return {};
         return bxdf_.Eval(wo, wi, lambda, mode);
     }
     std::optional<BsdfSample> Sample(const Vec3f& wo_world, float uc, Point2f u,
@@ -308,7 +316,9 @@ class Bsdf {
         if (wo.z == 0.f || !bxdf_.Flags()) return std::nullopt;
         std::optional<BsdfSample> s = bxdf_.Sample(wo, uc, u, lambda, mode);
         if (!s || !s->f || s->pdf == 0.f || s->wi.z == 0.f) return std::nullopt;
-        s->wi = frame_.FromLocal(s->wi);
+        const Vec3f wi_world = frame_.FromLocal(s->wi);
+        if (!SidesAgree(wo_world, wi_world, wo, s->wi)) return std::nullopt;
+        s->wi = wi_world;
         return s;
     }
     float Pdf(const Vec3f& wo_world, const Vec3f& wi_world, const SampledWavelengths& lambda,
@@ -322,8 +332,17 @@ class Bsdf {
     const Bxdf& bxdf() const { return bxdf_; }
 
   private:
+    /// Whether the geometric normal, if set, sees the pair on the sides the shading frame does.
+    bool SidesAgree(const Vec3f& wo_world, const Vec3f& wi_world, const Vec3f& wo,
+                    const Vec3f& wi) const {
+        if (ng_.x == 0.f && ng_.y == 0.f && ng_.z == 0.f) return true;
+        const bool geometric_reflection = Dot(wo_world, ng_) * Dot(wi_world, ng_) > 0;
+        return geometric_reflection == (wo.z * wi.z > 0);
+    }
+
     Frame frame_;
     Bxdf bxdf_;
+    Vec3f ng_{0, 0, 0};  ///< 0: not set
 };
 
 }  // namespace nave
