@@ -101,7 +101,9 @@ bool SomeCoarseLevelResident(const BrickSource& source) {
     return false;
 }
 
-void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
+// With `all_kept`, a budget that keeps every coarse level resident; else one that holds only some
+// of them (KeptLevels: the smallest, within half the budget).
+void ExpectPagedEqualsInCore(const std::string& mode, double bound, bool all_kept = true) {
     const std::vector<std::string> names = {"floor", "ball"};
     auto in_core = BuildAndRender(
         GridSourceWithLevels(Balls(), NamedMaterials(names), {4, 4, 1}, TestLevels()),
@@ -114,9 +116,29 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     const BrickBudgetMinimum m = MinimumBrickBudget(*in_core->source, true);
     EXPECT_GT(m.kept_bytes, 0u);
     PagerOptions paging;
-    // The kept levels and the two largest others: many reloads.
-    paging.brick_budget_bytes = std::max(m.kept_bytes * 2, m.kept_bytes + m.min_bytes);
-    EXPECT_TRUE(KeepsCoarseLevels(m, paging.brick_budget_bytes));
+    if (all_kept) {
+        // The kept levels and the two largest others: many reloads.
+        paging.brick_budget_bytes = std::max(m.kept_bytes * 2, m.kept_bytes + m.min_bytes);
+        EXPECT_TRUE(KeepsCoarseLevels(m, paging.brick_budget_bytes));
+    } else {
+        // Half the coarse levels' bytes beside the two largest others.
+        paging.brick_budget_bytes = m.min_bytes + m.kept_bytes / 2;
+        ASSERT_FALSE(KeepsCoarseLevels(m, paging.brick_budget_bytes));
+        const std::vector<bool> kept = KeptLevels(*in_core->source, m, paging.brick_budget_bytes);
+        uint64_t kept_bytes = 0;
+        size_t kept_count = 0, coarse_count = 0;
+        for (uint32_t b = 0; b < kept.size(); ++b) {
+            if (KeptResident(*in_core->source, b)) ++coarse_count;
+            if (!kept[b]) continue;
+            EXPECT_TRUE(KeptResident(*in_core->source, b)) << "slot " << b;
+            kept_bytes += in_core->source->EstimatedResidentBytes(b);
+            ++kept_count;
+        }
+        EXPECT_GT(kept_count, 0u);
+        EXPECT_LT(kept_count, coarse_count);
+        EXPECT_LE(kept_bytes, paging.brick_budget_bytes / 2);
+        EXPECT_LE(kept_bytes + m.min_bytes, paging.brick_budget_bytes);
+    }
     paging.spill_dir = std::filesystem::temp_directory_path();
     testing::RunOptions run;
     run.paging = &paging;
@@ -134,6 +156,9 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
 // The level is chosen by the ray's footprint, never by what is resident.
 TEST_F(LevelsOfDetail, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
 TEST_F(LevelsOfDetail, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-4); }
+TEST_F(LevelsOfDetail, PagedRenderWithSomeCoarseLevelsKeptEqualsInCore) {
+    ExpectPagedEqualsInCore("path", 1e-9, /*all_kept=*/false);
+}
 
 TEST_F(LevelsOfDetail, FullDetailIgnoresTheLevels) {
     const std::vector<std::string> names = {"floor", "ball"};

@@ -258,7 +258,8 @@ TEST_F(StoreLevels, InconsistentLevelsBehindValidChecksumsAreRefused) {
         std::memcpy(&triangles, &bytes[at + 8], 8);
         std::memcpy(&vertices, &bytes[at + 16], 8);
         triangles -= 1;
-        const uint64_t decoded = BrickMesh::BytesFor(vertices, triangles, /*normals=*/false, true);
+        const uint64_t decoded =
+            BrickMesh::BytesFor(vertices, triangles, /*has_normals=*/false, true);
         std::memcpy(&bytes[at + 8], &triangles, 8);
         std::memcpy(&bytes[at + 24], &decoded, 8);
         auto store = OpenBytes(Resealed(bytes));

@@ -125,6 +125,33 @@ bool KeepsCoarseLevels(const BrickBudgetMinimum& m, uint64_t brick_budget_bytes)
            m.kept_bytes + m.min_bytes <= brick_budget_bytes;
 }
 
+std::vector<bool> KeptLevels(const BrickSource& source, const BrickBudgetMinimum& m,
+                             uint64_t brick_budget_bytes) {
+    std::vector<bool> kept(source.slot_count(), false);
+    if (m.kept_bytes == 0) return kept;
+    if (KeepsCoarseLevels(m, brick_budget_bytes)) {
+        for (uint32_t b = 0; b < source.slot_count(); ++b) kept[b] = KeptResident(source, b);
+        return kept;
+    }
+    // They do not all fit: as many as half the budget holds (while the largest bricks still fit),
+    // the smallest first, so that the most bricks answer wide rays without a load. Which ones
+    // changes what is loaded when, never the image.
+    if (m.min_bytes >= brick_budget_bytes) return kept;
+    const uint64_t room = std::min(brick_budget_bytes / 2, brick_budget_bytes - m.min_bytes);
+    std::vector<std::pair<uint64_t, uint32_t>> by_size;
+    for (uint32_t b = 0; b < source.slot_count(); ++b) {
+        if (KeptResident(source, b)) by_size.push_back({source.EstimatedResidentBytes(b), b});
+    }
+    std::sort(by_size.begin(), by_size.end());
+    uint64_t used = 0;
+    for (const auto& [bytes, slot] : by_size) {
+        if (used + bytes > room) break;
+        used += bytes;
+        kept[slot] = true;
+    }
+    return kept;
+}
+
 bool KeptResident(const BrickSource& source, uint32_t slot) {
     const uint32_t level = source.LevelOfSlot(slot);
     return level > 0 && level + 1 == source.LevelsOf(source.BrickOfSlot(slot));
@@ -205,10 +232,7 @@ StatusOr<std::unique_ptr<Pager>> Pager::Create(BrickSource& source, const PagerO
             need.DescribeLargest(options.prefetch), FormatBytes(need.min_bytes), need.min_bytes);
     }
     std::unique_ptr<Pager> pager(new Pager(source, options, std::move(waiting)));
-    if (KeepsCoarseLevels(need, options.brick_budget_bytes)) {
-        for (uint32_t b = 0; b < source.slot_count(); ++b)
-            pager->kept_[b] = KeptResident(source, b);
-    }
+    pager->kept_ = KeptLevels(source, need, options.brick_budget_bytes);
     // Bricks an earlier render left resident: keep those that fit, drop the rest.
     for (uint32_t b = 0; b < source.slot_count(); ++b) {
         if (!source.IsResident(b)) continue;

@@ -108,7 +108,8 @@ struct BrickBudgetMinimum {
     uint64_t total_bytes = 0;  ///< all bricks resident at once (the in-core size)
     /// The coarsest level of every brick that has levels (KeptResident): never evicted when they
     /// take at most half the budget (KeepsCoarseLevels), so that the rays with wide footprints,
-    /// most of those past the first bounce, never wait for a load; paged like the rest otherwise.
+    /// most of those past the first bounce, never wait for a load; otherwise as many of them as
+    /// half the budget holds (KeptLevels), the rest paged like any brick.
     uint64_t kept_bytes = 0;
 
     /// "its largest brick, brick 12, takes 40.1 MiB (42049536 bytes) when resident[, and
@@ -125,6 +126,11 @@ bool KeptResident(const BrickSource& source, uint32_t slot);
 /// Whether a pager with `brick_budget_bytes` keeps the coarsest levels resident: when they take
 /// at most half of it, and leave room for the largest bricks.
 bool KeepsCoarseLevels(const BrickBudgetMinimum& m, uint64_t brick_budget_bytes);
+/// Per slot, whether the pager never evicts it once loaded: every KeptResident slot when they all
+/// fit (KeepsCoarseLevels), else the smallest of them that together take at most half the budget
+/// and leave room for the largest bricks.
+std::vector<bool> KeptLevels(const BrickSource& source, const BrickBudgetMinimum& m,
+                             uint64_t brick_budget_bytes);
 
 /// What the pager did during one render.
 struct PagerStats {
