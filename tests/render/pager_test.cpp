@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 
 #include "common/file_size_limit.h"
 #include "common/run_nave.h"
@@ -21,6 +22,7 @@
 #include "src/render/bricks/store_brick_source.h"
 #include "src/render/stream/memory_plan.h"
 #include "src/render/stream/ray.h"
+#include "src/render/stream/stream_scheduler.h"
 #include "store/store_reader.h"
 
 namespace nave::render {
@@ -263,6 +265,50 @@ TEST_F(PagerTest, EstimatesMatchTheRealSizes) {
         ASSERT_TRUE(h.ok());
         EXPECT_EQ((*h)->memory_bytes(), source->EstimatedResidentBytes(b)) << "brick " << b;
     }
+}
+
+// A pass over the model (the sky's portals, the light sources) visits every brick once, in order,
+// with the loaders fetching the next ones, in-core and under the smallest budget; a visit's error
+// ends it.
+TEST_F(PagerTest, ForEachBrickVisitsEveryBrickInOrderWithTheLoadersAhead) {
+    for (const bool tight : {false, true}) {
+        SCOPED_TRACE(tight ? "smallest budget" : "in-core");
+        auto source = BallGridSource();
+        PagerOptions options;
+        if (tight) options.brick_budget_bytes = MinimumBrickBudget(*source, true).min_bytes;
+        auto scheduler = StreamScheduler::Create(*source, options, {}, 1000);
+        ASSERT_TRUE(scheduler.ok()) << scheduler.status().ToString();
+        std::vector<uint32_t> visited;
+        const Status pass =
+            (*scheduler)->ForEachBrick("test pass", [&](uint32_t b, const ResidentBrick& brick) {
+                visited.push_back(b);
+                EXPECT_EQ(brick.memory_bytes(), source->EstimatedResidentBytes(b));
+                return Status::Ok();
+            });
+        ASSERT_TRUE(pass.ok()) << pass.ToString();
+        std::vector<uint32_t> in_order(source->brick_count());
+        std::iota(in_order.begin(), in_order.end(), 0u);
+        EXPECT_EQ(visited, in_order);
+        StreamStats stats;
+        (*scheduler)->FillStats(BrickSourceStats(), &stats);
+        EXPECT_GT(stats.residency.prefetch_loads, 0u);  // the loaders were ahead
+        if (tight) {
+            EXPECT_LE(stats.residency.peak_resident_bytes, options.brick_budget_bytes);
+        } else {
+            EXPECT_EQ(stats.residency.loads, source->brick_count());
+        }
+    }
+    auto source = BallGridSource();
+    auto scheduler = StreamScheduler::Create(*source, PagerOptions(), {}, 1000);
+    ASSERT_TRUE(scheduler.ok());
+    uint32_t last = 0;
+    const Status stopped =
+        (*scheduler)->ForEachBrick("test pass", [&](uint32_t b, const ResidentBrick&) {
+            last = b;
+            return b == 3 ? DataLossError("brick {} refused", b) : Status::Ok();
+        });
+    EXPECT_EQ(stopped.code(), StatusCode::kDataLoss);
+    EXPECT_EQ(last, 3u);
 }
 
 // Eviction order: emptiest queue first, least recently used on ties; pinned bricks stay.

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "src/core/check.h"
+#include "src/core/progress.h"
 #include "src/core/trace.h"
 #include "src/render/bricks/brick_walk.h"
 #include "src/render/stream/level_choice.h"
@@ -76,6 +77,35 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
 }
 
 StatusOr<BrickHandle> StreamScheduler::Acquire(uint32_t brick) { return pager_->Acquire(brick); }
+
+Status StreamScheduler::ForEachBrick(
+    std::string_view task,
+    const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit) {
+    // How many bricks past the one visited the loaders may fetch: enough to keep both loaders
+    // busy, few enough that a small budget does not evict them before their turn.
+    constexpr uint32_t kAhead = 4;
+    const uint32_t count = source_.brick_count();
+    ProgressBar progress(std::string(task), count, "bricks");
+    std::vector<size_t> ahead(source_.slot_count(), 0);
+    for (uint32_t b = 0; b < count; ++b) {
+        // The next bricks, the nearest ranked first, as if rays waited for them.
+        for (uint32_t n = b + 1; n < std::min(count, b + 1 + kAhead); ++n)
+            ahead[source_.SlotOf(n, 0)] = kAhead + 1 - (n - b);
+        if (b > 0) ahead[source_.SlotOf(b, 0)] = 0;
+        const uint32_t slot = source_.SlotOf(b, 0);
+        pager_->Prefetch(ahead, slot, 0);
+        NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(slot));
+        NAVE_RETURN_IF_ERROR(visit(b, *handle));
+        handle.Reset();
+        pager_->BatchDone();
+        progress.Add(1);
+    }
+    // Nothing ahead any more: the loaders wait for the render's queues.
+    std::fill(ahead.begin(), ahead.end(), 0);
+    pager_->Prefetch(ahead, store::kNoBrick, 0);
+    progress.Finish();
+    return Status::Ok();
+}
 
 uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) const {
     const uint32_t current_brick =

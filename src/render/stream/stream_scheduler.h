@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -89,6 +90,12 @@ class StreamScheduler {
     /// Pins brick `brick` for a batch or a pass over the bricks, through the pager. Load errors
     /// name the brick.
     StatusOr<BrickHandle> Acquire(uint32_t brick);
+    /// Pins every brick at full detail in turn, in order, for `visit` (a pass over the whole model
+    /// before the render: the sky's portals, the light sources), while the pager's loaders load the
+    /// next few: the loads then run on every core instead of one after another on this thread.
+    /// `task` names the pass on its progress bar. Errors: a brick that cannot be pinned, `visit`'s.
+    Status ForEachBrick(std::string_view task,
+                        const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit);
     /// Sets r's segment to the first brick after `from_t` other than `current`'s; returns its slot
     /// at the level of detail r's footprint there chooses (level_choice.h), or store::kNoBrick
     /// (the ray leaves the model, or reaches t_max, first). `current` is a slot.

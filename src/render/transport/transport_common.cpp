@@ -7,18 +7,16 @@ Status ForEachOwnedTriangle(
     const std::function<bool(const SurfaceMaterial&)>& want,
     const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit) {
     const store::BrickTree& tree = scheduler.tree();
-    for (uint32_t b = 0; b < scene.source->brick_count(); ++b) {
-        NAVE_ASSIGN_OR_RETURN(BrickHandle h,
-                              scheduler.Acquire(b));  // released at the end of the iteration
-        const ResidentMesh& m = h->mesh();
+    return scheduler.ForEachBrick("model scan", [&](uint32_t b, const ResidentBrick& brick) {
+        const ResidentMesh& m = brick.mesh();
         for (size_t t = 0; t < m.TriangleCount(); ++t) {
             const uint32_t mat = m.material_ids[t];
             if (mat >= scene.materials.size() || !want(scene.materials[mat])) continue;
             const std::array<Vec3f, 3> v = m.TrianglePositions(t);
             if (tree.Locate((v[0] + v[1] + v[2]) * (1.f / 3.f)) == b) visit(m, t, b);
         }
-    }
-    return Status::Ok();
+        return Status::Ok();
+    });
 }
 
 }  // namespace nave::render
