@@ -131,10 +131,8 @@ double PathIntegrator::NoiseEstimate(int passes) const {
 
 bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& brick,
                                const SurfaceHit& h, bool last, RayOutbox& out) {
-    const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
-    bsdf.SetGeometricNormal(h.ng);
+    Bsdf bsdf = BsdfAt(h, &r.lambda);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));

@@ -205,8 +205,7 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
     const SurfaceMaterial& mat = *h.material;
     const Vec3f wo = -r.dir;
     AbsorbInsideGlass(mat, h, &r);
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
-    bsdf.SetGeometricNormal(h.ng);
+    Bsdf bsdf = BsdfAt(h, &r.lambda);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     // Direct light from the sun and the other delta or disc lights is next-event estimated at the

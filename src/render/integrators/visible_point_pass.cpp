@@ -25,8 +25,7 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
         r.lambda = IterationWavelengths(uint64_t(scene_.settings.seed), iteration(),
                                         VisiblePoints::PixelChannel(r.pixel));
     }
-    Bsdf bsdf = mat.MakeBsdf(h.ns, &r.lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
-    bsdf.SetGeometricNormal(h.ng);
+    Bsdf bsdf = BsdfAt(h, &r.lambda);
     const uint8_t flags = bsdf.Flags();
     if (flags == kBxdfUnset) return false;
     VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));

@@ -128,15 +128,10 @@ bool KeepsCoarseLevels(const BrickBudgetMinimum& m, uint64_t brick_budget_bytes)
 std::vector<bool> KeptLevels(const BrickSource& source, const BrickBudgetMinimum& m,
                              uint64_t brick_budget_bytes) {
     std::vector<bool> kept(source.slot_count(), false);
-    if (m.kept_bytes == 0) return kept;
-    if (KeepsCoarseLevels(m, brick_budget_bytes)) {
-        for (uint32_t b = 0; b < source.slot_count(); ++b) kept[b] = KeptResident(source, b);
-        return kept;
-    }
-    // They do not all fit: as many as half the budget holds (while the largest bricks still fit),
-    // the smallest first, so that the most bricks answer wide rays without a load. Which ones
-    // changes what is loaded when, never the image.
-    if (m.min_bytes >= brick_budget_bytes) return kept;
+    // As many as half the budget holds while the largest bricks still fit, the smallest first, so
+    // that the most bricks answer wide rays without a load: all of them where KeepsCoarseLevels.
+    // Which ones changes what is loaded when, never the image.
+    if (m.kept_bytes == 0 || m.min_bytes >= brick_budget_bytes) return kept;
     const uint64_t room = std::min(brick_budget_bytes / 2, brick_budget_bytes - m.min_bytes);
     std::vector<std::pair<uint64_t, uint32_t>> by_size;
     for (uint32_t b = 0; b < source.slot_count(); ++b) {

@@ -88,11 +88,11 @@ Status StreamScheduler::ForEachBrick(
     ProgressBar progress(std::string(task), count, "bricks");
     std::vector<size_t> ahead(source_.slot_count(), 0);
     for (uint32_t b = 0; b < count; ++b) {
+        const uint32_t slot = source_.SlotOf(b, 0);
         // The next bricks, the nearest ranked first, as if rays waited for them.
+        ahead[slot] = 0;
         for (uint32_t n = b + 1; n < std::min(count, b + 1 + kAhead); ++n)
             ahead[source_.SlotOf(n, 0)] = kAhead + 1 - (n - b);
-        if (b > 0) ahead[source_.SlotOf(b, 0)] = 0;
-        const uint32_t slot = source_.SlotOf(b, 0);
         pager_->Prefetch(ahead, slot, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(slot));
         NAVE_RETURN_IF_ERROR(visit(b, *handle));

@@ -76,6 +76,14 @@ inline void AbsorbInsideGlass(const SurfaceMaterial& m, const SurfaceHit& h, Ray
     r->beta *= glass->Transmittance(r->since_vertex + Length(h.p - r->origin), r->lambda);
 }
 
+/// The BSDF of the surface at `h` for `lambda`, which cannot tell reflection from transmission
+/// otherwise than its facet does (Bsdf::SetGeometricNormal).
+inline Bsdf BsdfAt(const SurfaceHit& h, SampledWavelengths* lambda) {
+    Bsdf bsdf = h.material->MakeBsdf(h.ns, lambda, h.has_uv ? &h.uv : nullptr, h.footprint);
+    bsdf.SetGeometricNormal(h.ng);
+    return bsdf;
+}
+
 /// The cone of `r` (ray.h) as it leaves `h`, `t` from its origin, into `wi`: as wide as it arrived;
 /// a non-specular (`scattered`) bounce widens its spread to at least kScatteredConeSpread, a
 /// specular one or a straight pass keeps it (a mirror or a pane does not blur; the surfaces'
