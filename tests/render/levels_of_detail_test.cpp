@@ -11,8 +11,11 @@
 #include "render_test_util.h"
 #include "src/core/progress.h"
 #include "src/render/bricks/procedural_meshes.h"
+#include "src/render/scene/lights/point_light.h"
+#include "src/render/scene/lights/sun_light.h"
 #include "src/render/stream/level_choice.h"
 #include "src/render/stream/pager.h"
+#include "src/render/stream/stream_scheduler.h"
 
 namespace nave::render {
 namespace {
@@ -44,6 +47,27 @@ TEST(LevelChoice, RaysKeepTheirOriginsLevelUntilPastEveryCopyOfTheirSurface) {
     EXPECT_NEAR(LevelReach(0.01f, 10.f, 0.05f), 0.24f, 1e-6f);
     // Without levels, nothing to keep: full detail renders as without them.
     EXPECT_EQ(LevelReach(0, 0.5f, 0), 0.f);
+}
+
+// A shadow ray is as wide as its light: the sun's penumbrae blur over its disc, 0.53 degrees (the
+// disc of radius 0.2666 degrees, as at 1 AU), so its shadows' occluders may be read at the levels
+// that footprint allows; a point light's shadows are sharp and keep full detail.
+TEST(LevelChoice, ShadowRaysAreAsWideAsTheirLight) {
+    const double radius = 0.2666 * M_PI / 180;
+    const SunLight sun(Vec3f(0, 0, 1), radius, Spectrum::Constant(1.f));
+    EXPECT_NEAR(sun.ShadowSpread(), 9.306e-3f, 1e-6f);
+    const PointLight lamp(Vec3f(0, 0, 2), Spectrum::Constant(1.f));
+    EXPECT_EQ(lamp.ShadowSpread(), 0.f);
+    // From a camera hit 20 m away at a pixel's 2.65 mrad (5.3 cm wide), a sun shadow ray reaches
+    // a level of 5 cm error 5 m along, where the camera's own cone would have needed 17.7 m.
+    const float errors[] = {0.f, 0.05f};
+    RayRecord r{};
+    r.cone_width = 20 * 2.65e-3f;
+    r.cone_spread = 2.65e-3f;
+    EXPECT_EQ(ChooseLevel(errors, 2, ConeWidthAt(r, 6.f)), 0u);
+    r.cone_spread = std::max(r.cone_spread, sun.ShadowSpread());
+    EXPECT_EQ(ChooseLevel(errors, 2, ConeWidthAt(r, 4.f)), 0u);
+    EXPECT_EQ(ChooseLevel(errors, 2, ConeWidthAt(r, 6.f)), 1u);
 }
 
 /// Levels of a few cm and a decimetre on these metre-sized test bricks.
@@ -173,6 +197,40 @@ TEST_F(LevelsOfDetail, FullDetailIgnoresTheLevels) {
     EXPECT_EQ(without->source->level_count(), 1u);
     // The same rays through the same triangles; only the order of the film's sums may differ.
     EXPECT_LT(MaxRelativeDifference(*without->film, *full->film), 1e-9);
+}
+
+// The pass over the model before a render (the sky's portals) reads each brick's coarsest level
+// when levels are in use: fewer triangles, and no full-detail brick loaded for it alone.
+TEST_F(LevelsOfDetail, TheModelScanReadsEachBricksCoarsestLevel) {
+    auto source =
+        GridSourceWithLevels(Balls(), NamedMaterials({"floor", "ball"}), {4, 4, 1}, TestLevels());
+    ASSERT_TRUE(source != nullptr);
+    ASSERT_TRUE(source->UseLevels(8).ok());
+    ASSERT_GT(source->level_count(), 1u);
+    auto scheduler = StreamScheduler::Create(*source, PagerOptions(), {}, 1000);
+    ASSERT_TRUE(scheduler.ok()) << scheduler.status().ToString();
+    uint64_t triangles[2] = {0, 0};
+    uint32_t coarse_bricks = 0;
+    for (const ScanDetail detail : {ScanDetail::kCoarsest, ScanDetail::kFull}) {
+        const bool full = detail == ScanDetail::kFull;
+        const Status pass =
+            (*scheduler)->ForEachBrick("scan", detail, [&](uint32_t b, const ResidentBrick& brick) {
+                const uint32_t expected = full ? 0 : source->LevelsOf(b) - 1;
+                EXPECT_EQ(brick.lod().level, expected) << "brick " << b;
+                if (!full && expected > 0) ++coarse_bricks;
+                triangles[full] += brick.mesh().TriangleCount();
+                return Status::Ok();
+            });
+        ASSERT_TRUE(pass.ok()) << pass.ToString();
+        if (full) continue;
+        for (uint32_t b = 0; b < source->brick_count(); ++b) {
+            if (source->LevelsOf(b) > 1) {
+                EXPECT_FALSE(source->IsResident(source->SlotOf(b, 0))) << "brick " << b;
+            }
+        }
+    }
+    EXPECT_GT(coarse_bricks, 0u);
+    EXPECT_LT(triangles[0], triangles[1]);
 }
 
 // A room whose walls are two shells 50 cm apart (an inward sphere of 2 m inside an outward one),

@@ -280,11 +280,13 @@ TEST_F(PagerTest, ForEachBrickVisitsEveryBrickInOrderWithTheLoadersAhead) {
         ASSERT_TRUE(scheduler.ok()) << scheduler.status().ToString();
         std::vector<uint32_t> visited;
         const Status pass =
-            (*scheduler)->ForEachBrick("test pass", [&](uint32_t b, const ResidentBrick& brick) {
-                visited.push_back(b);
-                EXPECT_EQ(brick.memory_bytes(), source->EstimatedResidentBytes(b));
-                return Status::Ok();
-            });
+            (*scheduler)
+                ->ForEachBrick(
+                    "test pass", ScanDetail::kFull, [&](uint32_t b, const ResidentBrick& brick) {
+                        visited.push_back(b);
+                        EXPECT_EQ(brick.memory_bytes(), source->EstimatedResidentBytes(b));
+                        return Status::Ok();
+                    });
         ASSERT_TRUE(pass.ok()) << pass.ToString();
         std::vector<uint32_t> in_order(source->brick_count());
         std::iota(in_order.begin(), in_order.end(), 0u);
@@ -303,10 +305,11 @@ TEST_F(PagerTest, ForEachBrickVisitsEveryBrickInOrderWithTheLoadersAhead) {
     ASSERT_TRUE(scheduler.ok());
     uint32_t last = 0;
     const Status stopped =
-        (*scheduler)->ForEachBrick("test pass", [&](uint32_t b, const ResidentBrick&) {
-            last = b;
-            return b == 3 ? DataLossError("brick {} refused", b) : Status::Ok();
-        });
+        (*scheduler)
+            ->ForEachBrick("test pass", ScanDetail::kFull, [&](uint32_t b, const ResidentBrick&) {
+                last = b;
+                return b == 3 ? DataLossError("brick {} refused", b) : Status::Ok();
+            });
     EXPECT_EQ(stopped.code(), StatusCode::kDataLoss);
     EXPECT_EQ(last, 3u);
 }

@@ -79,7 +79,7 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
 StatusOr<BrickHandle> StreamScheduler::Acquire(uint32_t brick) { return pager_->Acquire(brick); }
 
 Status StreamScheduler::ForEachBrick(
-    std::string_view task,
+    std::string_view task, ScanDetail detail,
     const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit) {
     // How many bricks past the one visited the loaders may fetch: enough to keep both loaders
     // busy, few enough that a small budget does not evict them before their turn.
@@ -87,12 +87,15 @@ Status StreamScheduler::ForEachBrick(
     const uint32_t count = source_.brick_count();
     ProgressBar progress(std::string(task), count, "bricks");
     std::vector<size_t> ahead(source_.slot_count(), 0);
+    const auto slot_of = [&](uint32_t b) {
+        return source_.SlotOf(b, detail == ScanDetail::kFull ? 0 : source_.LevelsOf(b) - 1);
+    };
     for (uint32_t b = 0; b < count; ++b) {
-        const uint32_t slot = source_.SlotOf(b, 0);
+        const uint32_t slot = slot_of(b);
         // The next bricks, the nearest ranked first, as if rays waited for them.
         ahead[slot] = 0;
         for (uint32_t n = b + 1; n < std::min(count, b + 1 + kAhead); ++n)
-            ahead[source_.SlotOf(n, 0)] = kAhead + 1 - (n - b);
+            ahead[slot_of(n)] = kAhead + 1 - (n - b);
         pager_->Prefetch(ahead, slot, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(slot));
         NAVE_RETURN_IF_ERROR(visit(b, *handle));

@@ -69,6 +69,13 @@ class RayProcessor {
                               std::span<const RayRecord> rays, RayOutbox& out) = 0;
 };
 
+/// Which level of each brick a pass over the whole model reads (StreamScheduler::ForEachBrick).
+enum class ScanDetail {
+    kFull,      ///< level 0: every triangle as stored
+    kCoarsest,  ///< the coarsest level each brick has in use (level 0 without levels): a tenth of
+                ///< the triangles to decode, and the level the render keeps resident first
+};
+
 /// The ray queues of one render and the loop that drains them. Acquire, Drain, SpillIfOverCap and
 /// FillStats are called from the render's thread; Route and Flush from any thread (workers call
 /// them).
@@ -90,11 +97,11 @@ class StreamScheduler {
     /// Pins brick `brick` for a batch or a pass over the bricks, through the pager. Load errors
     /// name the brick.
     StatusOr<BrickHandle> Acquire(uint32_t brick);
-    /// Pins every brick at full detail in turn, in order, for `visit` (a pass over the whole model
-    /// before the render: the sky's portals, the light sources), while the pager's loaders load the
-    /// next few: the loads then run on every core instead of one after another on this thread.
+    /// Pins every brick in turn, in order, for `visit` (a pass over the whole model before the
+    /// render: the sky's portals, the light sources), at `detail`, while the pager's loaders load
+    /// the next few: the loads then run on every core instead of one after another on this thread.
     /// `task` names the pass on its progress bar. Errors: a brick that cannot be pinned, `visit`'s.
-    Status ForEachBrick(std::string_view task,
+    Status ForEachBrick(std::string_view task, ScanDetail detail,
                         const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit);
     /// Sets r's segment to the first brick after `from_t` other than `current`'s; returns its slot
     /// at the level of detail r's footprint there chooses (level_choice.h), or store::kNoBrick

@@ -74,8 +74,10 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
         return InvalidArgumentError(
             "render.sky_sampling = \"portals\" but no material has portal = true");
     }
+    // The portals only guide the sky's samples (SkyPdf mixes them with uniform directions and
+    // counts the same triangles), so the coarsest levels serve: a tenth of the triangles to read.
     NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
-        scene, scheduler, [](const SurfaceMaterial& m) { return m.portal; },
+        scene, scheduler, ScanDetail::kCoarsest, [](const SurfaceMaterial& m) { return m.portal; },
         [&](const ResidentMesh& m, size_t t, uint32_t) {
             triangles.push_back(m.TrianglePositions(t));
         }));
@@ -113,6 +115,8 @@ std::optional<RayRecord> LightSampler::SampleLight(const Light& light, int index
     RayRecord s = r;
     s.kind = kShadowRay;
     s.origin = LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
+    // As wide as the light: its shadows blur over as much (Light::ShadowSpread).
+    s.cone_spread = std::max(s.cone_spread, light.ShadowSpread());
     s.dir = wi;
     s.t_max = ls->t_max;
     s.beta = r.beta * f * ls->weight * w;
@@ -156,7 +160,9 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                   : 1.f;
     RayRecord s = r;
     s.kind = kShadowRay;
-    s.origin = LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/false);
+    // One direction of the sky seen through the windows, a cone of sky as wide as a diffuse
+    // bounce's lobe or more: its footprint widens as a scattered ray's (kScatteredConeSpread).
+    s.origin = LeaveSurface(s, h, wi, Length(h.p - r.origin), /*scattered=*/true);
     s.dir = wi;
     s.t_max = kInfinity;
     const SampledSpectrum radiance = scene_.sky->Radiance(wi, r.lambda);

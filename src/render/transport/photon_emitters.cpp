@@ -28,8 +28,8 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
     scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
     const float disk_area = kPi * scene_radius_ * scene_radius_;
 
-    // One pass over the bricks that hold emissive or portal materials. A triangle stored in several
-    // bricks (it crosses cells) is kept only in the brick whose cell holds its centroid.
+    // Passes over the bricks for the emissive and portal materials' triangles. A triangle stored
+    // in several bricks (it crosses cells) is kept only in the brick whose cell holds its centroid.
     const bool want_portals =
         scene_.settings.photon_target == RenderSettings::PhotonTarget::kPortals;
     bool any_emissive = false, any_portal = false;
@@ -52,24 +52,35 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
             if (scene_.materials[i].emissive)
                 power[i] = TriangleLight::MaterialPower(scene_.materials[i]);
         }
-        NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
-            scene_, scheduler,
-            [&](const SurfaceMaterial& sm) { return sm.emissive || (want_portals && sm.portal); },
-            [&](const ResidentMesh& m, size_t t, uint32_t) {
-                const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
-                const std::array<Vec3f, 3> v = m.TrianglePositions(t);
-                if (want_portals && sm.portal) portal_triangles.push_back(v);
-                if (!sm.emissive) return;
-                std::array<std::array<float, 2>, 3> uv{};
-                if (m.HasUvs()) {
-                    for (int k = 0; k < 3; ++k) uv[k] = m.uvs[m.indices[3 * t + k]];
-                }
-                std::optional<TriangleLight> light = TriangleLight::Make(
-                    v, sm, m.HasUvs() ? &uv : nullptr, power[m.material_ids[t]]);
-                if (!light) return;
-                triangles.push_back(std::move(*light));
-                triangle_weights.push_back(triangles.back().Power(PhotonTarget()));
-            }));
+        // The portals only aim photons (their density mixes them with the whole disc and counts
+        // the same triangles), so the coarsest levels serve; light sources are read at full
+        // detail, in a second pass only when the model has any.
+        if (want_portals) {
+            NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
+                scene_, scheduler, ScanDetail::kCoarsest,
+                [](const SurfaceMaterial& sm) { return sm.portal; },
+                [&](const ResidentMesh& m, size_t t, uint32_t) {
+                    portal_triangles.push_back(m.TrianglePositions(t));
+                }));
+        }
+        if (any_emissive) {
+            NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
+                scene_, scheduler, ScanDetail::kFull,
+                [](const SurfaceMaterial& sm) { return sm.emissive; },
+                [&](const ResidentMesh& m, size_t t, uint32_t) {
+                    const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
+                    std::array<std::array<float, 2>, 3> uv{};
+                    if (m.HasUvs()) {
+                        for (int k = 0; k < 3; ++k) uv[k] = m.uvs[m.indices[3 * t + k]];
+                    }
+                    std::optional<TriangleLight> light =
+                        TriangleLight::Make(m.TrianglePositions(t), sm, m.HasUvs() ? &uv : nullptr,
+                                            power[m.material_ids[t]]);
+                    if (!light) return;
+                    triangles.push_back(std::move(*light));
+                    triangle_weights.push_back(triangles.back().Power(PhotonTarget()));
+                }));
+        }
     }
     for (const std::unique_ptr<Light>& l : scene_.lights) {
         Emitter e;

@@ -126,13 +126,16 @@ inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, bool spec
     return true;
 }
 
-/// One pass over the bricks (pinned through `scheduler`, so through the pager when paging) calling
-/// `visit(mesh, t, b)` for every triangle t of brick b whose material passes `want`. A triangle
-/// stored in several bricks (it crosses cells) is visited once: in the brick whose cell holds its
-/// centroid. Errors: a brick that cannot be pinned. Call from the render's thread, not during a
-/// Drain.
+/// One pass over the bricks at `detail` (pinned through `scheduler`, so through the pager when
+/// paging) calling `visit(mesh, t, b)` for every triangle t of brick b whose material passes
+/// `want`. A triangle stored in several bricks (it crosses cells) is visited once: in the brick
+/// whose cell holds its centroid. At ScanDetail::kCoarsest the triangles are a level's, which
+/// may differ from the full surface by the level's error and, at a cell's face, miss or repeat a
+/// sliver: fit for what only guides sampling under a density that stays consistent with the set
+/// (the portals), not for light sources. Errors: a brick that cannot be pinned. Call from the
+/// render's thread, not during a Drain.
 Status ForEachOwnedTriangle(
-    const RenderScene& scene, StreamScheduler& scheduler,
+    const RenderScene& scene, StreamScheduler& scheduler, ScanDetail detail,
     const std::function<bool(const SurfaceMaterial&)>& want,
     const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit);
 

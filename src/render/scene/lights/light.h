@@ -96,6 +96,11 @@ class Light {
     virtual double Power(const PhotonTarget& target) const = 0;
     /// This light as a light far away whose photons start on a plane facing it, or null.
     virtual const DistantLight* distant() const { return nullptr; }
+    /// The angle (radians) the light spans seen from the scene, 0 for a point or a direction. A
+    /// shadow ray toward it is one sample of that cone, and its shadows' penumbrae are as wide:
+    /// an occluder at distance d blurs over d times this angle, so geometry coarser by less than
+    /// that cannot show in them (the ray's footprint, level_choice.h).
+    virtual float ShadowSpread() const { return 0.f; }
 
   private:
     LightKind kind_;

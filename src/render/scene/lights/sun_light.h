@@ -35,6 +35,8 @@ class SunLight final : public DistantLight {
     SampledSpectrum PhotonPower(const Vec3f& to, float area,
                                 const SampledWavelengths& lambda) const override;
     double Power(const PhotonTarget& target) const override;
+    /// The disc's angular diameter (0.53 degrees from the Earth).
+    float ShadowSpread() const override { return float(2 * radius_rad_); }
 
   private:
     double radius_rad_;
