@@ -145,7 +145,7 @@ void DeriveNormals(const draco::Mesh& dm, const PlainAttribute& positions,
 
 StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid& grid,
                                         const EncodeOptions& options,
-                                        const Bounds3f& complete_within) {
+                                        const Bounds3f& complete_within, uint32_t grid_shift) {
     if (!(grid.step > 0) || !std::isfinite(grid.step) || !IsFinite(grid.origin)) {
         return InvalidArgumentError(
             "invalid grid: origin {}, step {} (the step must be finite and > 0)",
@@ -164,8 +164,16 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
             "normal bits {} (expected 2..30) or uv bits {} (expected 1..30) out of range",
             options.normal_bits, options.uv_bits);
     }
+    if (grid_shift > kMaxMeshGridShift) {
+        return InvalidArgumentError("grid shift {} out of range [0, {}]", grid_shift,
+                                    kMaxMeshGridShift);
+    }
     const size_t vertex_count = mesh.VertexCount();
     const size_t triangle_count = mesh.TriangleCount();
+    // With a shift, every 2^shift-th grid point (indices stay the grid's: a multiple of 2^shift).
+    const int64_t shift_scale = int64_t(1) << grid_shift;
+    GlobalGrid snap_grid = grid;
+    snap_grid.step = grid.step * double(shift_scale);
 
     // 1. Snap every position to the grid.
     constexpr double kLimit = double(std::numeric_limits<int32_t>::max() - 1);
@@ -183,6 +191,19 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
             }
         }
         q[v] = grid.Quantize(p);
+        if (grid_shift > 0) {
+            const Vec3i c = snap_grid.Quantize(p);
+            for (int a = 0; a < 3; ++a) {
+                const int64_t index = int64_t(c[a]) * shift_scale;
+                if (!(std::llabs(index) < int64_t(kLimit))) {
+                    return InvalidArgumentError(
+                        "vertex {} at {} lies outside the grid's int32 range once snapped to "
+                        "every {}th grid point",
+                        v, fmt::streamed(p), shift_scale);
+                }
+                q[v][a] = int32_t(index);
+            }
+        }
     }
 
     // 2. One Draco position value per distinct grid point, so that vertices the input split (for
@@ -333,8 +354,9 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         }
     }
     out.bytes.resize(kMeshPrefixBytes);
-    const int32_t prefix[4] = {base.x, base.y, base.z,
-                               int32_t(out.has_normals ? kMeshFlagShading : 0u)};
+    const uint32_t flags =
+        (out.has_normals ? kMeshFlagShading : 0u) | (grid_shift << kMeshGridShiftBit);
+    const int32_t prefix[4] = {base.x, base.y, base.z, int32_t(flags)};
     std::memcpy(out.bytes.data(), prefix, kMeshPrefixBytes);
 
     size_t encoded_points = 0;  // Draco's count, after its own splits: what decoding gives
@@ -345,7 +367,9 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
         auto pos = NewAttribute(kPositionType, 3, draco::DT_INT32, unique_positions.size());
         for (size_t i = 0; i < unique_positions.size(); ++i) {
             const Vec3i& g = unique_positions[i];
-            const int32_t rel[3] = {g.x - base.x, g.y - base.y, g.z - base.z};
+            // Exact: every index and the base are multiples of 2^grid_shift.
+            const int32_t rel[3] = {(g.x - base.x) >> grid_shift, (g.y - base.y) >> grid_shift,
+                                    (g.z - base.z) >> grid_shift};
             pos->SetAttributeValue(draco::AttributeValueIndex(uint32_t(i)), rel);
         }
         pos->SetExplicitMapping(point_count);
@@ -454,13 +478,19 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
     std::memcpy(prefix, bytes.data(), kMeshPrefixBytes);
     const Vec3i base{prefix[0], prefix[1], prefix[2]};
     const uint32_t flags = uint32_t(prefix[3]);
-    constexpr uint32_t kKnownFlags = kMeshFlagFlatFaces | kMeshFlagShading;
+    constexpr uint32_t kKnownFlags = kMeshFlagFlatFaces | kMeshFlagShading | kMeshGridShiftMask;
     if ((flags & ~kKnownFlags) != 0) {
         return DataLossError(
             "{}: mesh section flags 0x{:x} hold bits this nave does not know (0x{:x})", what, flags,
             flags & ~kKnownFlags);
     }
-    if (flags == kKnownFlags) {
+    const uint32_t grid_shift = (flags & kMeshGridShiftMask) >> kMeshGridShiftBit;
+    if (grid_shift > kMaxMeshGridShift) {
+        return DataLossError("{}: mesh section grid shift {} out of range [0, {}]", what,
+                             grid_shift, kMaxMeshGridShift);
+    }
+    if ((flags & (kMeshFlagFlatFaces | kMeshFlagShading)) ==
+        (kMeshFlagFlatFaces | kMeshFlagShading)) {
         return DataLossError(
             "{}: mesh section flags 0x{:x} mark flat faces in both the 2.0 and the 3.0 way", what,
             flags);
@@ -518,7 +548,7 @@ StatusOr<BrickMesh> DecodeMeshSection(std::string_view bytes, const GlobalGrid& 
         // it is damage (a prefix or a Draco value), not a position.
         int32_t q[3];
         for (int a = 0; a < 3; ++a) {
-            const int64_t sum = int64_t(base[a]) + g[a];
+            const int64_t sum = int64_t(base[a]) + int64_t(g[a]) * (int64_t(1) << grid_shift);
             if (sum < INT32_MIN || sum > INT32_MAX) {
                 return DataLossError(
                     "{}: vertex {} at grid step {} + {} on axis {}: outside the int32 grid", what,

@@ -28,6 +28,14 @@ inline constexpr uint32_t kMeshFlagFlatFaces = 1u;
 /// * 4 + shading (face_shading.h). Unset (and kMeshFlagFlatFaces unset): the attribute is the
 /// material, and the brick has no normals or every face keeps its own.
 inline constexpr uint32_t kMeshFlagShading = 2u;
+/// Mesh section prefix flags, bits 8-12 (format 3.2): the grid shift s. Positions are stored in
+/// units of 2^s grid steps (relative to the base, itself in grid steps): a coarse level snaps to a
+/// coarser grid than its brick, and its positions take fewer bits. 3.1 readers refuse the section
+/// (unknown flag bits) rather than read it at the wrong scale.
+inline constexpr uint32_t kMeshGridShiftBit = 8;
+inline constexpr uint32_t kMeshGridShiftMask = 0x1fu << kMeshGridShiftBit;
+/// Largest grid shift a section may carry (positions on a grid 65 536 steps apart).
+inline constexpr uint32_t kMaxMeshGridShift = 16;
 /// Largest material id a brick can store (shading and smoothing group take four bits of the int32
 /// value).
 inline constexpr uint32_t kMaxMaterialId = (1u << 27) - 1;
@@ -56,11 +64,13 @@ struct EncodedMesh {
 /// Snaps, encodes, then decodes the result once to check it and to learn the decoded counts.
 /// `complete_within` is the box inside which the mesh holds every face around each vertex (a
 /// brick's cell: bricks hold every triangle that overlaps it); only there may normals be derived
-/// (face_shading.h). Thread-safe.
+/// (face_shading.h). With `grid_shift` s > 0 positions snap to every 2^s-th point of `grid`
+/// (kMaxMeshGridShift at most). Thread-safe.
 StatusOr<EncodedMesh> EncodeMeshSection(
     const BrickMesh& mesh, const GlobalGrid& grid, const EncodeOptions& options,
     const Bounds3f& complete_within = Bounds3f(Vec3f(-kInfinity, -kInfinity, -kInfinity),
-                                               Vec3f(kInfinity, kInfinity, kInfinity)));
+                                               Vec3f(kInfinity, kInfinity, kInfinity)),
+    uint32_t grid_shift = 0);
 
 /// Decodes a mesh section. `material_count` bounds the material ids; `what` prefixes every error
 /// ("abbey.nave brick 12 @0x1a2b"). Thread-safe.

@@ -163,7 +163,51 @@ Status ValidateLevelOptions(const LevelOptions& options) {
         return InvalidArgumentError("largest area change {} out of range [0, 1)",
                                     options.max_area_change);
     }
+    if (!(options.max_grid_error_fraction >= 0 && options.max_grid_error_fraction < 1)) {
+        return InvalidArgumentError("largest grid error fraction {} out of range [0, 1)",
+                                    options.max_grid_error_fraction);
+    }
+    if (options.draco_speed < 0 || options.draco_speed > 10) {
+        return InvalidArgumentError("levels' Draco speed {} out of range [0, 10]",
+                                    options.draco_speed);
+    }
     return Status::Ok();
+}
+
+uint32_t LevelGridShift(const BrickMesh& level, float error, const GlobalGrid& grid,
+                        const LevelOptions& options) {
+    constexpr uint32_t kMaxShift = 16;  // codec::kMaxMeshGridShift
+    uint32_t shift = 0;
+    while (shift < kMaxShift &&
+           GridSnapDistance(grid, shift + 1) <= options.max_grid_error_fraction * double(error)) {
+        ++shift;
+    }
+    if (shift == 0 || level.TriangleCount() == 0) return 0;
+    // Each material's area before snapping, then at each candidate shift, coarsest first: a snap
+    // coarser than a part's size collapses it (a stud, a thin moulding) and its light with it.
+    auto material_areas = [&](const std::vector<Vec3f>& positions) {
+        std::vector<double> area;
+        for (size_t t = 0; t < level.TriangleCount(); ++t) {
+            const uint32_t m = level.material_ids[t];
+            if (m >= area.size()) area.resize(size_t(m) + 1, 0.0);
+            area[m] += SurfaceArea(positions, &level.indices[3 * t], 3);
+        }
+        return area;
+    };
+    const std::vector<double> before = material_areas(level.positions);
+    std::vector<Vec3f> snapped(level.positions.size());
+    for (; shift > 0; --shift) {
+        GlobalGrid coarse = grid;
+        coarse.step = grid.step * double(uint64_t(1) << shift);
+        for (size_t v = 0; v < snapped.size(); ++v)
+            snapped[v] = coarse.Dequantize(coarse.Quantize(level.positions[v]));
+        const std::vector<double> after = material_areas(snapped);
+        bool kept = true;
+        for (size_t m = 0; m < before.size() && kept; ++m)
+            kept = !(std::abs(after[m] - before[m]) > 0.5 * options.max_area_change * before[m]);
+        if (kept) return shift;
+    }
+    return 0;
 }
 
 std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options) {

@@ -3,10 +3,13 @@
 // (meshoptimizer), for rays whose footprint is wider than the full mesh's detail (after diffuse
 // bounces). docs/store-format.md, "Levels". No meshoptimizer type leaves brick_levels.cpp.
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "src/core/status.h"
 #include "store/brick_mesh.h"
+#include "store/grid.h"
 
 namespace nave::store {
 
@@ -38,6 +41,16 @@ struct LevelOptions {
     /// level is shaded with its facets' normals (docs/render.md, "Levels of detail"), and normals
     /// it stored would only take room (a third of a level's bytes on the abbey).
     bool keep_normals = false;
+    /// A level's positions snap to a grid coarser than the store's, by a power of two, whose
+    /// largest snapping distance (half a diagonal of its cell) is at most this fraction of the
+    /// level's error, and which changes no material's area by more than half max_area_change
+    /// (LevelGridShift): its positions then take fewer bits (0: the store's grid). The distance
+    /// adds to the level's error.
+    double max_grid_error_fraction = 0.1;
+    /// Draco's encoder speed for levels (0, the smallest, to 10): levels are a tenth of a brick's
+    /// triangles and load once per render when they stay resident, so their size matters more
+    /// than their decoding speed.
+    int draco_speed = 0;
 };
 
 /// One coarser version of a brick's mesh.
@@ -64,5 +77,18 @@ inline constexpr size_t kMinLevelSourceTriangles = 64;
 /// materials, stay where they are, so a level has no hole its brick's full mesh lacks. `full`
 /// must satisfy ValidateBrickMesh; so does every level.
 std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options = {});
+
+/// The grid shift s (EncodeMeshSection) for `level`, whose error is `error`: the largest such that
+/// every 2^s-th point of `grid` lies within options.max_grid_error_fraction * error of any point
+/// (half its cell's diagonal), and that snapping there changes no material's area in the level by
+/// more than half options.max_area_change. 0 when none coarser than the grid qualifies.
+uint32_t LevelGridShift(const BrickMesh& level, float error, const GlobalGrid& grid,
+                        const LevelOptions& options);
+
+/// Half the diagonal of a cell of every 2^shift-th point of `grid`: the farthest a position moves
+/// when snapped there.
+inline double GridSnapDistance(const GlobalGrid& grid, uint32_t shift) {
+    return 0.5 * std::sqrt(3.0) * grid.step * double(uint64_t(1) << shift);
+}
 
 }  // namespace nave::store

@@ -17,7 +17,7 @@ namespace nave::store {
 /// store no normals. 2.0: flat faces marked in the mesh section (no normals, shared corners). 1.1:
 /// material alpha_cutoff.
 inline constexpr uint16_t kFormatMajor = 3;
-inline constexpr uint16_t kFormatMinor = 1;
+inline constexpr uint16_t kFormatMinor = 2;
 /// The oldest major version this nave still reads (1.x stores decode as before).
 inline constexpr uint16_t kOldestReadableMajor = 1;
 

@@ -210,17 +210,21 @@ Status Store::VerifyBrick(uint32_t id) const {
                              fmt::streamed(info.geometry_bounds));
     }
     // A level's vertices are vertices of the brick (edge collapse moves none), snapped to the same
-    // grid: its box lies inside the brick's.
+    // grid or (3.2) a coarser one, which moves them by less than the level's error: its box lies
+    // inside the brick's grown by that error.
     for (uint32_t k = 1; k <= info.levels.size(); ++k) {
         NAVE_ASSIGN_OR_RETURN(BrickMesh level, ReadBrick(id, k));
         Bounds3f level_box;
         for (const Vec3f& p : level.positions) level_box.Extend(p);
-        if (!info.geometry_bounds.Contains(level_box.min) ||
-            !info.geometry_bounds.Contains(level_box.max)) {
+        const float error = info.levels[k - 1].error;
+        const Bounds3f allowed(info.geometry_bounds.min - Vec3f(error, error, error),
+                               info.geometry_bounds.max + Vec3f(error, error, error));
+        if (!allowed.Contains(level_box.min) || !allowed.Contains(level_box.max)) {
             return DataLossError(
-                "{} brick {} level {} @0x{:x}: decoded geometry box {} lies outside the brick's {}",
+                "{} brick {} level {} @0x{:x}: decoded geometry box {} lies outside the brick's {} "
+                "grown by the level's error {}",
                 impl_->name, id, k, info.levels[k - 1].mesh.offset, fmt::streamed(level_box),
-                fmt::streamed(info.geometry_bounds));
+                fmt::streamed(info.geometry_bounds), error);
         }
     }
     return Status::Ok();

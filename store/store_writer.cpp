@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "src/core/file.h"
@@ -115,15 +116,28 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     std::vector<BrickLevel> levels = MakeBrickLevels(*encoded.decoded, options.levels);
     brick.simplify_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EncodeOptions level_options = options;
+    level_options.draco_speed = options.levels.draco_speed;
     for (size_t k = 0; k < levels.size(); ++k) {
-        auto level = codec::EncodeMeshSection(levels[k].mesh, grid, options, cell);
+        const uint32_t shift =
+            LevelGridShift(levels[k].mesh, levels[k].error, grid, options.levels);
+        auto level = codec::EncodeMeshSection(levels[k].mesh, grid, level_options, cell, shift);
         if (!level.ok()) return level.status().WithContext(fmt::format("level {}", k + 1));
         // Every triangle collapsed on the grid: this level and the coarser ones have nothing to
         // show.
         if (level->triangle_count == 0) break;
         EncodedLevel& out = brick.levels.emplace_back();
         out.mesh_bytes = std::move(level->bytes);
-        out.error = levels[k].error;
+        // Snapped to a coarser grid, the level lies that much farther from the full surface.
+        out.error =
+            float(double(levels[k].error) + (shift > 0 ? GridSnapDistance(grid, shift) : 0));
+        // Errors grow from level to level (the reader checks): a finer level's snap may have
+        // raised its error past this one's.
+        if (brick.levels.size() > 1) {
+            const float finer = brick.levels[brick.levels.size() - 2].error;
+            if (!(out.error > finer))
+                out.error = std::nextafter(finer, std::numeric_limits<float>::infinity());
+        }
         out.triangle_count = level->triangle_count;
         out.vertex_count = level->vertex_count;
         out.decoded_bytes = level->decoded_bytes;

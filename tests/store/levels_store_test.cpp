@@ -1,6 +1,7 @@
-// Levels of detail in the store (format 3.1): written and read back with their counts, errors and
-// sections; stores without levels (3.0 and older, or written without) open with none; damage to a
-// level's mesh section or to the levels table is refused naming the brick and the level.
+// Levels of detail in the store (format 3.1, on coarser grids in 3.2): written and read back with
+// their counts, errors and sections; stores without levels (3.0 and older, or written without) open
+// with none; damage to a level's mesh section or to the levels table is refused naming the brick
+// and the level.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,7 @@
 
 #include "src/core/file.h"
 #include "src/core/hash.h"
+#include "store/brick_codec.h"
 #include "store/store_format.h"
 #include "store/store_reader.h"
 #include "store/store_writer.h"
@@ -101,7 +103,7 @@ TEST_F(StoreLevels, RoundTripKeepsCountsErrorsAndSections) {
     ASSERT_TRUE(opened.ok()) << opened.status().ToString();
     const Store& store = **opened;
     EXPECT_EQ(store.header().major, 3);
-    EXPECT_EQ(store.header().minor, 1);
+    EXPECT_EQ(store.header().minor, 2);
     ASSERT_EQ(store.bricks().size(), 4u);
     for (const BrickInfo& b : store.bricks()) {
         SCOPED_TRACE(::testing::Message() << "brick " << b.id);
@@ -147,6 +149,74 @@ TEST_F(StoreLevels, RoundTripKeepsCountsErrorsAndSections) {
         ASSERT_TRUE(full.ok());
         EXPECT_EQ(full->TriangleCount(), b.triangle_count);
     }
+}
+
+// A level snaps to every 2^s-th point of the store's grid (s from its error, as the mesh section's
+// prefix records), which adds the snapping distance to its error and takes fewer bytes than the
+// store's own grid would.
+TEST_F(StoreLevels, LevelsSnapToACoarserGridWithinTheirError) {
+    auto opened = Store::Open(good_);
+    ASSERT_TRUE(opened.ok()) << opened.status().ToString();
+    const Store& store = **opened;
+    EncodeOptions fine = WithLevels();
+    fine.levels.max_grid_error_fraction = 0;
+    int shifted = 0;
+    for (const BrickInfo& b : store.bricks()) {
+        auto on_fine =
+            EncodeBrick(split_.bricks[b.id], store.tree().BrickCells(4)[b.id], grid_, fine);
+        ASSERT_TRUE(on_fine.ok()) << on_fine.status().ToString();
+        ASSERT_EQ(on_fine->levels.size(), b.levels.size());
+        for (uint32_t k = 1; k <= b.levels.size(); ++k) {
+            SCOPED_TRACE(::testing::Message() << "brick " << b.id << " level " << k);
+            const LevelInfo& l = b.levels[k - 1];
+            uint32_t flags = 0;
+            std::memcpy(&flags, &bytes_[l.mesh.offset + 12], 4);
+            const uint32_t shift = (flags & codec::kMeshGridShiftMask) >> codec::kMeshGridShiftBit;
+            const EncodedLevel& f = on_fine->levels[k - 1];
+            if (shift == 0) {
+                EXPECT_EQ(l.mesh.length, f.mesh_bytes.size());
+                continue;
+            }
+            ++shifted;
+            // Within the fraction of the error the options allow, and counted in it.
+            const double snap = GridSnapDistance(grid_, shift);
+            EXPECT_LE(snap, TwoLevels().max_grid_error_fraction * f.error);
+            EXPECT_NEAR(l.error, f.error + snap, 1e-6 * (f.error + snap));
+            EXPECT_LT(l.mesh.length, f.mesh_bytes.size());
+            auto mesh = store.ReadBrick(b.id, k);
+            ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
+            const double spacing = grid_.step * double(1u << shift);
+            for (const Vec3f& p : mesh->positions) {
+                for (int a = 0; a < 3; ++a) {
+                    const double cells = (double(p[a]) - grid_.origin[a]) / spacing;
+                    ASSERT_NEAR(cells, std::round(cells), 1e-3) << "axis " << a;
+                }
+            }
+        }
+    }
+    EXPECT_GT(shifted, 0);
+}
+
+// A grid shift past the largest the format allows is damage, named with the section.
+TEST(LevelGridShift, SectionsWithAnImpossibleShiftAreRefused) {
+    const BrickMesh mesh = testing::MakeSurface({.quads_x = 8, .quads_y = 8});
+    const GlobalGrid grid{{0, 0, 0}, 1e-3};
+    const Bounds3f kEverywhere(Vec3f(-codec::kInfinity, -codec::kInfinity, -codec::kInfinity),
+                               Vec3f(codec::kInfinity, codec::kInfinity, codec::kInfinity));
+    auto encoded = codec::EncodeMeshSection(mesh, grid, EncodeOptions(), kEverywhere, 3);
+    ASSERT_TRUE(encoded.ok()) << encoded.status().ToString();
+    auto decoded = codec::DecodeMeshSection(encoded->bytes, grid, 3, "test level");
+    ASSERT_TRUE(decoded.ok()) << decoded.status().ToString();
+    std::string bytes = encoded->bytes;
+    uint32_t flags = 0;
+    std::memcpy(&flags, &bytes[12], 4);
+    flags = (flags & ~codec::kMeshGridShiftMask) | (31u << codec::kMeshGridShiftBit);
+    std::memcpy(&bytes[12], &flags, 4);
+    ExpectError(codec::DecodeMeshSection(bytes, grid, 3, "test level").status(),
+                StatusCode::kDataLoss, {"test level", "grid shift 31", "[0, 16]"});
+    EXPECT_EQ(
+        codec::EncodeMeshSection(mesh, grid, EncodeOptions(), kEverywhere, 17).status().code(),
+        StatusCode::kInvalidArgument);
 }
 
 TEST_F(StoreLevels, LevelPastTheLastIsNotFoundNamingIt) {
