@@ -36,6 +36,15 @@ endforeach()
 list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
 find_package(OpenVDB QUIET)
 
+# MPI (Open MPI in Debian: libopenmpi-dev, openmpi-bin): the distributed render. Optional: without it
+# nave is one process (docs/distributed.md).
+find_package(MPI COMPONENTS CXX QUIET)
+if(MPI_CXX_FOUND)
+  message(STATUS "nave: MPI ${MPI_CXX_VERSION} found: building the distributed render")
+else()
+  message(STATUS "nave: MPI not found: nave renders as one process")
+endif()
+
 if(NAVE_BUILD_TESTS)
   find_package(GTest REQUIRED)
   include(GoogleTest)

@@ -22,6 +22,7 @@ packages=(
   libspdlog-dev libfmt-dev # logging and formatting
   libtinygltf-dev          # glTF 2.0 / GLB import
   libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS...)
+  libopenmpi-dev openmpi-bin  # Open MPI: the distributed render under mpirun (docs/distributed.md)
 )
 
 # Other scripts pass their own list (bench/setup-bench.sh): install those instead.

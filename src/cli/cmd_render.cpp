@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "src/cli/commands.h"
+#include "src/cli/distributed.h"
 #include "src/cli/interrupt.h"
 #include "src/cli/render_checkpoint.h"
 #include "src/core/file.h"
@@ -270,10 +271,32 @@ void PrintSummary(const RenderOptions& o, const std::filesystem::path& out,
     std::fputs(text.c_str(), stderr);
 }
 
+/// What a distributed render does not do yet (docs/distributed.md): refused before anything is
+/// read, so that no rank waits for another that stopped.
+Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& config) {
+    const char* missing = nullptr;
+    if (config.render.mode == render::RenderSettings::Mode::kPhoton) {
+        missing = "photon mode (--mode photon)";
+    } else if (config.render.noise_target > 0 || config.render.time_limit_s > 0) {
+        missing = "a noise target or a time limit (--noise, --time-limit)";
+    } else if (!o.checkpoint.checkpoint.empty() || !o.checkpoint.resume.empty()) {
+        missing = "checkpoints (--checkpoint, --resume)";
+    } else if (!o.trace.empty()) {
+        missing = "--trace";
+    }
+    if (missing == nullptr) return Status::Ok();
+    return InvalidArgumentError(
+        "under mpirun nave renders in path mode to a fixed number of samples; {} is not "
+        "distributed yet: run it as one process",
+        missing);
+}
+
 Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(CheckOptions(o));
     const std::filesystem::path out = o.output;
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, BuildConfig(o));
+    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks, JoinRanks());
+    if (ranks != nullptr) NAVE_RETURN_IF_ERROR(CheckDistributed(o, config));
     std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
@@ -312,13 +335,15 @@ Status RunRender(const RenderOptions& o) {
     render::Film film(config.camera.width, config.camera.height, scene.output);
     render::RenderStats stats;
     NAVE_RETURN_IF_ERROR(
-        render::RenderStreams(scene, &film, &stats, {}, &pager, &session->options));
+        render::RenderStreams(scene, &film, &stats, {}, &pager, &session->options, ranks));
     NAVE_RETURN_IF_ERROR(CheckNotInterrupted(*session, scene.settings, stats, out));
     // Free the bricks and the queues' pages before the image writer loads OpenImageIO (~120 MiB),
     // so that the two never add up (the allocator keeps freed pages a while otherwise).
     for (uint32_t b = 0; b < source.slot_count(); ++b) source.Evict(b);
     ReturnFreeMemory();
 
+    // Every rank holds the whole image (RenderStreams sums the films); rank 0 writes it.
+    if (ranks != nullptr && ranks->rank() != 0) return Status::Ok();
     render::RenderSummary summary(scene.settings, stats, TextureFacts(textures.get()));
     NAVE_RETURN_IF_ERROR(WriteImage(o, model, out, scene, film, summary));
     if (trace) NAVE_RETURN_IF_ERROR(trace->Write(o.trace).WithContext("--trace"));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "src/cli/commands.h"
+#include "src/cli/distributed.h"
 #include "src/core/log.h"
 #include "src/core/progress.h"
 
@@ -89,7 +90,11 @@ int main(int argc, char** argv) {
     if (!run) return 0;
     nave::Status status = run();
     if (!status.ok()) {
-        std::fprintf(stderr, "nave: error: %s\n", status.ToString().c_str());
+        const std::string rank = nave::cli::RankName();
+        std::fprintf(stderr, "nave: error%s: %s\n", rank.empty() ? "" : (" on " + rank).c_str(),
+                     status.ToString().c_str());
+        // The other ranks of a distributed render may be waiting for this one: end them all.
+        nave::cli::EndAllRanksAfterError(ExitCodeFor(status));
         return ExitCodeFor(status);
     }
     return 0;

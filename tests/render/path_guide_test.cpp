@@ -8,11 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <barrier>
 #include <cmath>
 #include <memory>
 #include <numeric>
 #include <random>
+#include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "render_test_util.h"
@@ -135,6 +138,56 @@ TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
         const Vec3f w = UniformDirection(rng);
         ASSERT_EQ(a.Pdf(p, kSide, w), b.Pdf(p, kSide, w));  // bit for bit
     }
+}
+
+// Two processes of a distributed render, each crediting half the paths, share their credits
+// before each update: both end with the guide one process crediting every path has, bit for bit,
+// over several updates (each shares only what was credited since the last).
+TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
+    std::mt19937 rng(11);
+    PathGuide one(kBox, 4, 16, 1.0), a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
+    // The sum over the two "processes": each thread offers its values and waits for the other's.
+    std::barrier meet(2);
+    std::vector<uint64_t> offered[2];
+    auto sum_over = [&](int me) {
+        return [&, me](std::span<uint64_t> values) {
+            offered[me].assign(values.begin(), values.end());
+            meet.arrive_and_wait();
+            const std::vector<uint64_t>& other = offered[1 - me];
+            if (other.size() != values.size()) return InternalError("sizes differ");
+            for (size_t i = 0; i < values.size(); ++i) values[i] += other[i];
+            meet.arrive_and_wait();  // both have read before either offers again
+            return Status::Ok();
+        };
+    };
+    const Vec3f points[2] = {Vec3f(3.5f, 0.5f, 2.5f), Vec3f(0.5f, 3.5f, 1.0f)};
+    for (int pass = 0; pass < 3; ++pass) {
+        for (int i = 0; i < 4000; ++i) {
+            const Vec3f p = points[i % 2];
+            const Vec3f w = UniformDirection(rng);
+            const double v = std::exp(std::uniform_real_distribution<double>(-6, 2)(rng));
+            one.Credit(one.CreditKey(p, kSide, w), v);
+            PathGuide& half = (i / 7) % 2 == 0 ? a : b;
+            half.Credit(half.CreditKey(p, kSide, w), v);
+        }
+        Status shared[2];
+        std::thread other([&] { shared[1] = b.ShareCredits(sum_over(1)); });
+        shared[0] = a.ShareCredits(sum_over(0));
+        other.join();
+        ASSERT_TRUE(shared[0].ok() && shared[1].ok())
+            << shared[0].ToString() << shared[1].ToString();
+        one.Update();
+        a.Update();
+        b.Update();
+        ByteWriter state_one, state_a, state_b;
+        one.SaveState(&state_one);
+        a.SaveState(&state_a);
+        b.SaveState(&state_b);
+        const std::string bytes = state_one.Take();
+        EXPECT_EQ(state_a.Take(), bytes) << "pass " << pass;
+        EXPECT_EQ(state_b.Take(), bytes) << "pass " << pass;
+    }
+    EXPECT_TRUE(one.Guides(points[0], kSide));
 }
 
 TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {

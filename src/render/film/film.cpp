@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <span>
 
 #include "src/core/atomic_add.h"
 #include "src/core/byte_stream.h"
@@ -136,7 +138,31 @@ Status GetAtomics(ByteReader* in, std::atomic<T>* values, size_t count, std::str
     return Status::Ok();
 }
 
+// Replaces `count` atomics by what `sum` makes of their values (their sums over the films of a
+// distributed render).
+template <typename T>
+Status SumAtomics(std::atomic<T>* values, size_t count,
+                  const std::function<Status(std::span<T>)>& sum) {
+    std::vector<T> plain(count);
+    for (size_t i = 0; i < count; ++i) plain[i] = values[i].load(std::memory_order_relaxed);
+    NAVE_RETURN_IF_ERROR(sum(plain));
+    for (size_t i = 0; i < count; ++i) values[i].store(plain[i], std::memory_order_relaxed);
+    return Status::Ok();
+}
+
 }  // namespace
+
+Status Film::CombineSums(const std::function<Status(std::span<double>)>& sum_doubles,
+                         const std::function<Status(std::span<float>)>& sum_floats,
+                         const std::function<Status(std::span<uint32_t>)>& sum_counts) {
+    NAVE_RETURN_IF_ERROR(SumAtomics(xyz_.get(), pixel_count() * 3, sum_doubles));
+    NAVE_RETURN_IF_ERROR(SumAtomics(y_half_.get(), pixel_count() * 2, sum_doubles));
+    if (aov_) {
+        NAVE_RETURN_IF_ERROR(SumAtomics(aov_.get(), pixel_count() * 7, sum_floats));
+        NAVE_RETURN_IF_ERROR(SumAtomics(aov_count_.get(), pixel_count(), sum_counts));
+    }
+    return Status::Ok();
+}
 
 void Film::SaveState(ByteWriter* out) const {
     out->Reserve(StateBytes(width_, height_, aov_ != nullptr));

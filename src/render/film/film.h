@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,6 +96,12 @@ class Film {
     /// Replaces the sums with those SaveState wrote. Errors: DataLoss for a film of another size
     /// or other channels, or truncated bytes. Not concurrent with adds.
     Status LoadState(ByteReader* in);
+    /// Combines this film with the films of the other processes of a distributed render: each
+    /// buffer of sums is replaced by what the given function makes of it (the sum over the
+    /// processes, in every one). Errors: the functions'. Not concurrent with adds.
+    Status CombineSums(const std::function<Status(std::span<double>)>& sum_doubles,
+                       const std::function<Status(std::span<float>)>& sum_floats,
+                       const std::function<Status(std::span<uint32_t>)>& sum_counts);
     /// Linear RGB of the output space (sRGB primaries) after white balance, per pixel.
     std::vector<float> LinearRgb() const;
 

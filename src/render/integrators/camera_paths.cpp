@@ -56,6 +56,8 @@ void CameraPaths::GenerateCameraChunk(uint64_t first, uint64_t last, uint32_t sa
             r.t_max = kInfinity;
             // A pinhole's cone: no width at the camera, one pixel's angle of spread.
             r.cone_spread = camera.PixelSpreadAngle();
+            // In a distributed render the process owning the ray's first brick makes it.
+            if (!scheduler_.MakesHere(r, p)) continue;
             Spawn(r, store::kNoBrick, nullptr, out);
         }
         scheduler_.Flush(out);

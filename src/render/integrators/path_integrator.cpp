@@ -99,6 +99,11 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
         }));
     if (update || boundaries) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
     if (update) {
+        if (RankGroup* ranks = scheduler_.ranks()) {
+            // Each process credited the paths it traced: all of them learn from all.
+            NAVE_RETURN_IF_ERROR(owned_guide_->ShareCredits(
+                [&](std::span<uint64_t> values) { return ranks->SumEverywhere(values); }));
+        }
         owned_guide_->Update();
         log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
                    owned_guide_->cells_used(), owned_guide_->cells_guiding());

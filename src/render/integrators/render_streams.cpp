@@ -20,7 +20,7 @@ namespace {
 /// ends the render or the session ends this run, then has it complete the film and fill `stats`:
 /// the part every mode shares (resume, progress, the stopping rule, checkpoints).
 Status RenderRounds(const RenderSettings& settings, Integrator& integrator, RenderSession& session,
-                    RenderStats* stats) {
+                    Film* film, RankGroup* ranks, RenderStats* stats) {
     const int start = session.start();
     NAVE_RETURN_IF_ERROR(session.RestoreFilm());
     if (session.resume() != nullptr) NAVE_RETURN_IF_ERROR(integrator.Restore(session));
@@ -48,6 +48,14 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
         if (enough || end_run) break;
     }
     NAVE_RETURN_IF_ERROR(integrator.Finish(done, stats));
+    if (ranks != nullptr) {
+        // Each process's film holds the samples it traced: the image is their sum, in every one.
+        NAVE_RETURN_IF_ERROR(
+            film->CombineSums([&](std::span<double> v) { return ranks->SumEverywhere(v); },
+                              [&](std::span<float> v) { return ranks->SumEverywhere(v); },
+                              [&](std::span<uint32_t> v) { return ranks->SumEverywhere(v); }));
+        stats->noise_relmse = integrator.NoiseEstimate(done);
+    }
     progress.Finish();
     return Status::Ok();
 }
@@ -55,7 +63,8 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
 }  // namespace
 
 Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, BrickPicker picker,
-                     const PagerOptions* paging, const SessionOptions* session_options) {
+                     const PagerOptions* paging, const SessionOptions* session_options,
+                     RankGroup* ranks) {
     NAVE_CHECK(film->width() == scene.camera->width() && film->height() == scene.camera->height());
     int threads = scene.settings.threads > 0 ? scene.settings.threads
                                              : tbb::this_task_arena::max_concurrency();
@@ -67,16 +76,18 @@ Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, B
             NAVE_ASSIGN_OR_RETURN(
                 std::unique_ptr<StreamScheduler> scheduler,
                 StreamScheduler::Create(*scene.source, paging != nullptr ? *paging : PagerOptions(),
-                                        std::move(picker), scene.settings.wave_paths));
+                                        std::move(picker), scene.settings.wave_paths, ranks));
             RenderSession session(session_options, film);
             const auto start = std::chrono::steady_clock::now();
             const BrickSourceStats before = scene.source->stats();
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<Integrator> integrator,
                                   Integrator::Create(scene, film, *scheduler));
-            NAVE_RETURN_IF_ERROR(RenderRounds(scene.settings, *integrator, session, stats));
+            NAVE_RETURN_IF_ERROR(
+                RenderRounds(scene.settings, *integrator, session, film, ranks, stats));
             stats->wall_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             scheduler->FillStats(before, stats);
+            NAVE_RETURN_IF_ERROR(scheduler->SumStatsOverRanks(stats));
             stats->peak_rss_bytes = PeakRssBytes();
             return Status::Ok();
         }();

@@ -20,6 +20,7 @@
 #include "src/render/scene/scene.h"
 #include "src/render/stream/brick_picker.h"
 #include "src/render/stream/pager.h"
+#include "src/render/stream/ray_exchange.h"
 
 namespace nave::render {
 
@@ -32,8 +33,11 @@ namespace nave::render {
 /// are paged under paging->brick_budget_bytes (pager.h; kUnlimitedBrickBudget is in-core), and an
 /// impossible budget is refused before anything is traced. `session` (null: one run from the start)
 /// continues from a checkpoint, writes checkpoints and may end the run early (render_session.h).
+/// `ranks` (null: one process) renders as one of the processes of a distributed render
+/// (docs/distributed.md): this one traces the rays of its bricks, and every process ends with the
+/// whole image in `film`.
 Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats,
                      BrickPicker picker = {}, const PagerOptions* paging = nullptr,
-                     const SessionOptions* session = nullptr);
+                     const SessionOptions* session = nullptr, RankGroup* ranks = nullptr);
 
 }  // namespace nave::render

@@ -84,6 +84,15 @@ RenderSummary::RenderSummary(const RenderSettings& settings, const RenderStats& 
     Add(kStats, "spill_bytes_written", Unit::kBytes, stats.spill_bytes_written);
     Add(kStats, "memory_returns", Unit::kCount, r.memory_returns);
     AddReal(kStats, "noise_relmse", Unit::kRatio, stats.noise_relmse);
+    ranks_ = stats.ranks;
+    if (stats.ranks > 1) {
+        Add(kStats, "ranks", Unit::kCount, uint64_t(stats.ranks));
+        Add(kStats, "rays_between_ranks", Unit::kCount, stats.exchange.records_sent);
+        Add(kStats, "messages_between_ranks", Unit::kCount, stats.exchange.messages_sent);
+        Add(kStats, "bytes_between_ranks", Unit::kBytes, stats.exchange.bytes_sent);
+        AddReal(kStats, "ranks_idle", Unit::kSeconds, stats.exchange.idle_seconds);
+        Add(kTerminalOnly, "termination_rounds", Unit::kCount, stats.exchange.termination_rounds);
+    }
 
     // The terminal's own: rates, and counts the metadata leaves to the settings or leaves out.
     const double secs = std::max(1e-9, stats.wall_seconds);
@@ -197,6 +206,14 @@ std::vector<std::string> RenderSummary::TerminalLines(const std::string& memory_
         stat("brick_moves"), stat("batches"), stat("brick_loads"), stat("bytes_read"),
         own("process_peak_rss"), Integer("process_peak_rss"), own("peak_queue_bytes")));
     lines.push_back(NoiseLine());
+    if (ranks_ > 1) {
+        lines.push_back(fmt::format(
+            "ranks {}: {} rays sent between them in {} messages ({}), idle {} in all, {} rounds "
+            "to find the ends of drains; the counts above are all ranks', the bricks below rank "
+            "0's",
+            stat("ranks"), stat("rays_between_ranks"), stat("messages_between_ranks"),
+            stat("bytes_between_ranks"), stat("ranks_idle"), own("termination_rounds")));
+    }
 
     const RenderFact& budget = Get(kStatisticsAttribute, "brick_budget");
     const RenderFact& peak = Get(kStatisticsAttribute, "peak_brick_bytes");

@@ -92,6 +92,7 @@ class RenderSummary {
 
     RenderSettings settings_;
     bool has_textures_ = false;
+    int ranks_ = 1;  // processes of a distributed render
     std::vector<RenderFact> facts_;
 };
 

@@ -7,12 +7,28 @@
 // that forwards the rays of the bricks owned elsewhere to their owner.
 
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <vector>
 
+#include "src/core/status.h"
 #include "src/render/stream/ray.h"
 #include "src/render/stream/ray_queue.h"
 
 namespace nave::render {
+
+/// What the exchange of a distributed render did: one process's, or (TotalCounts) every one's
+/// summed.
+struct ExchangeCounts {
+    uint64_t records_sent = 0;      ///< rays sent to other processes
+    uint64_t records_received = 0;  ///< rays received from other processes and queued here
+    uint64_t messages_sent = 0;
+    uint64_t messages_received = 0;
+    uint64_t bytes_sent = 0;
+    uint64_t bytes_received = 0;
+    uint64_t termination_rounds = 0;  ///< rounds of the sum that detects the end of a drain
+    double idle_seconds = 0;          ///< time waiting for rays with none to trace
+};
 
 /// Delivers rays to the owner of the brick their next segment lies in.
 class RayExchange {
@@ -22,6 +38,36 @@ class RayExchange {
     /// are copied: the caller may reuse the span's storage after the call. Thread-safe: every
     /// worker flushing its outbox calls it.
     virtual void Send(uint32_t brick, std::span<const RayRecord> rays) = 0;
+    /// Whether this process owns brick `brick` (traces its rays).
+    virtual bool Owns(uint32_t brick) const = 0;
+    /// Delivers the rays that have arrived from elsewhere to their queues; called between batches.
+    virtual Status Progress() { return Status::Ok(); }
+    /// For a process whose queues are empty: waits until rays arrive (false) or no process has a
+    /// ray left or in flight (true, in every process at once). One process: true at once.
+    virtual StatusOr<bool> WaitForRaysOrEnd() { return true; }
+    /// Every process's counts summed, and the closing check: every ray sent was received
+    /// (kInternal naming both sums otherwise). Collective, after the last drain. One process:
+    /// nothing sent.
+    virtual StatusOr<ExchangeCounts> TotalCounts() const { return ExchangeCounts{}; }
+};
+
+/// The processes of a distributed render as the renderer sees them (docs/distributed.md): their
+/// number, this one's rank, an exchange of rays among them and sums over them. Implemented over MPI
+/// (mpi_rank_group.h) where nave is built with it. Every method but rank and size is collective:
+/// every process calls it, in the same order.
+class RankGroup {
+  public:
+    virtual ~RankGroup() = default;
+    virtual int rank() const = 0;
+    virtual int size() const = 0;
+    /// The exchange for `queues` (which must outlive it), brick slot s owned by rank owners[s].
+    virtual StatusOr<std::unique_ptr<RayExchange>> MakeExchange(std::vector<int> owners,
+                                                                BrickQueues<RayRecord>& queues) = 0;
+    /// Replaces `values` by their sums over the processes, in every process.
+    virtual Status SumEverywhere(std::span<double> values) = 0;
+    virtual Status SumEverywhere(std::span<float> values) = 0;
+    virtual Status SumEverywhere(std::span<uint32_t> values) = 0;
+    virtual Status SumEverywhere(std::span<uint64_t> values) = 0;
 };
 
 /// The exchange of a single process: it owns every brick, and rays sent to a brick wait in its
@@ -34,6 +80,7 @@ class LocalRayExchange final : public RayExchange {
     void Send(uint32_t brick, std::span<const RayRecord> rays) override {
         queues_.Push(brick, rays.data(), rays.size());
     }
+    bool Owns(uint32_t) const override { return true; }
 
   private:
     BrickQueues<RayRecord>& queues_;

@@ -9,6 +9,7 @@
 #include "src/core/progress.h"
 #include "src/core/trace.h"
 #include "src/render/bricks/brick_walk.h"
+#include "src/render/stream/brick_owners.h"
 #include "src/render/stream/level_choice.h"
 #include "src/render/stream/memory_plan.h"
 
@@ -20,12 +21,14 @@ constexpr size_t kChunk = 256;
 
 }  // namespace
 
-StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths)
+StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths,
+                                 RankGroup* ranks)
     : source_(source),
       tree_(source.tree()),
       picker_(std::move(picker)),
       wave_paths_(wave_paths),
       queues_(source.slot_count()),
+      ranks_(ranks),
       max_batch_(MaxBatchRays(0)) {}
 
 StreamScheduler::~StreamScheduler() {
@@ -37,11 +40,26 @@ StreamScheduler::~StreamScheduler() {
 StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& source,
                                                                    const PagerOptions& paging,
                                                                    BrickPicker picker,
-                                                                   uint64_t wave_paths) {
+                                                                   uint64_t wave_paths,
+                                                                   RankGroup* ranks) {
     std::unique_ptr<StreamScheduler> scheduler(
-        new StreamScheduler(source, std::move(picker), wave_paths));
+        new StreamScheduler(source, std::move(picker), wave_paths, ranks));
+    if (ranks != nullptr) {
+        NAVE_ASSIGN_OR_RETURN(
+            scheduler->distributed_exchange_,
+            ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
+        scheduler->exchange_ = scheduler->distributed_exchange_.get();
+    }
     NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
     return scheduler;
+}
+
+bool StreamScheduler::MakesHere(RayRecord r, uint64_t index) const {
+    if (ranks_ == nullptr) return true;
+    const uint32_t first = Route(r, 0, store::kNoBrick);
+    if (first == store::kNoBrick)
+        return index % uint64_t(ranks_->size()) == uint64_t(ranks_->rank());
+    return exchange_->Owns(first);
 }
 
 Status StreamScheduler::StartPaging(const PagerOptions& paging) {
@@ -138,7 +156,7 @@ void StreamScheduler::Flush(RayOutbox& out) {
         size_t j = i;
         group.clear();
         while (j < rays.size() && rays[j].first == rays[i].first) group.push_back(rays[j++].second);
-        exchange_.Send(rays[i].first, group);
+        exchange_->Send(rays[i].first, group);
         i = j;
     }
     rays.clear();
@@ -157,7 +175,14 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         size_t total = 0;
         for (uint32_t i = 0; i < queues_.brick_count(); ++i)
             total += waiting[i] = queues_.Waiting(i);
-        if (total <= stop_below) break;
+        if (total <= stop_below) {
+            // A complete drain ends when no process has a ray left (one process: now); a partial
+            // one when this process has few left, the others' rays still arriving meanwhile.
+            if (stop_below > 0 || total > 0) break;
+            NAVE_ASSIGN_OR_RETURN(const bool end, exchange_->WaitForRaysOrEnd());
+            if (end) break;
+            continue;
+        }
         if (trace_ != nullptr) {
             trace_->Counter("rays waiting", {{"rays", total}});
             trace_->Counter("memory", {{"resident_bricks", source_.stats().resident_bytes},
@@ -191,6 +216,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
             });
         handle.Reset();
         pager_->BatchDone();
+        NAVE_RETURN_IF_ERROR(exchange_->Progress());
     }
     return Status::Ok();
 }
@@ -253,6 +279,24 @@ Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
 size_t StreamScheduler::WaveOverlap() const {
     if (pager_->options().in_core()) return 0;
     return size_t(pager_->options().wave_overlap * double(wave_paths_));
+}
+
+Status StreamScheduler::SumStatsOverRanks(StreamStats* stats) const {
+    if (ranks_ == nullptr) return Status::Ok();
+    uint64_t counts[] = {stats->rays,        stats->segments_traced, stats->shadow_segments,
+                         stats->brick_moves, stats->batches,         stats->bytes_read,
+                         stats->spilled_rays};
+    NAVE_RETURN_IF_ERROR(ranks_->SumEverywhere(counts));
+    stats->rays = counts[0];
+    stats->segments_traced = counts[1];
+    stats->shadow_segments = counts[2];
+    stats->brick_moves = counts[3];
+    stats->batches = counts[4];
+    stats->bytes_read = counts[5];
+    stats->spilled_rays = counts[6];
+    stats->ranks = ranks_->size();
+    NAVE_ASSIGN_OR_RETURN(stats->exchange, exchange_->TotalCounts());
+    return Status::Ok();
 }
 
 void StreamScheduler::FillStats(const BrickSourceStats& before, StreamStats* stats) const {

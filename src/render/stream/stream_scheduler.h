@@ -86,10 +86,14 @@ class StreamScheduler {
     /// workers trace). `picker` empty: the pager's choice. `wave_paths`: camera paths (or photons)
     /// per wave, the unit of WaveOverlap. Errors: an impossible budget (the pager's
     /// ResourceExhausted error), spill files that cannot be made.
+    /// `ranks` (null: one process) shares the bricks among the processes of a distributed render
+    /// (BrickOwners): this scheduler traces the rays of its own bricks and sends the others'
+    /// through the group's exchange; it must outlive the scheduler.
     static StatusOr<std::unique_ptr<StreamScheduler>> Create(BrickSource& source,
                                                              const PagerOptions& paging,
                                                              BrickPicker picker,
-                                                             uint64_t wave_paths);
+                                                             uint64_t wave_paths,
+                                                             RankGroup* ranks = nullptr);
     ~StreamScheduler();
     StreamScheduler(const StreamScheduler&) = delete;
     StreamScheduler& operator=(const StreamScheduler&) = delete;
@@ -107,6 +111,13 @@ class StreamScheduler {
     /// at the level of detail r's footprint there chooses (level_choice.h), or store::kNoBrick
     /// (the ray leaves the model, or reaches t_max, first). `current` is a slot.
     uint32_t Route(RayRecord& r, float from_t, uint32_t current) const;
+    /// Whether this process makes ray `r`, one of the rays made outside a batch (a camera ray or
+    /// a photon, `index` its pixel or photon): every process makes them all in the same way and
+    /// keeps those whose first brick it owns, and of those that meet no brick, every size-th
+    /// index. One process: always.
+    bool MakesHere(RayRecord r, uint64_t index) const;
+    /// The processes of a distributed render (null: one process).
+    RankGroup* ranks() const { return ranks_; }
     /// Sends the rays of `out` to the exchange, grouped by brick, adds its counts to the render's
     /// and empties it.
     void Flush(RayOutbox& out);
@@ -137,6 +148,10 @@ class StreamScheduler {
     /// Fills `stats` (rays, segments, brick moves, batches, bytes read, residency, peak queue
     /// bytes, brick cache, spilling). `before`: the source's counters when the render started.
     void FillStats(const BrickSourceStats& before, StreamStats* stats) const;
+    /// In a distributed render, after FillStats: sums the counts of `stats` over the processes
+    /// (residency stays this process's) and adds the exchange's, checking that every ray sent
+    /// was received. Collective. One process: nothing to do.
+    Status SumStatsOverRanks(StreamStats* stats) const;
 
     /// The bricks the rays are scheduled over (slots: bricks at their levels of detail).
     const BrickSource& source() const { return source_; }
@@ -144,7 +159,7 @@ class StreamScheduler {
     const store::BrickTree& tree() const { return tree_; }
 
   private:
-    StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths);
+    StreamScheduler(BrickSource& source, BrickPicker picker, uint64_t wave_paths, RankGroup* ranks);
     /// Sets the source up for `paging` (BVH settings, decode limit, brick cache), makes the queues'
     /// spill file and starts the pager.
     Status StartPaging(const PagerOptions& paging);
@@ -159,7 +174,9 @@ class StreamScheduler {
     const uint64_t wave_paths_;
     BrickQueues<RayRecord> queues_;
     LocalRayExchange local_exchange_{queues_};
-    RayExchange& exchange_ = local_exchange_;  // every ray leaving a batch goes through here
+    RankGroup* const ranks_;
+    std::unique_ptr<RayExchange> distributed_exchange_;  // with ranks_: the group's
+    RayExchange* exchange_ = &local_exchange_;  // every ray leaving a batch goes through here
 
     // Under a budget: queue blocks spilled to disk beyond queue_memory_ (null: none).
     std::unique_ptr<store::SpillFile> queue_spill_;

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "src/render/stream/pager.h"
+#include "src/render/stream/ray_exchange.h"
 
 namespace nave::render {
 
@@ -32,6 +33,10 @@ struct StreamStats {
     uint64_t spilled_rays = 0;
     uint64_t spill_bytes_written = 0;
     uint64_t spill_peak_disk_bytes = 0;
+    // A distributed render (docs/distributed.md): its processes, and what their exchange did,
+    // summed over them (the counts above are summed too; residency is this process's).
+    int ranks = 1;
+    ExchangeCounts exchange;
 };
 
 }  // namespace nave::render

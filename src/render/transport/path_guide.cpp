@@ -183,6 +183,36 @@ void PathGuide::Update(uint32_t min_credits) {
     }
 }
 
+Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>& sum) {
+    // Everything credited, flattened: the levels' counts, then each cell's bins and credit count.
+    // Cells only ever join at the end (Update), so earlier entries keep their place.
+    size_t size = 0;
+    for (const Level& level : levels_) size += level.size;
+    size += cells_.size() * (kBins + 1);
+    std::vector<uint64_t> values(size);
+    size_t at = 0;
+    for (const Level& level : levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.count[i];
+    }
+    for (const std::unique_ptr<Cell>& cell : cells_) {
+        for (int b = 0; b < kBins; ++b) values[at++] = cell->sum[b];
+        values[at++] = cell->credits;
+    }
+    shared_.resize(size, 0);  // new cells: nothing shared yet
+    for (size_t i = 0; i < size; ++i) values[i] -= shared_[i];
+    NAVE_RETURN_IF_ERROR(sum(values));
+    for (size_t i = 0; i < size; ++i) shared_[i] += values[i];
+    at = 0;
+    for (Level& level : levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) level.count[i] = uint32_t(shared_[at++]);
+    }
+    for (const std::unique_ptr<Cell>& cell : cells_) {
+        for (int b = 0; b < kBins; ++b) cell->sum[b] = shared_[at++];
+        cell->credits = uint32_t(shared_[at++]);
+    }
+    return Status::Ok();
+}
+
 void PathGuide::SaveState(ByteWriter* out) const {
     for (const Level& level : levels_) {
         out->PutArray(level.slot.get(), level.size);

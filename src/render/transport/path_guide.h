@@ -14,8 +14,10 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "src/core/byte_stream.h"
@@ -106,6 +108,13 @@ class PathGuide {
     /// The solid-angle pdf of Sample at `p`, `side` for direction `w` (0 if no cell there guides).
     float Pdf(const Vec3f& p, int side, const Vec3f& w) const;
 
+    /// In a distributed render (docs/distributed.md), before each Update: gives every process's
+    /// guide the credits of all. `sum` replaces its values by their sums over the processes; each
+    /// process passes what it credited since the last call, so every guide ends with the same
+    /// credits, those one process would have (they are integers: the order of sums does not
+    /// matter), and the same Update. Collective; not concurrent with Credit, Sample or Pdf.
+    Status ShareCredits(const std::function<Status(std::span<uint64_t>)>& sum);
+
     /// Appends everything learned (credits, counts, cells and their distributions) to `out`, for
     /// a checkpoint; LoadState into a guide made with the same arguments restores it exactly (the
     /// credits are integers). Not concurrent with Credit or Update.
@@ -146,6 +155,9 @@ class PathGuide {
     Level levels_[kLevels];  // coarse to fine
     std::vector<std::unique_ptr<Cell>> cells_;
     uint32_t cells_guiding_ = 0;
+    // The credits as of the last ShareCredits (every count, then every cell's sums and credits),
+    // all processes' together: what this process credited since is its values minus these.
+    std::vector<uint64_t> shared_;
 };
 
 /// A path vertex's continuation: its BSDF, mixed with the guide's distribution where the guide's

@@ -1,0 +1,39 @@
+#include "src/render/stream/brick_owners.h"
+
+#include <algorithm>
+
+namespace nave::render {
+
+std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
+    // Leaves in depth-first order: each run of them is a subtree or a few neighbouring ones.
+    std::vector<uint32_t> order;
+    const auto& nodes = source.tree().nodes();
+    std::vector<uint32_t> stack;
+    if (!nodes.empty()) stack.push_back(0);
+    while (!stack.empty()) {
+        const store::BrickTreeNode& node = nodes[stack.back()];
+        stack.pop_back();
+        if (node.IsLeaf()) {
+            if (node.brick < source.brick_count()) order.push_back(node.brick);
+            continue;
+        }
+        stack.push_back(node.child[1]);
+        stack.push_back(node.child[0]);
+    }
+    std::vector<double> weight(source.brick_count(), 0.0);
+    double total = 0;
+    for (uint32_t b : order) total += weight[b] = double(source.EstimatedResidentBytes(b)) + 1.0;
+    std::vector<int> brick_owner(source.brick_count(), 0);
+    double before = 0;
+    for (uint32_t b : order) {
+        // The rank whose share holds the middle of the brick's weight.
+        const double middle = (before + 0.5 * weight[b]) / total;
+        brick_owner[b] = std::clamp(int(middle * ranks), 0, ranks - 1);
+        before += weight[b];
+    }
+    std::vector<int> owners(source.slot_count());
+    for (uint32_t s = 0; s < owners.size(); ++s) owners[s] = brick_owner[source.BrickOfSlot(s)];
+    return owners;
+}
+
+}  // namespace nave::render

@@ -1,0 +1,337 @@
+#include "src/render/stream/mpi_ray_exchange.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "src/render/stream/ray_message.h"
+
+namespace nave::render {
+
+namespace {
+
+// The tag of ray messages on the exchange's own communicator.
+constexpr int kRaysTag = 1;
+
+// MPI's own words for error `code`.
+std::string MpiErrorText(int code) {
+    char text[MPI_MAX_ERROR_STRING];
+    int length = 0;
+    if (MPI_Error_string(code, text, &length) != MPI_SUCCESS) return fmt::format("code {}", code);
+    return std::string(text, size_t(length));
+}
+
+Status Check(int code, std::string_view call) {
+    if (code == MPI_SUCCESS) return Status::Ok();
+    return InternalError("MPI: {} failed: {}", call, MpiErrorText(code));
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+struct MpiRayExchange::Impl {
+    Impl(std::vector<int> owners_in, BrickQueues<RayRecord>& queues_in,
+         const MpiExchangeOptions& options_in)
+        : owners(std::move(owners_in)), queues(queues_in), options(options_in) {}
+
+    // A message ready to go, with the rays it holds.
+    struct Message {
+        std::vector<std::byte> bytes;
+        uint64_t rays = 0;
+    };
+    // What workers append to for one destination rank (Send, under the mutex).
+    struct Outgoing {
+        std::mutex mutex;
+        RayMessage filling;
+        std::deque<Message> ready;
+    };
+    // A send posted and not yet complete: its buffer must live until then.
+    struct Posted {
+        MPI_Request request = MPI_REQUEST_NULL;
+        std::vector<std::byte> bytes;
+    };
+
+    // Posts the full messages (and, with `all`, the partly filled ones too).
+    Status PostReady(bool all);
+    // Completes the finished sends to `dest`; returns whether any completed.
+    StatusOr<bool> CompleteSends(int dest);
+    // Receives and queues every message that has arrived; returns whether any did.
+    StatusOr<bool> Receive();
+    // One step of progress with nothing else to do: sends and receipts.
+    StatusOr<bool> Step();
+
+    MPI_Comm rays_comm = MPI_COMM_NULL;  // point-to-point ray messages
+    MPI_Comm sum_comm = MPI_COMM_NULL;   // the termination rounds' sums
+    int rank = 0, size = 1;
+    const std::vector<int> owners;
+    BrickQueues<RayRecord>& queues;
+    const MpiExchangeOptions options;
+    std::vector<std::unique_ptr<Outgoing>> outgoing;  // per rank
+    std::vector<std::deque<Posted>> posted;           // per rank; the exchange's thread only
+    ExchangeCounts counts;                            // the exchange's thread only
+    // The sums of the last termination round, while a drain's end is being detected.
+    uint64_t last_sums[2] = {0, 0};
+    bool have_last_sums = false;
+    std::vector<std::byte> receive_buffer;
+};
+
+StatusOr<std::unique_ptr<MpiRayExchange>> MpiRayExchange::Create(
+    std::vector<int> owners, BrickQueues<RayRecord>& queues, const MpiExchangeOptions& options) {
+    int initialized = 0;
+    MPI_Initialized(&initialized);
+    if (!initialized) return InternalError("MPI: the ray exchange needs MPI initialized first");
+    if (owners.size() != queues.brick_count()) {
+        return InvalidArgumentError("ray exchange: {} owners for {} brick slots", owners.size(),
+                                    queues.brick_count());
+    }
+    if (options.message_bytes < kRayMessageHeaderBytes + kRayGroupHeaderBytes + sizeof(RayRecord) ||
+        options.max_sends_in_flight < 1) {
+        return InvalidArgumentError(
+            "ray exchange: messages of {} bytes (expected room for one ray at least) or {} sends "
+            "in "
+            "flight (expected >= 1)",
+            options.message_bytes, options.max_sends_in_flight);
+    }
+    auto impl = std::make_unique<Impl>(std::move(owners), queues, options);
+    NAVE_RETURN_IF_ERROR(Check(MPI_Comm_dup(MPI_COMM_WORLD, &impl->rays_comm), "MPI_Comm_dup"));
+    NAVE_RETURN_IF_ERROR(Check(MPI_Comm_dup(MPI_COMM_WORLD, &impl->sum_comm), "MPI_Comm_dup"));
+    // Errors come back as codes, turned into Status here, instead of ending the process mute.
+    MPI_Comm_set_errhandler(impl->rays_comm, MPI_ERRORS_RETURN);
+    MPI_Comm_set_errhandler(impl->sum_comm, MPI_ERRORS_RETURN);
+    MPI_Comm_rank(impl->rays_comm, &impl->rank);
+    MPI_Comm_size(impl->rays_comm, &impl->size);
+    for (size_t s = 0; s < impl->owners.size(); ++s) {
+        if (impl->owners[s] < 0 || impl->owners[s] >= impl->size) {
+            return InvalidArgumentError(
+                "ray exchange: brick slot {} owned by rank {} (expected [0, {}))", s,
+                impl->owners[s], impl->size);
+        }
+    }
+    impl->outgoing.resize(size_t(impl->size));
+    for (auto& o : impl->outgoing) o = std::make_unique<Impl::Outgoing>();
+    impl->posted.resize(size_t(impl->size));
+    return std::unique_ptr<MpiRayExchange>(new MpiRayExchange(std::move(impl)));
+}
+
+MpiRayExchange::MpiRayExchange(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+MpiRayExchange::~MpiRayExchange() {
+    // Sends still posted (a render that failed) are cancelled: their buffers go with the exchange.
+    for (auto& dest : impl_->posted) {
+        for (Impl::Posted& p : dest) {
+            MPI_Cancel(&p.request);
+            MPI_Request_free(&p.request);
+        }
+    }
+    MPI_Comm_free(&impl_->rays_comm);
+    MPI_Comm_free(&impl_->sum_comm);
+}
+
+int MpiRayExchange::rank() const { return impl_->rank; }
+int MpiRayExchange::size() const { return impl_->size; }
+int MpiRayExchange::Owner(uint32_t slot) const { return impl_->owners[slot]; }
+
+void MpiRayExchange::Send(uint32_t slot, std::span<const RayRecord> rays) {
+    const int dest = impl_->owners[slot];
+    if (dest == impl_->rank) {
+        impl_->queues.Push(slot, rays.data(), rays.size());
+        return;
+    }
+    Impl::Outgoing& out = *impl_->outgoing[size_t(dest)];
+    const size_t per_message =
+        (impl_->options.message_bytes - kRayMessageHeaderBytes - kRayGroupHeaderBytes) /
+        sizeof(RayRecord);
+    std::lock_guard<std::mutex> lock(out.mutex);
+    while (!rays.empty()) {
+        const size_t room =
+            per_message > out.filling.ray_count() ? per_message - out.filling.ray_count() : 0;
+        const size_t n = std::min(rays.size(), std::max<size_t>(room, 1));
+        out.filling.Append(slot, rays.first(n));
+        rays = rays.subspan(n);
+        if (out.filling.size_bytes() + kRayGroupHeaderBytes + sizeof(RayRecord) >
+            impl_->options.message_bytes) {
+            const uint64_t count = out.filling.ray_count();
+            out.ready.push_back({out.filling.Take(), count});
+        }
+    }
+}
+
+Status MpiRayExchange::Impl::PostReady(bool all) {
+    for (int dest = 0; dest < size; ++dest) {
+        if (dest == rank) continue;
+        std::deque<Message> ready;
+        {
+            Outgoing& out = *outgoing[size_t(dest)];
+            std::lock_guard<std::mutex> lock(out.mutex);
+            if (all && !out.filling.empty()) {
+                const uint64_t count = out.filling.ray_count();
+                out.ready.push_back({out.filling.Take(), count});
+            }
+            ready.swap(out.ready);
+        }
+        for (Message& m : ready) {
+            // At most max_sends_in_flight to one rank: wait for the oldest, receiving meanwhile
+            // (the rank we wait for may itself be waiting to send to us).
+            while (int(posted[size_t(dest)].size()) >= options.max_sends_in_flight) {
+                NAVE_ASSIGN_OR_RETURN(bool progressed, Step());
+                if (!progressed) std::this_thread::sleep_for(std::chrono::microseconds(50));
+            }
+            Posted& p = posted[size_t(dest)].emplace_back();
+            p.bytes = std::move(m.bytes);
+            NAVE_RETURN_IF_ERROR(Check(MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE,
+                                                 dest, kRaysTag, rays_comm, &p.request),
+                                       "MPI_Isend"));
+            counts.records_sent += m.rays;
+            counts.messages_sent += 1;
+            counts.bytes_sent += p.bytes.size();
+        }
+    }
+    return Status::Ok();
+}
+
+StatusOr<bool> MpiRayExchange::Impl::CompleteSends(int dest) {
+    bool any = false;
+    auto& list = posted[size_t(dest)];
+    for (auto it = list.begin(); it != list.end();) {
+        int done = 0;
+        NAVE_RETURN_IF_ERROR(Check(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        if (done) {
+            it = list.erase(it);
+            any = true;
+        } else {
+            ++it;
+        }
+    }
+    return any;
+}
+
+StatusOr<bool> MpiRayExchange::Impl::Receive() {
+    bool any = false;
+    while (true) {
+        int arrived = 0;
+        MPI_Status status;
+        NAVE_RETURN_IF_ERROR(Check(
+            MPI_Iprobe(MPI_ANY_SOURCE, kRaysTag, rays_comm, &arrived, &status), "MPI_Iprobe"));
+        if (!arrived) return any;
+        int bytes = 0;
+        NAVE_RETURN_IF_ERROR(Check(MPI_Get_count(&status, MPI_BYTE, &bytes), "MPI_Get_count"));
+        receive_buffer.resize(size_t(std::max(bytes, 0)));
+        NAVE_RETURN_IF_ERROR(
+            Check(MPI_Recv(receive_buffer.data(), bytes, MPI_BYTE, status.MPI_SOURCE, kRaysTag,
+                           rays_comm, MPI_STATUS_IGNORE),
+                  "MPI_Recv"));
+        const std::string what =
+            fmt::format("rays from rank {} to rank {}", status.MPI_SOURCE, rank);
+        uint32_t foreign_slot = UINT32_MAX;
+        NAVE_ASSIGN_OR_RETURN(uint64_t rays,
+                              ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
+                                              [&](uint32_t slot, std::span<const RayRecord> group) {
+                                                  if (owners[slot] != rank) {
+                                                      foreign_slot = slot;
+                                                      return;
+                                                  }
+                                                  queues.Push(slot, group.data(), group.size());
+                                              }));
+        if (foreign_slot != UINT32_MAX) {
+            return DataLossError("{}: brick slot {} belongs to rank {}, not this one", what,
+                                 foreign_slot, owners[foreign_slot]);
+        }
+        counts.records_received += rays;
+        counts.messages_received += 1;
+        counts.bytes_received += uint64_t(bytes);
+        any = true;
+    }
+}
+
+StatusOr<bool> MpiRayExchange::Impl::Step() {
+    bool any = false;
+    for (int dest = 0; dest < size; ++dest) {
+        if (dest == rank) continue;
+        NAVE_ASSIGN_OR_RETURN(bool completed, CompleteSends(dest));
+        any = any || completed;
+    }
+    NAVE_ASSIGN_OR_RETURN(bool received, Receive());
+    return any || received;
+}
+
+Status MpiRayExchange::Progress() {
+    NAVE_RETURN_IF_ERROR(impl_->PostReady(false));
+    return impl_->Step().status();
+}
+
+StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
+    Impl& m = *impl_;
+    const auto start = std::chrono::steady_clock::now();
+    NAVE_RETURN_IF_ERROR(m.PostReady(true));
+    while (true) {
+        // This rank's counts while it is idle; the sum over ranks, computed while rays still
+        // arrive. Two rounds in a row with the same sums and sent = received: no rank sent or
+        // received between them, each was idle at both, so none has a ray or one in flight.
+        const uint64_t local[2] = {m.counts.records_sent, m.counts.records_received};
+        uint64_t sums[2] = {0, 0};
+        MPI_Request request = MPI_REQUEST_NULL;
+        NAVE_RETURN_IF_ERROR(
+            Check(MPI_Iallreduce(local, sums, 2, MPI_UINT64_T, MPI_SUM, m.sum_comm, &request),
+                  "MPI_Iallreduce"));
+        m.counts.termination_rounds += 1;
+        int done = 0;
+        while (true) {
+            NAVE_RETURN_IF_ERROR(Check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+            if (done) break;
+            NAVE_ASSIGN_OR_RETURN(bool progressed, m.Step());
+            // Ranks may share cores (mpirun --oversubscribe): a waiting rank yields them.
+            if (!progressed) std::this_thread::sleep_for(std::chrono::microseconds(50));
+        }
+        const bool unchanged =
+            m.have_last_sums && sums[0] == m.last_sums[0] && sums[1] == m.last_sums[1];
+        m.last_sums[0] = sums[0];
+        m.last_sums[1] = sums[1];
+        m.have_last_sums = true;
+        if (unchanged && sums[0] == sums[1]) {
+            m.have_last_sums = false;  // the next drain starts its own rounds
+            m.counts.idle_seconds += SecondsSince(start);
+            return true;
+        }
+        if (m.queues.TotalWaiting() > 0) {
+            m.counts.idle_seconds += SecondsSince(start);
+            return false;
+        }
+    }
+}
+
+ExchangeCounts MpiRayExchange::counts() const { return impl_->counts; }
+
+StatusOr<ExchangeCounts> MpiRayExchange::TotalCounts() const {
+    const ExchangeCounts& c = impl_->counts;
+    const uint64_t local[7] = {c.records_sent,      c.records_received, c.messages_sent,
+                               c.messages_received, c.bytes_sent,       c.bytes_received,
+                               c.termination_rounds};
+    uint64_t sums[7] = {};
+    NAVE_RETURN_IF_ERROR(Check(
+        MPI_Allreduce(local, sums, 7, MPI_UINT64_T, MPI_SUM, impl_->sum_comm), "MPI_Allreduce"));
+    double idle = 0;
+    NAVE_RETURN_IF_ERROR(
+        Check(MPI_Allreduce(&c.idle_seconds, &idle, 1, MPI_DOUBLE, MPI_SUM, impl_->sum_comm),
+              "MPI_Allreduce"));
+    ExchangeCounts total{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], idle};
+    if (total.records_sent != total.records_received ||
+        total.messages_sent != total.messages_received) {
+        return InternalError(
+            "ray exchange: the ranks sent {} rays in {} messages and received {} in {}: rays were "
+            "lost or counted twice",
+            total.records_sent, total.messages_sent, total.records_received,
+            total.messages_received);
+    }
+    return total;
+}
+
+}  // namespace nave::render

@@ -1,0 +1,53 @@
+#include "src/render/stream/mpi_runtime.h"
+
+#include <mpi.h>
+
+#include <cstdlib>
+
+namespace nave::render {
+
+StatusOr<MpiRuntime> MpiRuntime::Init(int* argc, char*** argv) {
+    int provided = 0;
+    if (MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+        return InternalError("MPI: MPI_Init_thread failed");
+    }
+    if (provided < MPI_THREAD_FUNNELED) {
+        MPI_Finalize();
+        return UnsupportedError(
+            "MPI gives thread level {} where nave needs MPI_THREAD_FUNNELED ({}): its workers "
+            "trace "
+            "on threads while one of them calls MPI",
+            provided, int(MPI_THREAD_FUNNELED));
+    }
+    return MpiRuntime();
+}
+
+MpiRuntime::~MpiRuntime() {
+    if (active_) MPI_Finalize();
+}
+
+int MpiRuntime::rank() const {
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    return rank;
+}
+
+int MpiRuntime::size() const {
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    return size;
+}
+
+std::string MpiRuntime::host() const {
+    char name[MPI_MAX_PROCESSOR_NAME];
+    int length = 0;
+    if (MPI_Get_processor_name(name, &length) != MPI_SUCCESS) return "unknown host";
+    return std::string(name, size_t(length));
+}
+
+void MpiRuntime::AbortAll(int exit_code) {
+    MPI_Abort(MPI_COMM_WORLD, exit_code);
+    std::abort();  // MPI_Abort does not return; if it did, this rank still ends
+}
+
+}  // namespace nave::render

@@ -1,0 +1,75 @@
+// Bricks to the ranks of a distributed render (brick_owners.h): every rank gets a run of
+// neighbouring bricks of about equal size, every level of a brick goes with it, and every rank
+// computes the same.
+
+#include "src/render/stream/brick_owners.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "render_test_util.h"
+#include "store/testing/store_testing.h"
+
+namespace nave::render {
+namespace {
+
+TEST(BrickOwners, RanksGetRunsOfNeighbouringBricksOfAboutEqualSize) {
+    const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 128, .quads_y = 128});
+    store::LevelOptions levels;
+    levels.relative_errors = {0.02};
+    levels.lock_borders = false;
+    auto source = testing::GridSourceWithLevels(mesh, testing::NamedMaterials({"a", "b", "c"}),
+                                                {4, 4, 1}, levels);
+    ASSERT_TRUE(source != nullptr);
+    ASSERT_TRUE(source->UseLevels(2).ok());
+    ASSERT_EQ(source->level_count(), 2u);
+    for (int ranks : {1, 2, 3, 5}) {
+        SCOPED_TRACE(::testing::Message() << ranks << " ranks");
+        const std::vector<int> owners = BrickOwners(*source, ranks);
+        ASSERT_EQ(owners.size(), source->slot_count());
+        EXPECT_EQ(owners, BrickOwners(*source, ranks));  // deterministic
+        std::vector<double> bytes(size_t(ranks), 0.0);
+        double total = 0, largest = 0;
+        for (uint32_t s = 0; s < source->slot_count(); ++s) {
+            const uint32_t b = source->BrickOfSlot(s);
+            ASSERT_GE(owners[s], 0);
+            ASSERT_LT(owners[s], ranks);
+            EXPECT_EQ(owners[s], owners[b]) << "slot " << s << ": a level away from its brick";
+            if (s != b) continue;
+            const double size = double(source->EstimatedResidentBytes(b));
+            bytes[size_t(owners[b])] += size;
+            total += size;
+            largest = std::max(largest, size);
+        }
+        // Each rank's share within a brick of the mean.
+        for (int r = 0; r < ranks; ++r)
+            EXPECT_NEAR(bytes[size_t(r)], total / ranks, largest) << "rank " << r;
+        // Runs in the tree's depth-first order: walking it, the rank never goes back.
+        std::vector<uint32_t> order;
+        std::vector<uint32_t> stack = {0};
+        const auto& nodes = source->tree().nodes();
+        while (!stack.empty()) {
+            const store::BrickTreeNode& node = nodes[stack.back()];
+            stack.pop_back();
+            if (node.IsLeaf()) {
+                if (node.brick != store::kNoBrick) order.push_back(node.brick);
+                continue;
+            }
+            stack.push_back(node.child[1]);
+            stack.push_back(node.child[0]);
+        }
+        std::set<int> seen;
+        for (size_t i = 0; i < order.size(); ++i) {
+            const int r = owners[order[i]];
+            if (i > 0 && r != owners[order[i - 1]]) {
+                EXPECT_TRUE(seen.insert(owners[order[i - 1]]).second)
+                    << "rank " << owners[order[i - 1]] << " owns two runs";
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace nave::render

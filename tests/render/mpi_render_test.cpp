@@ -1,0 +1,173 @@
+// `mpirun -np N nave render` as users run it (docs/distributed.md): 2 and 3 ranks, each paging its
+// bricks under --memory, give the single-process image bit for bit (RGB; the abbey's textured glass
+// included), and report the rays they sent each other, every one received; what a distributed
+// render does not do yet is refused naming it; a corrupt brick ends the whole job naming the brick
+// and the rank. Runs mpirun and the nave executable (NAVE_BINARY, MPIEXEC), from a process of its
+// own that is not an MPI rank.
+
+#include <OpenImageIO/imagebuf.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "common/run_nave.h"
+#include "store/store_reader.h"
+
+namespace nave::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+// mpirun for this machine and CI containers: more ranks than cores, as root, and shared memory
+// without cross-memory attach (ptrace), which containers forbid.
+std::string Mpirun(int ranks) {
+    // (Under AddressSanitizer, what Open MPI keeps to the end is not nave's leak.)
+    return std::string(
+               "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+               "OMPI_MCA_btl_vader_single_copy_mechanism=none LSAN_OPTIONS=suppressions=") +
+           NAVE_SOURCE_DIR + "/tests/lsan_mpi.supp timeout 120 " + MPIEXEC + " -np " +
+           std::to_string(ranks) + " --oversubscribe ";
+}
+
+// The RGB channels of an EXR.
+std::vector<float> Rgb(const fs::path& exr) {
+    OIIO::ImageBuf image(exr.string());
+    std::vector<float> rgb;
+    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT)) return rgb;
+    const OIIO::ImageSpec& spec = image.spec();
+    rgb.resize(size_t(spec.width) * spec.height * 3);
+    image.get_pixels(OIIO::ROI(0, spec.width, 0, spec.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
+                     rgb.data());
+    return rgb;
+}
+
+class MpiRender : public ::testing::Test {
+  protected:
+    // One store for every test: the detail-1 abbey in 64 small bricks, so that a budget holds a
+    // few of each rank's and every rank pages; rendered in path mode with the abbey's config,
+    // path guiding included (the ranks share the guide's credits).
+    static void SetUpTestSuite() {
+        dir_ = new fs::path(fs::temp_directory_path() / ("nave_mpi_" + std::to_string(getpid())));
+        fs::create_directories(*dir_);
+        const test::CommandResult made = test::RunNave(
+            "preprocess --generate abbey:detail=1 --brick-triangles 40000 -q -o " + Store());
+        ASSERT_EQ(made.exit_code, 0) << made.output;
+    }
+    static void TearDownTestSuite() {
+        fs::remove_all(*dir_);
+        delete dir_;
+    }
+    static std::string Store() { return (*dir_ / "abbey.nave").string(); }
+    static std::string Config() { return std::string(NAVE_SOURCE_DIR) + "/configs/abbey.toml"; }
+    static std::string Render(const std::string& out, const std::string& mode = "path") {
+        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() + " --mode " +
+               mode + " --resolution 96x64 --spp 4 --memory 330M -o " + (*dir_ / out).string();
+    }
+    static test::CommandResult Shell(const std::string& command) {
+        // RunNave prefixes the binary: run the shell's own way instead.
+        test::CommandResult result;
+        FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+        if (pipe == nullptr) return result;
+        char buffer[4096];
+        size_t n;
+        while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0)
+            result.output.append(buffer, n);
+        const int status = ::pclose(pipe);
+        result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        return result;
+    }
+    static fs::path* dir_;
+};
+fs::path* MpiRender::dir_ = nullptr;
+
+TEST_F(MpiRender, RanksPagingTheirBricksGiveTheSingleProcessImage) {
+    const test::CommandResult one = Shell(Render("one.exr"));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const std::vector<float> reference = Rgb(*dir_ / "one.exr");
+    ASSERT_FALSE(reference.empty());
+    for (int ranks : {2, 3}) {
+        SCOPED_TRACE(::testing::Message() << ranks << " ranks");
+        const std::string name = "ranks" + std::to_string(ranks) + ".exr";
+        const test::CommandResult r = Shell(Mpirun(ranks) + Render(name));
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        // Rank 0 alone writes the image and the summary.
+        EXPECT_NE(r.output.find("ranks " + std::to_string(ranks) + ": "), std::string::npos)
+            << r.output;
+        EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("nave render: wrote", r.output.find("nave render: wrote") + 1),
+                  std::string::npos)
+            << "more than one rank wrote: " << r.output;
+        // Rank 0 paged its bricks under its --memory.
+        const size_t evictions = r.output.find("evictions ");
+        ASSERT_NE(evictions, std::string::npos) << r.output;
+        EXPECT_NE(r.output.compare(evictions, 11, "evictions 0"), 0) << r.output;
+        const std::vector<float> image = Rgb(*dir_ / name);
+        ASSERT_EQ(image.size(), reference.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < image.size(); ++i) differ += image[i] != reference[i];
+        EXPECT_EQ(differ, 0u) << "of " << image.size() << " values";
+    }
+}
+
+// Levels of detail are slots of their bricks: they go to the brick's rank.
+TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
+    const std::string store = (*dir_ / "levels.nave").string();
+    const test::CommandResult made = test::RunNave(
+        "preprocess --generate abbey:detail=1 --brick-triangles 40000 --levels -q -o " + store);
+    ASSERT_EQ(made.exit_code, 0) << made.output;
+    auto render = [&](const std::string& out) {
+        return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() +
+               " --mode path --lod auto --resolution 64x48 --spp 2 --memory 330M -q -o " +
+               (*dir_ / out).string();
+    };
+    const test::CommandResult one = Shell(render("levels1.exr"));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const test::CommandResult two = Shell(Mpirun(2) + render("levels2.exr"));
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    const std::vector<float> a = Rgb(*dir_ / "levels1.exr"), b = Rgb(*dir_ / "levels2.exr");
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, b);
+}
+
+TEST_F(MpiRender, WhatIsNotDistributedYetIsRefusedByEveryRank) {
+    const test::CommandResult r = Shell(Mpirun(2) + Render("photon.exr", "photon"));
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("photon mode"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("on rank "), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(*dir_ / "photon.exr"));
+}
+
+TEST_F(MpiRender, ACorruptBrickEndsTheJobNamingTheBrickAndTheRank) {
+    const fs::path damaged = *dir_ / "damaged.nave";
+    fs::copy_file(Store(), damaged, fs::copy_options::overwrite_existing);
+    fs::copy(Store() + ".textures", damaged.string() + ".textures",
+             fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    {
+        auto store = store::Store::Open(damaged);
+        ASSERT_TRUE(store.ok()) << store.status().ToString();
+        const store::BrickInfo& brick = (*store)->bricks()[5];
+        std::fstream file(damaged, std::ios::in | std::ios::out | std::ios::binary);
+        file.seekp(std::streamoff(brick.mesh.offset + brick.mesh.length / 2));
+        file.put('\x5a');
+    }
+    const std::string command = std::string(NAVE_BINARY) + " render " + damaged.string() + " -c " +
+                                Config() + " --mode path --resolution 32x24 --spp 1 -o " +
+                                (*dir_ / "damaged.exr").string();
+    const auto start = std::chrono::steady_clock::now();
+    const test::CommandResult r = Shell(Mpirun(2) + command);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("brick 5"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("checksum"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("on rank "), std::string::npos) << r.output;
+    EXPECT_LT(seconds, 60) << "the job did not end soon after the error";
+    EXPECT_FALSE(fs::exists(*dir_ / "damaged.exr"));
+}
+
+}  // namespace
+}  // namespace nave::render
