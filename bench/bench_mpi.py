@@ -73,16 +73,16 @@ def main():
         if ranks > 1:
             cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd
         t = nb.run_timed(cmd, log)
-        stats = nb.read_statistics(out) if t.ok() else {}
+        stats = nb.read_statistics(out) if t.ok else {}
         same = ""
-        if t.ok():
+        if t.ok:
             image = rgb(out)
             if reference is None and ranks == 1:
                 reference = image
             elif reference is not None:
                 same = "yes" if (image == reference).all() else "no"
         row = {
-            "ranks": ranks, "threads": threads, "status": "ok" if t.ok() else nb.error_reason(t.output, t.returncode),
+            "ranks": ranks, "threads": threads, "status": "ok" if t.ok else nb.error_reason(t.output, t.returncode),
             "wall_s": t.elapsed_s, "peak_rss_gib": round(t.peak_rss_bytes / 2**30, 2) if t.peak_rss_bytes else "",
             "rays": stats.get("rays", ""), "rays_between_ranks": stats.get("rays_between_ranks", 0),
             "messages": stats.get("messages_between_ranks", 0), "bytes": stats.get("bytes_between_ranks", 0),
