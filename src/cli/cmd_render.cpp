@@ -357,7 +357,9 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     auto opts = std::make_shared<RenderOptions>();
     CLI::App* cmd = app.add_subcommand(
         "render",
-        "Render a brick store with spectral ray streams over its bricks (path tracing or SPPM)");
+        "Render a brick store with spectral ray streams over its bricks (path tracing or SPPM). "
+        "Under mpirun (path mode, fixed --spp) the ranks share the bricks and send rays to each "
+        "other; rank 0 writes the image (docs/distributed.md)");
     cmd->add_option("model", opts->model, "The model (.nave store from `nave preprocess`)");
     cmd->add_option("--procedural", opts->procedural,
                     "Render a built-in test model instead: furnace, caustic or clutter, with "
