@@ -7,12 +7,17 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "common/run_nave.h"
 #include "store/store_reader.h"
@@ -168,6 +173,55 @@ TEST_F(MpiRender, ACorruptBrickEndsTheJobNamingTheBrickAndTheRank) {
     EXPECT_NE(r.output.find("on rank "), std::string::npos) << r.output;
     EXPECT_LT(seconds, 60) << "the job did not end soon after the error";
     EXPECT_FALSE(fs::exists(*dir_ / "damaged.exr"));
+}
+
+// The pids of `pid`'s children (Linux: /proc/PID/task/PID/children).
+std::vector<pid_t> Children(pid_t pid) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
+    std::vector<pid_t> children;
+    pid_t child;
+    while (in >> child) children.push_back(child);
+    return children;
+}
+
+// A rank killed outright mid-render (out of memory, an operator's kill -9): mpirun ends the whole
+// job, naming the rank and the signal, and no image is written.
+TEST_F(MpiRender, ARankKilledMidRenderEndsTheJob) {
+    const fs::path log = *dir_ / "killed.log";
+    // In-core, and long enough (256 samples) to be killed mid-render.
+    const std::string command = "exec env " + Mpirun(2) + NAVE_BINARY + " render " + Store() +
+                                " -c " + Config() +
+                                " --mode path --resolution 96x64 --spp 256 -o " +
+                                (*dir_ / "killed.exr").string() + " > " + log.string() + " 2>&1";
+    const pid_t mpirun = ::fork();
+    ASSERT_GE(mpirun, 0);
+    if (mpirun == 0) {
+        ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    // `timeout` runs mpirun, which runs the ranks: wait for both ranks to be rendering.
+    std::vector<pid_t> ranks;
+    for (int i = 0; i < 200 && ranks.size() < 2; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        ranks.clear();
+        for (pid_t launcher : Children(mpirun))
+            for (pid_t rank : Children(launcher)) ranks.push_back(rank);
+    }
+    ASSERT_EQ(ranks.size(), 2u) << "the ranks did not start";
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    const auto start = std::chrono::steady_clock::now();
+    ::kill(ranks[1], SIGKILL);
+    int status = 0;
+    ASSERT_EQ(::waitpid(mpirun, &status, 0), mpirun);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::ifstream in(log);
+    const std::string output((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+    EXPECT_TRUE(!WIFEXITED(status) || WEXITSTATUS(status) != 0) << output;
+    EXPECT_NE(output.find("signal 9"), std::string::npos) << output;
+    EXPECT_LT(seconds, 30) << "the job did not end soon after the rank was killed";
+    EXPECT_FALSE(fs::exists(*dir_ / "killed.exr"));
 }
 
 }  // namespace
