@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "src/render/stream/mpi_runtime.h"
+
 namespace nave::render {
 
 struct MpiRankGroup::Comm {
@@ -18,15 +20,9 @@ Status SumInParts(MPI_Comm comm, std::span<T> values, MPI_Datatype type) {
     constexpr size_t kPart = size_t(1) << 28;
     for (size_t at = 0; at < values.size(); at += kPart) {
         const int count = int(std::min(kPart, values.size() - at));
-        const int code =
-            MPI_Allreduce(MPI_IN_PLACE, values.data() + at, count, type, MPI_SUM, comm);
-        if (code != MPI_SUCCESS) {
-            char text[MPI_MAX_ERROR_STRING];
-            int length = 0;
-            MPI_Error_string(code, text, &length);
-            return InternalError("MPI: MPI_Allreduce of {} values failed: {}", count,
-                                 std::string_view(text, size_t(length)));
-        }
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Allreduce(MPI_IN_PLACE, values.data() + at, count, type, MPI_SUM, comm),
+                      "MPI_Allreduce"));
     }
     return Status::Ok();
 }
@@ -39,8 +35,8 @@ StatusOr<std::unique_ptr<MpiRankGroup>> MpiRankGroup::Create(const MpiExchangeOp
     if (!initialized) return InternalError("MPI: the rank group needs MPI initialized first");
     std::unique_ptr<MpiRankGroup> group(new MpiRankGroup());
     group->comm_ = std::make_unique<Comm>();
-    if (MPI_Comm_dup(MPI_COMM_WORLD, &group->comm_->comm) != MPI_SUCCESS)
-        return InternalError("MPI: MPI_Comm_dup failed");
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Comm_dup(MPI_COMM_WORLD, &group->comm_->comm), "MPI_Comm_dup"));
     MPI_Comm_set_errhandler(group->comm_->comm, MPI_ERRORS_RETURN);
     MPI_Comm_rank(group->comm_->comm, &group->rank_);
     MPI_Comm_size(group->comm_->comm, &group->size_);

@@ -10,6 +10,7 @@
 #include <thread>
 #include <utility>
 
+#include "src/render/stream/mpi_runtime.h"
 #include "src/render/stream/ray_message.h"
 
 namespace nave::render {
@@ -18,19 +19,6 @@ namespace {
 
 // The tag of ray messages on the exchange's own communicator.
 constexpr int kRaysTag = 1;
-
-// MPI's own words for error `code`.
-std::string MpiErrorText(int code) {
-    char text[MPI_MAX_ERROR_STRING];
-    int length = 0;
-    if (MPI_Error_string(code, text, &length) != MPI_SUCCESS) return fmt::format("code {}", code);
-    return std::string(text, size_t(length));
-}
-
-Status Check(int code, std::string_view call) {
-    if (code == MPI_SUCCESS) return Status::Ok();
-    return InternalError("MPI: {} failed: {}", call, MpiErrorText(code));
-}
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -96,14 +84,13 @@ StatusOr<std::unique_ptr<MpiRayExchange>> MpiRayExchange::Create(
     if (options.message_bytes < kRayMessageHeaderBytes + kRayGroupHeaderBytes + sizeof(RayRecord) ||
         options.max_sends_in_flight < 1) {
         return InvalidArgumentError(
-            "ray exchange: messages of {} bytes (expected room for one ray at least) or {} sends "
-            "in "
-            "flight (expected >= 1)",
+            "ray exchange: messages of {} bytes (expected room for one ray at least) or {} "
+            "sends in flight (expected >= 1)",
             options.message_bytes, options.max_sends_in_flight);
     }
     auto impl = std::make_unique<Impl>(std::move(owners), queues, options);
-    NAVE_RETURN_IF_ERROR(Check(MPI_Comm_dup(MPI_COMM_WORLD, &impl->rays_comm), "MPI_Comm_dup"));
-    NAVE_RETURN_IF_ERROR(Check(MPI_Comm_dup(MPI_COMM_WORLD, &impl->sum_comm), "MPI_Comm_dup"));
+    NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Comm_dup(MPI_COMM_WORLD, &impl->rays_comm), "MPI_Comm_dup"));
+    NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Comm_dup(MPI_COMM_WORLD, &impl->sum_comm), "MPI_Comm_dup"));
     // Errors come back as codes, turned into Status here, instead of ending the process mute.
     MPI_Comm_set_errhandler(impl->rays_comm, MPI_ERRORS_RETURN);
     MPI_Comm_set_errhandler(impl->sum_comm, MPI_ERRORS_RETURN);
@@ -187,9 +174,9 @@ Status MpiRayExchange::Impl::PostReady(bool all) {
             }
             Posted& p = posted[size_t(dest)].emplace_back();
             p.bytes = std::move(m.bytes);
-            NAVE_RETURN_IF_ERROR(Check(MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE,
-                                                 dest, kRaysTag, rays_comm, &p.request),
-                                       "MPI_Isend"));
+            NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE,
+                                                     dest, kRaysTag, rays_comm, &p.request),
+                                           "MPI_Isend"));
             counts.records_sent += m.rays;
             counts.messages_sent += 1;
             counts.bytes_sent += p.bytes.size();
@@ -203,7 +190,8 @@ StatusOr<bool> MpiRayExchange::Impl::CompleteSends(int dest) {
     auto& list = posted[size_t(dest)];
     for (auto it = list.begin(); it != list.end();) {
         int done = 0;
-        NAVE_RETURN_IF_ERROR(Check(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
         if (done) {
             it = list.erase(it);
             any = true;
@@ -219,16 +207,16 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
     while (true) {
         int arrived = 0;
         MPI_Status status;
-        NAVE_RETURN_IF_ERROR(Check(
+        NAVE_RETURN_IF_ERROR(MpiStatus(
             MPI_Iprobe(MPI_ANY_SOURCE, kRaysTag, rays_comm, &arrived, &status), "MPI_Iprobe"));
         if (!arrived) return any;
         int bytes = 0;
-        NAVE_RETURN_IF_ERROR(Check(MPI_Get_count(&status, MPI_BYTE, &bytes), "MPI_Get_count"));
+        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Get_count(&status, MPI_BYTE, &bytes), "MPI_Get_count"));
         receive_buffer.resize(size_t(std::max(bytes, 0)));
         NAVE_RETURN_IF_ERROR(
-            Check(MPI_Recv(receive_buffer.data(), bytes, MPI_BYTE, status.MPI_SOURCE, kRaysTag,
-                           rays_comm, MPI_STATUS_IGNORE),
-                  "MPI_Recv"));
+            MpiStatus(MPI_Recv(receive_buffer.data(), bytes, MPI_BYTE, status.MPI_SOURCE, kRaysTag,
+                               rays_comm, MPI_STATUS_IGNORE),
+                      "MPI_Recv"));
         const std::string what =
             fmt::format("rays from rank {} to rank {}", status.MPI_SOURCE, rank);
         uint32_t foreign_slot = UINT32_MAX;
@@ -280,12 +268,13 @@ StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
         uint64_t sums[2] = {0, 0};
         MPI_Request request = MPI_REQUEST_NULL;
         NAVE_RETURN_IF_ERROR(
-            Check(MPI_Iallreduce(local, sums, 2, MPI_UINT64_T, MPI_SUM, m.sum_comm, &request),
-                  "MPI_Iallreduce"));
+            MpiStatus(MPI_Iallreduce(local, sums, 2, MPI_UINT64_T, MPI_SUM, m.sum_comm, &request),
+                      "MPI_Iallreduce"));
         m.counts.termination_rounds += 1;
         int done = 0;
         while (true) {
-            NAVE_RETURN_IF_ERROR(Check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+            NAVE_RETURN_IF_ERROR(
+                MpiStatus(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
             if (done) break;
             NAVE_ASSIGN_OR_RETURN(bool progressed, m.Step());
             // Ranks may share cores (mpirun --oversubscribe): a waiting rank yields them.
@@ -308,20 +297,18 @@ StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
     }
 }
 
-ExchangeCounts MpiRayExchange::counts() const { return impl_->counts; }
-
 StatusOr<ExchangeCounts> MpiRayExchange::TotalCounts() const {
     const ExchangeCounts& c = impl_->counts;
     const uint64_t local[7] = {c.records_sent,      c.records_received, c.messages_sent,
                                c.messages_received, c.bytes_sent,       c.bytes_received,
                                c.termination_rounds};
     uint64_t sums[7] = {};
-    NAVE_RETURN_IF_ERROR(Check(
+    NAVE_RETURN_IF_ERROR(MpiStatus(
         MPI_Allreduce(local, sums, 7, MPI_UINT64_T, MPI_SUM, impl_->sum_comm), "MPI_Allreduce"));
     double idle = 0;
     NAVE_RETURN_IF_ERROR(
-        Check(MPI_Allreduce(&c.idle_seconds, &idle, 1, MPI_DOUBLE, MPI_SUM, impl_->sum_comm),
-              "MPI_Allreduce"));
+        MpiStatus(MPI_Allreduce(&c.idle_seconds, &idle, 1, MPI_DOUBLE, MPI_SUM, impl_->sum_comm),
+                  "MPI_Allreduce"));
     ExchangeCounts total{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], idle};
     if (total.records_sent != total.records_received ||
         total.messages_sent != total.messages_received) {

@@ -63,8 +63,6 @@ class MpiRayExchange final : public RayExchange {
     /// arrive (returns false: trace them, then call again) or every rank is idle with no ray in
     /// flight (returns true, on every rank in the same call). Collective.
     StatusOr<bool> WaitForRaysOrEnd() override;
-    /// This rank's counts.
-    ExchangeCounts counts() const;
     /// Every rank's counts summed, and the closing check: every record sent was received. Errors:
     /// kInternal naming both sums when they differ. Collective; call after WaitForRaysOrEnd
     /// returned true.

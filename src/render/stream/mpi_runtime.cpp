@@ -14,9 +14,8 @@ StatusOr<MpiRuntime> MpiRuntime::Init(int* argc, char*** argv) {
     if (provided < MPI_THREAD_FUNNELED) {
         MPI_Finalize();
         return UnsupportedError(
-            "MPI gives thread level {} where nave needs MPI_THREAD_FUNNELED ({}): its workers "
-            "trace "
-            "on threads while one of them calls MPI",
+            "MPI gives thread level {} where nave needs MPI_THREAD_FUNNELED ({}): its "
+            "workers trace on threads while one of them calls MPI",
             provided, int(MPI_THREAD_FUNNELED));
     }
     return MpiRuntime();
@@ -43,6 +42,16 @@ std::string MpiRuntime::host() const {
     int length = 0;
     if (MPI_Get_processor_name(name, &length) != MPI_SUCCESS) return "unknown host";
     return std::string(name, size_t(length));
+}
+
+Status MpiStatus(int code, std::string_view call) {
+    if (code == MPI_SUCCESS) return Status::Ok();
+    char text[MPI_MAX_ERROR_STRING];
+    int length = 0;
+    if (MPI_Error_string(code, text, &length) != MPI_SUCCESS) {
+        return InternalError("MPI: {} failed: code {}", call, code);
+    }
+    return InternalError("MPI: {} failed: {}", call, std::string_view(text, size_t(length)));
 }
 
 void MpiRuntime::AbortAll(int exit_code) {

@@ -4,6 +4,7 @@
 // finalized when the runtime is destroyed. Built only where MPI is found (NAVE_HAVE_MPI).
 
 #include <string>
+#include <string_view>
 
 #include "src/core/status.h"
 
@@ -31,5 +32,9 @@ class MpiRuntime {
     MpiRuntime() = default;
     bool active_ = true;
 };
+
+/// MPI's result `code` of the call named `call` as a Status: Ok for MPI_SUCCESS, else kInternal
+/// with MPI's own words for the error (on communicators set to MPI_ERRORS_RETURN).
+Status MpiStatus(int code, std::string_view call);
 
 }  // namespace nave::render
