@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "store/brick_codec.h"
+
 namespace nave::store {
 namespace {
 
@@ -176,9 +178,8 @@ Status ValidateLevelOptions(const LevelOptions& options) {
 
 uint32_t LevelGridShift(const BrickMesh& level, float error, const GlobalGrid& grid,
                         const LevelOptions& options) {
-    constexpr uint32_t kMaxShift = 16;  // codec::kMaxMeshGridShift
     uint32_t shift = 0;
-    while (shift < kMaxShift &&
+    while (shift < codec::kMaxMeshGridShift &&
            GridSnapDistance(grid, shift + 1) <= options.max_grid_error_fraction * double(error)) {
         ++shift;
     }
