@@ -51,6 +51,12 @@ std::vector<float> Rgb(const fs::path& exr) {
     return rgb;
 }
 
+// One worker thread per process: a paged render with several workers is not reproducible bit for
+// bit (about 2 in 100 renders of this store under --memory differ from the others in a few pixels
+// or, through the path guide, in a few hundred: an open defect of the pager, see
+// docs/distributed.md), and what this suite checks is that ranks reproduce one process.
+constexpr const char* kOneThread = " --threads 1";
+
 class MpiRender : public ::testing::Test {
   protected:
     // One store for every test: the detail-1 abbey in 64 small bricks, so that a budget holds a
@@ -71,7 +77,8 @@ class MpiRender : public ::testing::Test {
     static std::string Config() { return std::string(NAVE_SOURCE_DIR) + "/configs/abbey.toml"; }
     static std::string Render(const std::string& out, const std::string& mode = "path") {
         return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() + " --mode " +
-               mode + " --resolution 96x64 --spp 4 --memory 330M -o " + (*dir_ / out).string();
+               mode + " --resolution 96x64 --spp 4 --memory 330M" + kOneThread + " -o " +
+               (*dir_ / out).string();
     }
     static test::CommandResult Shell(const std::string& command) {
         // RunNave prefixes the binary: run the shell's own way instead.
@@ -127,8 +134,8 @@ TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
     ASSERT_EQ(made.exit_code, 0) << made.output;
     auto render = [&](const std::string& out) {
         return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() +
-               " --mode path --lod auto --resolution 64x48 --spp 2 --memory 330M -q -o " +
-               (*dir_ / out).string();
+               " --mode path --lod auto --resolution 64x48 --spp 2 --memory 330M" + kOneThread +
+               " -q -o " + (*dir_ / out).string();
     };
     const test::CommandResult one = Shell(render("levels1.exr"));
     ASSERT_EQ(one.exit_code, 0) << one.output;
