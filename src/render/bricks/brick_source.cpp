@@ -87,9 +87,14 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     }
     acquires_.fetch_add(1, std::memory_order_relaxed);
     Slot& slot = *slots_[id];
-    // Pin first, then check: an evictor takes the slot lock and refuses while pins > 0.
-    slot.pins.fetch_add(1, std::memory_order_acq_rel);
-    if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
+    // Pin first, then check: an evictor takes the slot lock and refuses while pins > 0. The pin and
+    // the check are sequentially consistent, as are the evictor's clearing of `ready` and its
+    // second look at the pins (Evict): each side writes one variable and then reads the other, and
+    // only a single total order of the four makes sure that one of them sees the other's write
+    // (with release and acquire alone, the evictor's read of the pins may pass its store to
+    // `ready`, as x86's store buffer allows, and both sides would go on).
+    slot.pins.fetch_add(1, std::memory_order_seq_cst);
+    if (const ResidentBrick* b = slot.ready.load(std::memory_order_seq_cst))
         return BrickHandle(this, b);
     std::lock_guard<std::mutex> lock(slot.mutex);
     if (const ResidentBrick* b = slot.ready.load(std::memory_order_acquire))
@@ -198,10 +203,10 @@ bool BrickSource::Evict(uint32_t id) {
     Slot& slot = *slots_[id];
     std::lock_guard<std::mutex> lock(slot.mutex);
     if (slot.brick == nullptr || slot.pins.load(std::memory_order_acquire) != 0) return false;
-    slot.ready.store(nullptr, std::memory_order_release);
+    slot.ready.store(nullptr, std::memory_order_seq_cst);
     // A reader that pinned between our check and the store above would hold a dangling pointer;
-    // re-check.
-    if (slot.pins.load(std::memory_order_acquire) != 0) {
+    // re-check (sequentially consistent with the store above: Acquire says why).
+    if (slot.pins.load(std::memory_order_seq_cst) != 0) {
         slot.ready.store(slot.brick.get(), std::memory_order_release);
         return false;
     }
