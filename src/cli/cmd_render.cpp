@@ -277,8 +277,6 @@ Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& confi
     const char* missing = nullptr;
     if (config.render.mode == render::RenderSettings::Mode::kPhoton) {
         missing = "photon mode (--mode photon)";
-    } else if (config.render.noise_target > 0 || config.render.time_limit_s > 0) {
-        missing = "a noise target or a time limit (--noise, --time-limit)";
     } else if (!o.checkpoint.checkpoint.empty() || !o.checkpoint.resume.empty()) {
         missing = "checkpoints (--checkpoint, --resume)";
     } else if (!o.trace.empty()) {
@@ -286,7 +284,7 @@ Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& confi
     }
     if (missing == nullptr) return Status::Ok();
     return InvalidArgumentError(
-        "under mpirun nave renders in path mode to a fixed number of samples; {} is not "
+        "under mpirun nave renders in path mode, without checkpoints or a trace; {} is not "
         "distributed yet: run it as one process",
         missing);
 }

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -115,6 +116,54 @@ TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
         for (size_t i = 0; i < image.size(); ++i) differ += image[i] != reference[i];
         EXPECT_EQ(differ, 0u) << "of " << image.size() << " values";
     }
+}
+
+// The samples per pixel a render's summary reports ("after 62 samples per pixel"), or -1.
+int SamplesReported(const std::string& output) {
+    const size_t at = output.find(" samples per pixel");
+    if (at == std::string::npos) return -1;
+    const size_t start = output.rfind(' ', at - 1);
+    return std::atoi(output.substr(start + 1, at - start - 1).c_str());
+}
+
+// A noise target: the ranks estimate the whole image's noise together (each holds the part of the
+// image it traced) and stop after the pass one process stops after, with its image.
+TEST_F(MpiRender, ANoiseTargetStopsTheRanksWhereOneProcessStops) {
+    auto render = [&](const std::string& out) {
+        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() +
+               " --mode path --resolution 96x64 --spp 128 --noise 0.2 -o " + (*dir_ / out).string();
+    };
+    const test::CommandResult one = Shell(render("noise1.exr"));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const test::CommandResult two = Shell(Mpirun(2) + render("noise2.exr"));
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    const int samples = SamplesReported(one.output);
+    EXPECT_GT(samples, 1) << one.output;
+    EXPECT_LT(samples, 128) << "the target should end the render early: " << one.output;
+    EXPECT_EQ(SamplesReported(two.output), samples) << two.output;
+    EXPECT_NE(two.output.find("target 0.2 reached"), std::string::npos) << two.output;
+    const std::vector<float> a = Rgb(*dir_ / "noise1.exr"), b = Rgb(*dir_ / "noise2.exr");
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, b);
+}
+
+// A time limit: each rank's clock may pass it after a different pass, and the ranks stop together
+// after the first pass where one of them has.
+TEST_F(MpiRender, ATimeLimitEndsTheRanksTogether) {
+    const auto start = std::chrono::steady_clock::now();
+    const test::CommandResult r =
+        Shell(Mpirun(2) + NAVE_BINARY + " render " + Store() + " -c " + Config() +
+              " --mode path --resolution 96x64 --spp 100000 --time-limit 3 -o " +
+              (*dir_ / "limited.exr").string());
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const int samples = SamplesReported(r.output);
+    EXPECT_GT(samples, 0) << r.output;
+    EXPECT_LT(samples, 100000) << r.output;
+    EXPECT_LT(seconds, 60) << r.output;
+    EXPECT_NE(r.output.find("ranks 2: "), std::string::npos) << r.output;
+    EXPECT_FALSE(Rgb(*dir_ / "limited.exr").empty());
 }
 
 // Each rank pages its own bricks under its own --memory, and the job completes with every ray

@@ -57,8 +57,13 @@ class Integrator {
     /// that may write checkpoints or stop early). Errors: a brick that cannot be pinned, a failed
     /// spill.
     virtual StatusOr<int> RenderRounds(int done, bool boundaries) = 0;
-    /// The image's estimated relMSE after `done` rounds (NaN with fewer than two).
+    /// The image's estimated relMSE after `done` rounds (NaN with fewer than two): HalvesRelMse of
+    /// HalfLuminances over the pixels.
     virtual double NoiseEstimate(int done) const = 0;
+    /// The luminance of the two halves of `pixel`'s samples after `done` rounds (NaN for a half
+    /// with none yet): what NoiseEstimate measures. In a distributed render each process's are the
+    /// part of the image it traced, and their sums over the processes are the whole image's.
+    virtual std::array<double, 2> HalfLuminances(uint32_t pixel, int done) const = 0;
     /// Adds its state (guides, visible points) to a checkpoint.
     virtual void Save(Checkpoint* checkpoint) const = 0;
     /// After the last round: traces what is still in flight, completes the film for `done` rounds

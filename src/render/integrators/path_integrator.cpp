@@ -97,7 +97,11 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
                 NAVE_RETURN_IF_ERROR(GenerateCameraRays(first, last, uint32_t(k)));
             return Status::Ok();
         }));
-    if (update || boundaries) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
+    // Processes that check a noise target or a time limit after the round agree on it with
+    // collective sums, which no process may enter while rays are still on their way to it (its
+    // senders would wait for it): the round ends with a complete drain there.
+    const bool collective_check = checks && scheduler_.ranks() != nullptr;
+    if (update || boundaries || collective_check) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
     if (update) {
         if (RankGroup* ranks = scheduler_.ranks()) {
             // Each process credited the paths it traced: all of them learn from all.
@@ -128,10 +132,12 @@ Status PathIntegrator::Finish(int passes, RenderStats* stats) {
 
 double PathIntegrator::NoiseEstimate(int passes) const {
     if (passes < 2) return std::nan("");
-    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
-        return std::array<double, 2>{film_->HalfLuminance(uint32_t(p), 0, passes),
-                                     film_->HalfLuminance(uint32_t(p), 1, passes)};
-    });
+    return HalvesRelMse(film_->pixel_count(),
+                        [&](size_t p) { return HalfLuminances(uint32_t(p), passes); });
+}
+
+std::array<double, 2> PathIntegrator::HalfLuminances(uint32_t pixel, int passes) const {
+    return {film_->HalfLuminance(pixel, 0, passes), film_->HalfLuminance(pixel, 1, passes)};
 }
 
 bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& brick,

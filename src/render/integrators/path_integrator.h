@@ -29,6 +29,7 @@ class PathIntegrator final : public Integrator, public CameraPaths {
     /// The passes after the first `passes`: one, or with small images several in one wave.
     StatusOr<int> RenderRounds(int passes, bool boundaries) override;
     double NoiseEstimate(int passes) const override;
+    std::array<double, 2> HalfLuminances(uint32_t pixel, int passes) const override;
     void Save(Checkpoint* checkpoint) const override;
     Status Finish(int passes, RenderStats* stats) override;
 

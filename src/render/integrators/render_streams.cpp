@@ -3,10 +3,15 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <memory>
+#include <span>
+#include <vector>
 
 #include "src/core/check.h"
+#include "src/core/image_error.h"
 #include "src/core/memory.h"
 #include "src/core/progress.h"
 #include "src/render/integrators/integrator.h"
@@ -15,6 +20,34 @@
 
 namespace nave::render {
 namespace {
+
+/// The image's noise after `done` rounds when every process traced a part of it: the halves'
+/// luminances summed over the processes (2 doubles a pixel, held for the sum). Collective.
+StatusOr<double> NoiseOverRanks(const Integrator& integrator, int done, size_t pixels,
+                                RankGroup& ranks) {
+    if (done < 2) return std::nan("");  // the same in every process: no sum needed
+    std::vector<double> halves(2 * pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+        const std::array<double, 2> h = integrator.HalfLuminances(uint32_t(p), done);
+        halves[2 * p] = h[0];
+        halves[2 * p + 1] = h[1];
+    }
+    NAVE_RETURN_IF_ERROR(ranks.SumEverywhere(std::span<double>(halves)));
+    return HalvesRelMse(pixels, [&](size_t p) {
+        return std::array<double, 2>{halves[2 * p], halves[2 * p + 1]};
+    });
+}
+
+/// Whether a distributed render stops after `done` rounds: the whole image's noise against the
+/// target, and each process's clock against the time limit; the processes stop together as soon
+/// as one of them says so (their clocks differ a little). Collective.
+StatusOr<bool> StopEverywhere(const Integrator& integrator, int done, size_t pixels,
+                              RankGroup& ranks, StoppingRule& stop) {
+    NAVE_ASSIGN_OR_RETURN(const double noise, NoiseOverRanks(integrator, done, pixels, ranks));
+    uint64_t votes = stop.ShouldStop([&] { return noise; }) ? 1 : 0;
+    NAVE_RETURN_IF_ERROR(ranks.SumEverywhere(std::span<uint64_t>(&votes, 1)));
+    return votes > 0;
+}
 
 /// Renders rounds of `integrator` until it has all it asks for, the stopping rule of `settings`
 /// ends the render or the session ends this run, then has it complete the film and fill `stats`:
@@ -37,10 +70,17 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
         ~Unset() { integrator.set_progress(nullptr); }
     } unset{integrator};  // before `progress` goes, whichever way this returns
     StoppingRule stop(settings, &progress, session.elapsed_before_s());
+    const bool checks = settings.noise_target > 0 || settings.time_limit_s > 0;
     int done = start;
     while (done < wanted) {
         NAVE_ASSIGN_OR_RETURN(done, integrator.RenderRounds(done, session.active()));
-        const bool enough = stop.ShouldStop([&] { return integrator.NoiseEstimate(done); });
+        bool enough = false;
+        if (ranks != nullptr && checks) {
+            NAVE_ASSIGN_OR_RETURN(
+                enough, StopEverywhere(integrator, done, film->pixel_count(), *ranks, stop));
+        } else {
+            enough = stop.ShouldStop([&] { return integrator.NoiseEstimate(done); });
+        }
         bool end_run = false;
         NAVE_RETURN_IF_ERROR(session.AtBoundary(
             done, stop.Elapsed(), enough || done >= wanted,

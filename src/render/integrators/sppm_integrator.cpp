@@ -159,20 +159,24 @@ Status SppmIntegrator::Finish(int done, RenderStats* stats) {
 
 double SppmIntegrator::NoiseEstimate(int iterations) const {
     if (iterations < 2) return std::nan("");
+    // Pixel by pixel: no image is held.
+    return HalvesRelMse(film_->pixel_count(),
+                        [&](size_t p) { return HalfLuminances(uint32_t(p), iterations); });
+}
+
+std::array<double, 2> SppmIntegrator::HalfLuminances(uint32_t pixel, int iterations) const {
     // Each half: the film's direct light and specular chains of its iterations (even or odd) plus
-    // the photon estimate of the same iterations. Pixel by pixel: no image is held.
+    // the photon estimate of the same iterations.
     const double photons = double(scene_.settings.photons_per_iteration);
     const int even = (iterations + 1) / 2,
               odd = iterations / 2;  // iterations 0, 2, 4... and 1, 3...
     const double emitted[2] = {photons * even, photons * odd};
-    return HalvesRelMse(film_->pixel_count(), [&](size_t p) {
-        std::array<double, 2> half;
-        for (int h = 0; h < 2; ++h) {
-            half[h] = film_->HalfLuminance(uint32_t(p), h, iterations) +
-                      visible_->IndirectHalfY(uint32_t(p), h, emitted[h]);
-        }
-        return half;
-    });
+    std::array<double, 2> half;
+    for (int h = 0; h < 2; ++h) {
+        half[h] = film_->HalfLuminance(pixel, h, iterations) +
+                  visible_->IndirectHalfY(pixel, h, emitted[h]);
+    }
+    return half;
 }
 
 void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,

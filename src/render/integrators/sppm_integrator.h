@@ -36,6 +36,7 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     StatusOr<int> RenderRounds(int done, bool boundaries) override;
     /// From the two halves of the film's samples and of the photons (visible_points.h).
     double NoiseEstimate(int iterations) const override;
+    std::array<double, 2> HalfLuminances(uint32_t pixel, int iterations) const override;
     void Save(Checkpoint* checkpoint) const override;
     /// Adds the photon estimate of the `done` iterations to the film.
     Status Finish(int done, RenderStats* stats) override;
