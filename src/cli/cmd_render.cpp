@@ -277,14 +277,12 @@ Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& confi
     const char* missing = nullptr;
     if (config.render.mode == render::RenderSettings::Mode::kPhoton) {
         missing = "photon mode (--mode photon)";
-    } else if (!o.checkpoint.checkpoint.empty() || !o.checkpoint.resume.empty()) {
-        missing = "checkpoints (--checkpoint, --resume)";
     } else if (!o.trace.empty()) {
         missing = "--trace";
     }
     if (missing == nullptr) return Status::Ok();
     return InvalidArgumentError(
-        "under mpirun nave renders in path mode, without checkpoints or a trace; {} is not "
+        "under mpirun nave renders in path mode, without a trace; {} is not "
         "distributed yet: run it as one process",
         missing);
 }

@@ -166,6 +166,38 @@ TEST_F(MpiRender, ATimeLimitEndsTheRanksTogether) {
     EXPECT_FALSE(Rgb(*dir_ / "limited.exr").empty());
 }
 
+// Checkpoints: rank 0 writes one checkpoint holding every rank's samples and the path guide's
+// credits together, which any number of processes continues: 2 ranks stop after 3 of 8 passes, and
+// 3 ranks or one process finish with the image one process renders with checkpoints, bit for bit.
+TEST_F(MpiRender, RanksWriteACheckpointThatAnyNumberOfProcessesContinues) {
+    auto render = [&](const std::string& out, const std::string& flags) {
+        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() +
+               " --mode path --resolution 96x64 --spp 8 -q -o " + (*dir_ / out).string() + " " +
+               flags;
+    };
+    const std::string one_ckpt = (*dir_ / "one.ckpt").string();
+    const test::CommandResult one = Shell(render("ckpt1.exr", "--checkpoint " + one_ckpt));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const std::vector<float> reference = Rgb(*dir_ / "ckpt1.exr");
+    ASSERT_FALSE(reference.empty());
+
+    const fs::path ranks_ckpt = *dir_ / "ranks.ckpt";
+    const test::CommandResult first = Shell(
+        Mpirun(2) + render("ckpt2.exr", "--checkpoint " + ranks_ckpt.string() + " --stop-after 3"));
+    ASSERT_EQ(first.exit_code, 0) << first.output;
+    ASSERT_TRUE(fs::exists(ranks_ckpt));
+    const fs::path copy = *dir_ / "ranks_copy.ckpt";
+    fs::copy_file(ranks_ckpt, copy, fs::copy_options::overwrite_existing);
+
+    const test::CommandResult three =
+        Shell(Mpirun(3) + render("ckpt3.exr", "--resume " + ranks_ckpt.string()));
+    ASSERT_EQ(three.exit_code, 0) << three.output;
+    EXPECT_EQ(Rgb(*dir_ / "ckpt3.exr"), reference);
+    const test::CommandResult single = Shell(render("ckpt4.exr", "--resume " + copy.string()));
+    ASSERT_EQ(single.exit_code, 0) << single.output;
+    EXPECT_EQ(Rgb(*dir_ / "ckpt4.exr"), reference);
+}
+
 // Each rank pages its own bricks under its own --memory, and the job completes with every ray
 // exchanged (the image is not compared bit for bit: see SetUpTestSuite).
 TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {

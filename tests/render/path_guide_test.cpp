@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <barrier>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -143,23 +144,40 @@ TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
 // Two processes of a distributed render, each crediting half the paths, share their credits
 // before each update: both end with the guide one process crediting every path has, bit for bit,
 // over several updates (each shares only what was credited since the last).
+// The sum over two "processes" of a distributed render, each a thread: each offers its values
+// and waits for the other's.
+class TwoProcessSum {
+  public:
+    std::function<Status(std::span<uint64_t>)> Of(int me) {
+        return [this, me](std::span<uint64_t> values) {
+            offered_[me].assign(values.begin(), values.end());
+            meet_.arrive_and_wait();
+            const std::vector<uint64_t>& other = offered_[1 - me];
+            if (other.size() != values.size()) return InternalError("sizes differ");
+            for (size_t i = 0; i < values.size(); ++i) values[i] += other[i];
+            meet_.arrive_and_wait();  // both have read before either offers again
+            return Status::Ok();
+        };
+    }
+    /// Both guides share their credits, each on its own thread.
+    void Share(PathGuide& a, PathGuide& b) {
+        Status shared[2];
+        std::thread other([&] { shared[1] = b.ShareCredits(Of(1)); });
+        shared[0] = a.ShareCredits(Of(0));
+        other.join();
+        ASSERT_TRUE(shared[0].ok() && shared[1].ok())
+            << shared[0].ToString() << shared[1].ToString();
+    }
+
+  private:
+    std::barrier<> meet_{2};
+    std::vector<uint64_t> offered_[2];
+};
+
 TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
     std::mt19937 rng(11);
     PathGuide one(kBox, 4, 16, 1.0), a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
-    // The sum over the two "processes": each thread offers its values and waits for the other's.
-    std::barrier meet(2);
-    std::vector<uint64_t> offered[2];
-    auto sum_over = [&](int me) {
-        return [&, me](std::span<uint64_t> values) {
-            offered[me].assign(values.begin(), values.end());
-            meet.arrive_and_wait();
-            const std::vector<uint64_t>& other = offered[1 - me];
-            if (other.size() != values.size()) return InternalError("sizes differ");
-            for (size_t i = 0; i < values.size(); ++i) values[i] += other[i];
-            meet.arrive_and_wait();  // both have read before either offers again
-            return Status::Ok();
-        };
-    };
+    TwoProcessSum sum;
     const Vec3f points[2] = {Vec3f(3.5f, 0.5f, 2.5f), Vec3f(0.5f, 3.5f, 1.0f)};
     for (int pass = 0; pass < 3; ++pass) {
         for (int i = 0; i < 4000; ++i) {
@@ -170,12 +188,7 @@ TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
             PathGuide& half = (i / 7) % 2 == 0 ? a : b;
             half.Credit(half.CreditKey(p, kSide, w), v);
         }
-        Status shared[2];
-        std::thread other([&] { shared[1] = b.ShareCredits(sum_over(1)); });
-        shared[0] = a.ShareCredits(sum_over(0));
-        other.join();
-        ASSERT_TRUE(shared[0].ok() && shared[1].ok())
-            << shared[0].ToString() << shared[1].ToString();
+        sum.Share(a, b);
         one.Update();
         a.Update();
         b.Update();
@@ -188,6 +201,54 @@ TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
         EXPECT_EQ(state_b.Take(), bytes) << "pass " << pass;
     }
     EXPECT_TRUE(one.Guides(points[0], kSide));
+}
+
+// A checkpoint of a distributed render: the processes share their credits mid-pass, one saves the
+// guide, and the processes resumed from it share only what they credit afterwards, ending with the
+// guide of one process that credited every path, bit for bit.
+TEST(PathGuide, ProcessesResumedFromASharedCheckpointShareOnlyNewCredits) {
+    std::mt19937 rng(5);
+    PathGuide one(kBox, 4, 16, 1.0), a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
+    const Vec3f p(3.5f, 0.5f, 2.5f);
+    auto credit = [&](int n, PathGuide& x, PathGuide& y) {
+        for (int i = 0; i < n; ++i) {
+            const Vec3f w = UniformDirection(rng);
+            const double v = std::exp(std::uniform_real_distribution<double>(-6, 2)(rng));
+            one.Credit(one.CreditKey(p, kSide, w), v);
+            PathGuide& half = i % 3 == 0 ? x : y;
+            half.Credit(half.CreditKey(p, kSide, w), v);
+        }
+    };
+    TwoProcessSum before;
+    credit(3000, a, b);
+    before.Share(a, b);
+    one.Update();
+    a.Update();
+    b.Update();
+    credit(1500, a, b);
+    before.Share(a, b);  // the checkpoint, mid-pass
+    ByteWriter checkpoint;
+    a.SaveState(&checkpoint);
+    const std::string bytes = checkpoint.Take();
+    PathGuide c(kBox, 4, 16, 1.0), d(kBox, 4, 16, 1.0);
+    for (PathGuide* resumed : {&c, &d}) {
+        ByteReader in(bytes, "checkpoint");
+        ASSERT_TRUE(resumed->LoadState(&in).ok());
+    }
+    credit(1500, c, d);
+    TwoProcessSum after;
+    after.Share(c, d);
+    one.Update();
+    c.Update();
+    d.Update();
+    ByteWriter state_one, state_c, state_d;
+    one.SaveState(&state_one);
+    c.SaveState(&state_c);
+    d.SaveState(&state_d);
+    const std::string expected = state_one.Take();
+    EXPECT_EQ(state_c.Take(), expected);
+    EXPECT_EQ(state_d.Take(), expected);
+    EXPECT_TRUE(one.Guides(p, kSide));
 }
 
 TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {

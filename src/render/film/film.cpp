@@ -164,6 +164,16 @@ Status Film::CombineSums(const std::function<Status(std::span<double>)>& sum_dou
     return Status::Ok();
 }
 
+void Film::Clear() {
+    for (size_t i = 0; i < pixel_count() * 3; ++i) xyz_[i].store(0, std::memory_order_relaxed);
+    for (size_t i = 0; i < pixel_count() * 2; ++i) y_half_[i].store(0, std::memory_order_relaxed);
+    if (aov_) {
+        for (size_t i = 0; i < pixel_count() * 7; ++i) aov_[i].store(0, std::memory_order_relaxed);
+        for (size_t i = 0; i < pixel_count(); ++i)
+            aov_count_[i].store(0, std::memory_order_relaxed);
+    }
+}
+
 void Film::SaveState(ByteWriter* out) const {
     out->Reserve(StateBytes(width_, height_, aov_ != nullptr));
     out->Put(int32_t(width_));

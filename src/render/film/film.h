@@ -102,6 +102,9 @@ class Film {
     Status CombineSums(const std::function<Status(std::span<double>)>& sum_doubles,
                        const std::function<Status(std::span<float>)>& sum_floats,
                        const std::function<Status(std::span<uint32_t>)>& sum_counts);
+    /// Sets every sum to zero: a process of a distributed render whose samples another process's
+    /// film now holds (RenderSession's checkpoints). Not concurrent with adds.
+    void Clear();
     /// Linear RGB of the output space (sRGB primaries) after white balance, per pixel.
     std::vector<float> LinearRgb() const;
 

@@ -64,6 +64,9 @@ class Integrator {
     /// with none yet): what NoiseEstimate measures. In a distributed render each process's are the
     /// part of the image it traced, and their sums over the processes are the whole image's.
     virtual std::array<double, 2> HalfLuminances(uint32_t pixel, int done) const = 0;
+    /// In a distributed render, before a checkpoint: makes the state Save writes (what its guides
+    /// learned) every process's together, in every process. Collective.
+    virtual Status ShareState(RankGroup& ranks) = 0;
     /// Adds its state (guides, visible points) to a checkpoint.
     virtual void Save(Checkpoint* checkpoint) const = 0;
     /// After the last round: traces what is still in flight, completes the film for `done` rounds

@@ -59,6 +59,12 @@ Status PathIntegrator::Restore(const RenderSession& session) {
     return in.ExpectEnd();
 }
 
+Status PathIntegrator::ShareState(RankGroup& ranks) {
+    if (!owned_guide_) return Status::Ok();
+    return owned_guide_->ShareCredits(
+        [&](std::span<uint64_t> values) { return ranks.SumEverywhere(values); });
+}
+
 void PathIntegrator::Save(Checkpoint* checkpoint) const {
     if (!owned_guide_) return;
     ByteWriter out;

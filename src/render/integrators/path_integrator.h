@@ -30,6 +30,8 @@ class PathIntegrator final : public Integrator, public CameraPaths {
     StatusOr<int> RenderRounds(int passes, bool boundaries) override;
     double NoiseEstimate(int passes) const override;
     std::array<double, 2> HalfLuminances(uint32_t pixel, int passes) const override;
+    /// The path guide's credits, summed over the processes (PathGuide::ShareCredits).
+    Status ShareState(RankGroup& ranks) override;
     void Save(Checkpoint* checkpoint) const override;
     Status Finish(int passes, RenderStats* stats) override;
 

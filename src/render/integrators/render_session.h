@@ -16,6 +16,8 @@
 
 namespace nave::render {
 
+class RankGroup;
+
 /// What the command asks of the run.
 struct SessionOptions {
     /// Continue from this state (already checked against `identity`); null: from the start. The
@@ -50,7 +52,10 @@ uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int he
 class RenderSession {
   public:
     /// `options` null: a render in one run (no resume, no checkpoints, never stops early).
-    RenderSession(const SessionOptions* options, Film* film);
+    /// `ranks`: the processes of a distributed render (null: one process), which agree on every
+    /// boundary's decisions; the first of them writes the checkpoints and restores the film from
+    /// one (docs/distributed.md, "Checkpoints").
+    RenderSession(const SessionOptions* options, Film* film, RankGroup* ranks = nullptr);
 
     bool active() const { return options_ != nullptr && options_->active(); }
     /// The checkpoint this run continues from, or null.
@@ -58,8 +63,9 @@ class RenderSession {
     /// Passes or iterations done before this run, and the seconds they took.
     int start() const { return start_; }
     double elapsed_before_s() const { return elapsed_before_s_; }
-    /// Restores the film from the checkpoint (nothing without one). Errors: a film section of
-    /// another size or truncated.
+    /// Restores the film from the checkpoint (nothing without one; in a distributed render, the
+    /// first process's only: the others' films start empty). Errors: a film section of another
+    /// size or truncated.
     Status RestoreFilm();
     /// The file resumed from, for messages.
     const std::string& resume_name() const { return options_->resume_name; }
@@ -71,12 +77,18 @@ class RenderSession {
     /// Called after `done` passes or iterations in all, `elapsed_s` seconds of rendering in all;
     /// `last`: the render ends here anyway. Writes a checkpoint when one is due (or this run ends
     /// here) with the film and the sections `save` adds; sets `*stop` when this run ends here.
+    /// In a distributed render it is collective: the processes end the run or write a checkpoint
+    /// when one of them asks to (a signal, its clock); then the films are summed into the first
+    /// process's (the others' are cleared), `share` makes the integrator's state every process's,
+    /// and the first process writes.
     Status AtBoundary(int done, double elapsed_s, bool last,
+                      const std::function<Status(RankGroup&)>& share,
                       const std::function<void(Checkpoint*)>& save, bool* stop);
 
   private:
     const SessionOptions* options_;
     Film* film_;
+    RankGroup* ranks_;
     int start_ = 0;
     double elapsed_before_s_ = 0;
     std::chrono::steady_clock::time_point last_write_;

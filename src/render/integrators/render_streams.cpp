@@ -84,6 +84,7 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
         bool end_run = false;
         NAVE_RETURN_IF_ERROR(session.AtBoundary(
             done, stop.Elapsed(), enough || done >= wanted,
+            [&](RankGroup& group) { return integrator.ShareState(group); },
             [&](Checkpoint* checkpoint) { integrator.Save(checkpoint); }, &end_run));
         if (enough || end_run) break;
     }
@@ -117,7 +118,7 @@ Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, B
                 std::unique_ptr<StreamScheduler> scheduler,
                 StreamScheduler::Create(*scene.source, paging != nullptr ? *paging : PagerOptions(),
                                         std::move(picker), scene.settings.wave_paths, ranks));
-            RenderSession session(session_options, film);
+            RenderSession session(session_options, film, ranks);
             const auto start = std::chrono::steady_clock::now();
             const BrickSourceStats before = scene.source->stats();
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<Integrator> integrator,

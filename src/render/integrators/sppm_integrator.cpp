@@ -157,6 +157,13 @@ Status SppmIntegrator::Finish(int done, RenderStats* stats) {
     return Status::Ok();
 }
 
+Status SppmIntegrator::ShareState(RankGroup& ranks) {
+    return UnsupportedError(
+        "photon mode's visible points and guides are not shared between the {} processes of a "
+        "distributed render",
+        ranks.size());
+}
+
 double SppmIntegrator::NoiseEstimate(int iterations) const {
     if (iterations < 2) return std::nan("");
     // Pixel by pixel: no image is held.

@@ -37,6 +37,9 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     /// From the two halves of the film's samples and of the photons (visible_points.h).
     double NoiseEstimate(int iterations) const override;
     std::array<double, 2> HalfLuminances(uint32_t pixel, int iterations) const override;
+    /// Photon mode is not distributed yet (refused under mpirun before anything is read): an
+    /// Unsupported error.
+    Status ShareState(RankGroup& ranks) override;
     void Save(Checkpoint* checkpoint) const override;
     /// Adds the photon estimate of the `done` iterations to the film.
     Status Finish(int done, RenderStats* stats) override;

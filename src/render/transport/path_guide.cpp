@@ -183,9 +183,9 @@ void PathGuide::Update(uint32_t min_credits) {
     }
 }
 
-Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>& sum) {
-    // Everything credited, flattened: the levels' counts, then each cell's bins and credit count.
-    // Cells only ever join at the end (Update), so earlier entries keep their place.
+std::vector<uint64_t> PathGuide::FlatCredits() const {
+    // The levels' counts, then each cell's bins and credit count. Cells only ever join at the end
+    // (Update), so earlier entries keep their place.
     size_t size = 0;
     for (const Level& level : levels_) size += level.size;
     size += cells_.size() * (kBins + 1);
@@ -198,11 +198,17 @@ Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>&
         for (int b = 0; b < kBins; ++b) values[at++] = cell->sum[b];
         values[at++] = cell->credits;
     }
+    return values;
+}
+
+Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>& sum) {
+    std::vector<uint64_t> values = FlatCredits();
+    const size_t size = values.size();
     shared_.resize(size, 0);  // new cells: nothing shared yet
     for (size_t i = 0; i < size; ++i) values[i] -= shared_[i];
     NAVE_RETURN_IF_ERROR(sum(values));
     for (size_t i = 0; i < size; ++i) shared_[i] += values[i];
-    at = 0;
+    size_t at = 0;
     for (Level& level : levels_) {
         for (uint32_t i = 0; i < level.size; ++i) level.count[i] = uint32_t(shared_[at++]);
     }
@@ -259,6 +265,10 @@ Status PathGuide::LoadState(ByteReader* in) {
         cells_.push_back(std::move(cell));
     }
     NAVE_RETURN_IF_ERROR(in->Get(&cells_guiding_, "guiding cell count"));
+    // What a checkpoint holds is every process's credits together (a distributed render shares
+    // them before it writes one): each process that resumes from it shares only what it credits
+    // after.
+    shared_ = FlatCredits();
     return Status::Ok();
 }
 

@@ -108,7 +108,8 @@ class PathGuide {
     /// The solid-angle pdf of Sample at `p`, `side` for direction `w` (0 if no cell there guides).
     float Pdf(const Vec3f& p, int side, const Vec3f& w) const;
 
-    /// In a distributed render (docs/distributed.md), before each Update: gives every process's
+    /// In a distributed render (docs/distributed.md), before each Update and before a checkpoint
+    /// is written: gives every process's
     /// guide the credits of all. `sum` replaces its values by their sums over the processes; each
     /// process passes what it credited since the last call, so every guide ends with the same
     /// credits, those one process would have (they are integers: the order of sums does not
@@ -155,6 +156,8 @@ class PathGuide {
     Level levels_[kLevels];  // coarse to fine
     std::vector<std::unique_ptr<Cell>> cells_;
     uint32_t cells_guiding_ = 0;
+    /// Everything credited, flattened as ShareCredits sums it.
+    std::vector<uint64_t> FlatCredits() const;
     // The credits as of the last ShareCredits (every count, then every cell's sums and credits),
     // all processes' together: what this process credited since is its values minus these.
     std::vector<uint64_t> shared_;
