@@ -277,13 +277,11 @@ Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& confi
     const char* missing = nullptr;
     if (config.render.mode == render::RenderSettings::Mode::kPhoton) {
         missing = "photon mode (--mode photon)";
-    } else if (!o.trace.empty()) {
-        missing = "--trace";
     }
     if (missing == nullptr) return Status::Ok();
     return InvalidArgumentError(
-        "under mpirun nave renders in path mode, without a trace; {} is not "
-        "distributed yet: run it as one process",
+        "under mpirun nave renders in path mode; {} is not distributed yet: run it as one "
+        "process",
         missing);
 }
 
@@ -319,7 +317,15 @@ Status RunRender(const RenderOptions& o) {
               scene.sun >= 0 ? ", sun " + scene.sun_description : std::string());
 
     std::unique_ptr<TraceRecorder> trace;
-    if (!o.trace.empty()) trace = std::make_unique<TraceRecorder>();
+    std::filesystem::path trace_path = o.trace;
+    if (!o.trace.empty()) {
+        trace = std::make_unique<TraceRecorder>();
+        if (ranks != nullptr) {
+            // A file per rank, each rank a process of its own in the viewer once merged.
+            trace_path = TracePathOfRank(o.trace, ranks->rank());
+            trace->NameProcess(ranks->rank(), "nave " + RankName());
+        }
+    }
     NAVE_ASSIGN_OR_RETURN(render::PagerOptions pager, BuildPagerOptions(o, out, trace.get()));
     // The brick sizes the memory plan counts depend on how their BVHs are built.
     NAVE_RETURN_IF_ERROR(source.SetBvhSettings(pager.bvh));
@@ -338,11 +344,11 @@ Status RunRender(const RenderOptions& o) {
     for (uint32_t b = 0; b < source.slot_count(); ++b) source.Evict(b);
     ReturnFreeMemory();
 
+    if (trace) NAVE_RETURN_IF_ERROR(trace->Write(trace_path).WithContext("--trace"));
     // Every rank holds the whole image (RenderStreams sums the films); rank 0 writes it.
     if (ranks != nullptr && ranks->rank() != 0) return Status::Ok();
     render::RenderSummary summary(scene.settings, stats, TextureFacts(textures.get()));
     NAVE_RETURN_IF_ERROR(WriteImage(o, model, out, scene, film, summary));
-    if (trace) NAVE_RETURN_IF_ERROR(trace->Write(o.trace).WithContext("--trace"));
     PrintSummary(o, out, &summary);
     return Status::Ok();
 }

@@ -81,6 +81,13 @@ std::string RankName() {
     return "";
 }
 
+std::filesystem::path TracePathOfRank(const std::filesystem::path& path, int rank) {
+    std::filesystem::path out = path;
+    out.replace_filename(path.stem().string() + ".rank" + std::to_string(rank) +
+                         path.extension().string());
+    return out;
+}
+
 void EndAllRanksAfterError(int exit_code) {
 #ifdef NAVE_HAVE_MPI
     if (State().group) render::MpiRuntime::AbortAll(exit_code);

@@ -2,6 +2,7 @@
 // nave under mpirun (docs/distributed.md): whether this process is one rank of an MPI job, MPI's
 // lifetime in the `nave` executable, and the end of the whole job when one rank fails.
 
+#include <filesystem>
 #include <string>
 
 #include "src/core/status.h"
@@ -20,6 +21,9 @@ StatusOr<render::RankGroup*> JoinRanks();
 
 /// Where a failed rank is named: "rank 2 of 4 on node7" ("" outside a distributed render).
 std::string RankName();
+/// Where rank `rank` of a distributed render writes the trace the user asked at `path`:
+/// "render.json" -> "render.rank1.json".
+std::filesystem::path TracePathOfRank(const std::filesystem::path& path, int rank);
 
 /// Ends every rank of a distributed render after this one failed (MPI_Abort with `exit_code`): the
 /// others may be waiting for its rays. Returns at once when there is no distributed render.

@@ -38,7 +38,8 @@ void AppendMicroseconds(std::string& out, int64_t ns) {
 
 }  // namespace
 
-TraceRecorder::TraceRecorder(size_t max_events) : max_events_(max_events), origin_(Clock::now()) {}
+TraceRecorder::TraceRecorder(size_t max_events)
+    : max_events_(max_events), origin_(Clock::now()), process_id_(int(::getpid())) {}
 
 bool TraceRecorder::Admit(Clock::time_point now) {
     if (events_.size() < max_events_) return true;
@@ -142,6 +143,12 @@ void TraceRecorder::NameThread(std::string_view name) {
     thread_names_[ThreadId()] = std::string(name);
 }
 
+void TraceRecorder::NameProcess(int id, std::string_view name) {
+    std::lock_guard lock(mutex_);
+    process_id_ = id;
+    process_name_ = std::string(name);
+}
+
 size_t TraceRecorder::event_count() const {
     std::lock_guard lock(mutex_);
     return events_.size();
@@ -160,6 +167,8 @@ Status TraceRecorder::Write(const std::filesystem::path& path) const {
     std::vector<StoredSeries> series;
     std::vector<std::string> names;
     std::map<uint32_t, std::string> thread_names;
+    int pid;
+    std::string process_name;
     uint64_t dropped;
     int64_t first_drop_ns;
     uint32_t first_drop_tid;
@@ -170,6 +179,8 @@ Status TraceRecorder::Write(const std::filesystem::path& path) const {
         series = series_;
         names = names_;
         thread_names = thread_names_;
+        pid = process_id_;
+        process_name = process_name_;
         dropped = dropped_;
         first_drop_ns = first_drop_ns_;
         first_drop_tid = first_drop_tid_;
@@ -188,7 +199,6 @@ Status TraceRecorder::Write(const std::filesystem::path& path) const {
     if (!file.ok())
         return file.status().WithContext(fmt::format("writing trace {}", path.string()));
 
-    const int pid = static_cast<int>(::getpid());
     std::string out;
     out.reserve(kFlushBytes + 4096);
     auto flush = [&]() -> Status {
@@ -208,7 +218,9 @@ Status TraceRecorder::Write(const std::filesystem::path& path) const {
 
     out += "{\"traceEvents\":[";
     begin_event("process_name", 'M', 0);
-    out += ",\"args\":{\"name\":\"nave\"}}";
+    out += ",\"args\":{\"name\":";
+    AppendJsonString(out, process_name);
+    out += "}}";
     for (const auto& [tid, name] : thread_names) {
         begin_event("thread_name", 'M', tid);
         out += ",\"args\":{\"name\":";

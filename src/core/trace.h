@@ -98,6 +98,10 @@ class TraceRecorder {
                  std::initializer_list<TraceArg> args = {});
     /// Names the calling thread's track ("main", "worker 3", "prefetch"); the last name given wins.
     void NameThread(std::string_view name);
+    /// The process the trace shows its threads under: its id in the file (the operating system's
+    /// process id unless set) and its name ("nave"). Traces of several processes written with
+    /// distinct ids merge into one view (docs/distributed.md, "Traces").
+    void NameProcess(int id, std::string_view name);
 
     /// Writes every event recorded so far to `path` (through AtomicFile: the file appears complete
     /// or not at all). Events are sorted by start time, enclosing spans before the spans they
@@ -154,6 +158,8 @@ class TraceRecorder {
     std::map<std::string, uint32_t, std::less<>> name_ids_;
     std::unordered_map<std::thread::id, uint32_t> thread_ids_;
     std::map<uint32_t, std::string> thread_names_;
+    int process_id_;  // NameProcess, else getpid()
+    std::string process_name_ = "nave";
     uint64_t dropped_ = 0;
     int64_t first_drop_ns_ = 0;
     uint32_t first_drop_tid_ = 0;

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -196,6 +197,26 @@ TEST_F(MpiRender, RanksWriteACheckpointThatAnyNumberOfProcessesContinues) {
     const test::CommandResult single = Shell(render("ckpt4.exr", "--resume " + copy.string()));
     ASSERT_EQ(single.exit_code, 0) << single.output;
     EXPECT_EQ(Rgb(*dir_ / "ckpt4.exr"), reference);
+}
+
+// --trace: each rank writes its own trace beside the path asked for, as a process of its own (its
+// rank), so that the files merge into one view.
+TEST_F(MpiRender, EachRankWritesItsOwnTrace) {
+    const fs::path trace = *dir_ / "render.json";
+    const test::CommandResult r =
+        Shell(Mpirun(2) + Render("traced.exr") + " --trace " + trace.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_FALSE(fs::exists(trace));
+    for (int rank : {0, 1}) {
+        SCOPED_TRACE(::testing::Message() << "rank " << rank);
+        std::ifstream in(*dir_ / ("render.rank" + std::to_string(rank) + ".json"));
+        ASSERT_TRUE(in.good());
+        const std::string text((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+        EXPECT_NE(text.find("\"pid\":" + std::to_string(rank) + ","), std::string::npos);
+        EXPECT_NE(text.find("nave rank " + std::to_string(rank) + " of 2 on "), std::string::npos);
+        EXPECT_NE(text.find("\"batch\""), std::string::npos) << "no batches traced";
+    }
 }
 
 // Each rank pages its own bricks under its own --memory, and the job completes with every ray
