@@ -53,7 +53,7 @@ StatusOr<bool> StopEverywhere(const Integrator& integrator, int done, size_t pix
 /// ends the render or the session ends this run, then has it complete the film and fill `stats`:
 /// the part every mode shares (resume, progress, the stopping rule, checkpoints).
 Status RenderRounds(const RenderSettings& settings, Integrator& integrator, RenderSession& session,
-                    Film* film, RankGroup* ranks, RenderStats* stats) {
+                    Film* film, RayExchange& exchange, RankGroup* ranks, RenderStats* stats) {
     const int start = session.start();
     NAVE_RETURN_IF_ERROR(session.RestoreFilm());
     if (session.resume() != nullptr) NAVE_RETURN_IF_ERROR(integrator.Restore(session));
@@ -65,10 +65,16 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
                          std::string(units.unit));
     progress.Add(units.per_round * uint64_t(start));
     integrator.set_progress(&progress);
+    // In a distributed render paths end in every process: the others report theirs to this bar.
+    exchange.ShareProgress(&progress);
     struct Unset {
         Integrator& integrator;
-        ~Unset() { integrator.set_progress(nullptr); }
-    } unset{integrator};  // before `progress` goes, whichever way this returns
+        RayExchange& exchange;
+        ~Unset() {
+            integrator.set_progress(nullptr);
+            exchange.ShareProgress(nullptr);
+        }
+    } unset{integrator, exchange};  // before `progress` goes, whichever way this returns
     StoppingRule stop(settings, &progress, session.elapsed_before_s());
     const bool checks = settings.noise_target > 0 || settings.time_limit_s > 0;
     int done = start;
@@ -89,6 +95,7 @@ Status RenderRounds(const RenderSettings& settings, Integrator& integrator, Rend
         if (enough || end_run) break;
     }
     NAVE_RETURN_IF_ERROR(integrator.Finish(done, stats));
+    NAVE_RETURN_IF_ERROR(exchange.FinishProgress());
     if (ranks != nullptr) {
         // Each process's film holds the samples it traced: the image is their sum, in every one.
         NAVE_RETURN_IF_ERROR(
@@ -123,8 +130,8 @@ Status RenderStreams(const RenderScene& scene, Film* film, RenderStats* stats, B
             const BrickSourceStats before = scene.source->stats();
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<Integrator> integrator,
                                   Integrator::Create(scene, film, *scheduler));
-            NAVE_RETURN_IF_ERROR(
-                RenderRounds(scene.settings, *integrator, session, film, ranks, stats));
+            NAVE_RETURN_IF_ERROR(RenderRounds(scene.settings, *integrator, session, film,
+                                              scheduler->exchange(), ranks, stats));
             stats->wall_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             scheduler->FillStats(before, stats);

@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <deque>
+#include <iterator>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <utility>
 
+#include "src/core/progress.h"
 #include "src/render/stream/mpi_runtime.h"
 #include "src/render/stream/ray_message.h"
 
@@ -17,8 +20,11 @@ namespace nave::render {
 
 namespace {
 
-// The tag of ray messages on the exchange's own communicator.
+// The tags of ray messages and of progress reports on the exchange's own communicator.
 constexpr int kRaysTag = 1;
+constexpr int kProgressTag = 2;
+// Least time between two progress reports of a rank: the bar redraws about as often.
+constexpr double kProgressReportSeconds = 0.5;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -56,6 +62,11 @@ struct MpiRayExchange::Impl {
     StatusOr<bool> Receive();
     // One step of progress with nothing else to do: sends and receipts.
     StatusOr<bool> Step();
+    // Progress reports: a rank other than 0 sends what its bar gained since its last report (at
+    // once with `now`, else after kProgressReportSeconds), and completes the reports sent; rank 0
+    // adds the reports that have arrived to its bar.
+    Status Report(bool now);
+    Status ReceiveReports();
 
     MPI_Comm rays_comm = MPI_COMM_NULL;  // point-to-point ray messages
     MPI_Comm sum_comm = MPI_COMM_NULL;   // the termination rounds' sums
@@ -70,6 +81,12 @@ struct MpiRayExchange::Impl {
     uint64_t last_sums[2] = {0, 0};
     bool have_last_sums = false;
     std::vector<std::byte> receive_buffer;
+    // Progress sharing (ShareProgress); the exchange's thread only.
+    ProgressBar* bar = nullptr;
+    uint64_t reported = 0;  // the bar's count at the last report
+    std::chrono::steady_clock::time_point last_report;
+    std::deque<Posted> reports;  // sent, not yet complete
+    uint64_t reports_sent = 0, reports_received = 0;
 };
 
 StatusOr<std::unique_ptr<MpiRayExchange>> MpiRayExchange::Create(
@@ -118,6 +135,10 @@ MpiRayExchange::~MpiRayExchange() {
             MPI_Cancel(&p.request);
             MPI_Request_free(&p.request);
         }
+    }
+    for (Impl::Posted& p : impl_->reports) {
+        MPI_Cancel(&p.request);
+        MPI_Request_free(&p.request);
     }
     MPI_Comm_free(&impl_->rays_comm);
     MPI_Comm_free(&impl_->sum_comm);
@@ -240,7 +261,51 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
     }
 }
 
+Status MpiRayExchange::Impl::Report(bool now) {
+    for (auto it = reports.begin(); it != reports.end();) {
+        int done = 0;
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        it = done ? reports.erase(it) : std::next(it);
+    }
+    if (bar == nullptr || rank == 0) return Status::Ok();
+    if (!now && SecondsSince(last_report) < kProgressReportSeconds) return Status::Ok();
+    const uint64_t done = bar->done();
+    if (done == reported) return Status::Ok();
+    const uint64_t gained = done - reported;
+    Posted& p = reports.emplace_back();
+    p.bytes.resize(sizeof(gained));
+    std::memcpy(p.bytes.data(), &gained, sizeof(gained));
+    NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE, 0,
+                                             kProgressTag, rays_comm, &p.request),
+                                   "MPI_Isend"));
+    reported = done;
+    last_report = std::chrono::steady_clock::now();
+    ++reports_sent;
+    return Status::Ok();
+}
+
+Status MpiRayExchange::Impl::ReceiveReports() {
+    if (rank != 0) return Status::Ok();
+    while (true) {
+        int arrived = 0;
+        MPI_Status status;
+        NAVE_RETURN_IF_ERROR(MpiStatus(
+            MPI_Iprobe(MPI_ANY_SOURCE, kProgressTag, rays_comm, &arrived, &status), "MPI_Iprobe"));
+        if (!arrived) return Status::Ok();
+        uint64_t gained = 0;
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Recv(&gained, int(sizeof(gained)), MPI_BYTE, status.MPI_SOURCE,
+                               kProgressTag, rays_comm, MPI_STATUS_IGNORE),
+                      "MPI_Recv"));
+        ++reports_received;
+        if (bar != nullptr) bar->Add(gained);
+    }
+}
+
 StatusOr<bool> MpiRayExchange::Impl::Step() {
+    NAVE_RETURN_IF_ERROR(Report(false));
+    NAVE_RETURN_IF_ERROR(ReceiveReports());
     bool any = false;
     for (int dest = 0; dest < size; ++dest) {
         if (dest == rank) continue;
@@ -295,6 +360,37 @@ StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
             return false;
         }
     }
+}
+
+void MpiRayExchange::ShareProgress(ProgressBar* bar) {
+    impl_->bar = bar;
+    impl_->reported = bar != nullptr ? bar->done() : 0;
+    impl_->last_report = std::chrono::steady_clock::now();
+}
+
+Status MpiRayExchange::FinishProgress() {
+    Impl& m = *impl_;
+    NAVE_RETURN_IF_ERROR(m.Report(true));
+    for (Impl::Posted& p : m.reports) {
+        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Wait(&p.request, MPI_STATUS_IGNORE), "MPI_Wait"));
+    }
+    m.reports.clear();
+    // Every report sent is received before the bar goes: rank 0 learns how many there were.
+    uint64_t sent = 0;
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Allreduce(&m.reports_sent, &sent, 1, MPI_UINT64_T, MPI_SUM, m.sum_comm),
+                  "MPI_Allreduce"));
+    while (m.rank == 0 && m.reports_received < sent) {
+        uint64_t gained = 0;
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Recv(&gained, int(sizeof(gained)), MPI_BYTE, MPI_ANY_SOURCE, kProgressTag,
+                               m.rays_comm, MPI_STATUS_IGNORE),
+                      "MPI_Recv"));
+        ++m.reports_received;
+        if (m.bar != nullptr) m.bar->Add(gained);
+    }
+    m.bar = nullptr;
+    return Status::Ok();
 }
 
 StatusOr<ExchangeCounts> MpiRayExchange::TotalCounts() const {

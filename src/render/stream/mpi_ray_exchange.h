@@ -67,6 +67,9 @@ class MpiRayExchange final : public RayExchange {
     /// kInternal naming both sums when they differ. Collective; call after WaitForRaysOrEnd
     /// returned true.
     StatusOr<ExchangeCounts> TotalCounts() const override;
+    /// Reports go to rank 0 as small messages of their own, at most every half second per rank.
+    void ShareProgress(ProgressBar* bar) override;
+    Status FinishProgress() override;
 
   private:
     struct Impl;

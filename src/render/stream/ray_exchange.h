@@ -15,6 +15,10 @@
 #include "src/render/stream/ray.h"
 #include "src/render/stream/ray_queue.h"
 
+namespace nave {
+class ProgressBar;
+}
+
 namespace nave::render {
 
 /// What the exchange of a distributed render did: one process's, or (TotalCounts) every one's
@@ -49,6 +53,15 @@ class RayExchange {
     /// (kInternal naming both sums otherwise). Collective, after the last drain. One process:
     /// nothing sent.
     virtual StatusOr<ExchangeCounts> TotalCounts() const { return ExchangeCounts{}; }
+    /// Work counted where it ends (a path ends in the process that traces its last ray) on
+    /// `bar`, which the first process shows: while rays are traced and awaited, the other
+    /// processes report what was added to their `bar` since their last report, and the first adds
+    /// the reports to its own, so that the bar the user sees counts the whole job. `bar` must
+    /// outlive the sharing; null stops it. One process: nothing to share.
+    virtual void ShareProgress(ProgressBar* bar) { (void)bar; }
+    /// After the last drain of the work `bar` counts: the last reports are sent and added, then
+    /// the sharing stops. Collective. One process: nothing to do.
+    virtual Status FinishProgress() { return Status::Ok(); }
 };
 
 /// The processes of a distributed render as the renderer sees them (docs/distributed.md): their

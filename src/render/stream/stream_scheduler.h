@@ -118,6 +118,8 @@ class StreamScheduler {
     bool MakesHere(RayRecord r, uint64_t index) const;
     /// The processes of a distributed render (null: one process).
     RankGroup* ranks() const { return ranks_; }
+    /// Where rays leaving a batch go: this process's queues, or the group's exchange.
+    RayExchange& exchange() const { return *exchange_; }
     /// Sends the rays of `out` to the exchange, grouped by brick, adds its counts to the render's
     /// and empties it.
     void Flush(RayOutbox& out);
