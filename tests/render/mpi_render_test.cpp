@@ -108,6 +108,11 @@ TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
         EXPECT_NE(r.output.find("ranks " + std::to_string(ranks) + ": "), std::string::npos)
             << r.output;
         EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
+        // Each rank reads only its own bricks, for the render and for the scan of the model's
+        // portals: rank 0 loads fewer than the store's 64.
+        const size_t loads = r.output.find(", loads ");
+        ASSERT_NE(loads, std::string::npos) << r.output;
+        EXPECT_LT(std::atoi(r.output.c_str() + loads + 8), 64) << r.output;
         // Paths end on every rank, and rank 0's bar counts them all: 96 x 64 x 4.
         EXPECT_NE(r.output.find("render 100.0% 24.6 k paths"), std::string::npos) << r.output;
         EXPECT_EQ(r.output.find("nave render: wrote", r.output.find("nave render: wrote") + 1),
@@ -224,7 +229,20 @@ TEST_F(MpiRender, EachRankWritesItsOwnTrace) {
 // Each rank pages its own bricks under its own --memory, and the job completes with every ray
 // exchanged (the image is not compared bit for bit: see SetUpTestSuite).
 TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {
-    const test::CommandResult r = Shell(Mpirun(2) + Render("paged.exr") + " --memory 330M");
+    // The smallest --memory a rank of this build can render with (MPI and sanitizers make the
+    // process larger), from the refusal of a budget far too small, and 64 MiB more (the reserve
+    // for the ray queues grows with --memory, the rest goes to bricks): a rank's 32 bricks take
+    // 68 MiB.
+    const test::CommandResult refused = Shell(Mpirun(2) + Render("probe.exr") + " --memory 1M");
+    ASSERT_NE(refused.exit_code, 0) << refused.output;
+    const size_t needed = refused.output.find(" bytes) is needed");
+    ASSERT_NE(needed, std::string::npos) << refused.output;
+    const size_t number = refused.output.rfind('(', needed);
+    ASSERT_NE(number, std::string::npos) << refused.output;
+    const uint64_t minimum = std::strtoull(refused.output.c_str() + number + 1, nullptr, 10);
+    ASSERT_GT(minimum, 0u) << refused.output;
+    const std::string memory = std::to_string((minimum >> 20) + 64) + "M";
+    const test::CommandResult r = Shell(Mpirun(2) + Render("paged.exr") + " --memory " + memory);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
     const size_t evictions = r.output.find("evictions ");

@@ -3,6 +3,8 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
 
 #include "src/render/stream/mpi_runtime.h"
 
@@ -66,6 +68,33 @@ Status MpiRankGroup::SumEverywhere(std::span<uint32_t> values) {
 }
 Status MpiRankGroup::SumEverywhere(std::span<uint64_t> values) {
     return SumInParts(comm_->comm, values, MPI_UINT64_T);
+}
+
+StatusOr<std::vector<std::byte>> MpiRankGroup::GatherEverywhere(std::span<const std::byte> mine) {
+    const int64_t size = int64_t(mine.size());
+    const auto ranks = static_cast<size_t>(size_);
+    std::vector<int64_t> sizes(ranks, 0);
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Allgather(&size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, comm_->comm),
+                  "MPI_Allgather"));
+    std::vector<int> counts(ranks), offsets(ranks);
+    int64_t total = 0;
+    for (int r = 0; r < size_; ++r) {
+        offsets[size_t(r)] = int(total);
+        counts[size_t(r)] = int(sizes[size_t(r)]);
+        total += sizes[size_t(r)];
+        if (total > int64_t(std::numeric_limits<int>::max())) {
+            return ResourceExhaustedError(
+                "MPI: {} bytes to gather from {} ranks, more than the {} one gather can count",
+                total, size_, std::numeric_limits<int>::max());
+        }
+    }
+    std::vector<std::byte> all(static_cast<size_t>(total));
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Allgatherv(mine.data(), int(mine.size()), MPI_BYTE, all.data(), counts.data(),
+                                 offsets.data(), MPI_BYTE, comm_->comm),
+                  "MPI_Allgatherv"));
+    return all;
 }
 
 }  // namespace nave::render

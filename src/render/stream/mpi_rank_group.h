@@ -24,6 +24,7 @@ class MpiRankGroup final : public RankGroup {
     Status SumEverywhere(std::span<float> values) override;
     Status SumEverywhere(std::span<uint32_t> values) override;
     Status SumEverywhere(std::span<uint64_t> values) override;
+    StatusOr<std::vector<std::byte>> GatherEverywhere(std::span<const std::byte> mine) override;
 
   private:
     MpiRankGroup() = default;

@@ -6,6 +6,7 @@
 // onto the brick's queue (LocalRayExchange); bricks owned by several processes need an exchange
 // that forwards the rays of the bricks owned elsewhere to their owner.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -81,6 +82,9 @@ class RankGroup {
     virtual Status SumEverywhere(std::span<float> values) = 0;
     virtual Status SumEverywhere(std::span<uint32_t> values) = 0;
     virtual Status SumEverywhere(std::span<uint64_t> values) = 0;
+    /// Every process's `mine` put end to end in rank order, in every process. Errors: more than
+    /// 2 GiB in all (MPI counts bytes in an int). Collective.
+    virtual StatusOr<std::vector<std::byte>> GatherEverywhere(std::span<const std::byte> mine) = 0;
 };
 
 /// The exchange of a single process: it owns every brick, and rays sent to a brick wait in its

@@ -108,12 +108,19 @@ Status StreamScheduler::ForEachBrick(
     const auto slot_of = [&](uint32_t b) {
         return source_.SlotOf(b, detail == ScanDetail::kFull ? 0 : source_.LevelsOf(b) - 1);
     };
+    // A process of a distributed render reads its own bricks only (the others read theirs).
+    std::vector<uint32_t> bricks;
     for (uint32_t b = 0; b < count; ++b) {
+        if (exchange_->Owns(slot_of(b))) bricks.push_back(b);
+    }
+    if (bricks.size() != count) progress.SetTotal(bricks.size());
+    for (size_t i = 0; i < bricks.size(); ++i) {
+        const uint32_t b = bricks[i];
         const uint32_t slot = slot_of(b);
         // The next bricks, the nearest ranked first, as if rays waited for them.
         ahead[slot] = 0;
-        for (uint32_t n = b + 1; n < std::min(count, b + 1 + kAhead); ++n)
-            ahead[slot_of(n)] = kAhead + 1 - (n - b);
+        for (size_t n = i + 1; n < std::min(bricks.size(), i + 1 + kAhead); ++n)
+            ahead[slot_of(bricks[n])] = kAhead + 1 - (n - i);
         pager_->Prefetch(ahead, slot, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(slot));
         NAVE_RETURN_IF_ERROR(visit(b, *handle));

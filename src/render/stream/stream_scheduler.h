@@ -104,7 +104,9 @@ class StreamScheduler {
     /// Pins every brick in turn, in order, for `visit` (a pass over the whole model before the
     /// render: the sky's portals, the light sources), at `detail`, while the pager's loaders load
     /// the next few: the loads then run on every core instead of one after another on this thread.
-    /// `task` names the pass on its progress bar. Errors: a brick that cannot be pinned, `visit`'s.
+    /// `task` names the pass on its progress bar. In a distributed render only the bricks this
+    /// process owns are visited: each process scans its own, and the caller gathers what it
+    /// needs of the others'. Errors: a brick that cannot be pinned, `visit`'s.
     Status ForEachBrick(std::string_view task, ScanDetail detail,
                         const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit);
     /// Sets r's segment to the first brick after `from_t` other than `current`'s; returns its slot

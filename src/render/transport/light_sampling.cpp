@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <span>
 
 #include "src/core/log.h"
 #include "src/core/sampling.h"
@@ -76,11 +78,16 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
     }
     // The portals only guide the sky's samples (SkyPdf mixes them with uniform directions and
     // counts the same triangles), so the coarsest levels serve: a tenth of the triangles to read.
+    std::vector<uint32_t> bricks;  // of each triangle
     NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
         scene, scheduler, ScanDetail::kCoarsest, [](const SurfaceMaterial& m) { return m.portal; },
-        [&](const ResidentMesh& m, size_t t, uint32_t) {
+        [&](const ResidentMesh& m, size_t t, uint32_t b) {
             triangles.push_back(m.TrianglePositions(t));
+            bricks.push_back(b);
         }));
+    if (RankGroup* ranks = scheduler.ranks()) {
+        NAVE_ASSIGN_OR_RETURN(triangles, GatherPortals(*ranks, triangles, bricks));
+    }
     if (triangles.empty()) {
         return InvalidArgumentError(
             "render.sky_sampling = \"portals\" but the model has no triangle of a "
@@ -90,6 +97,34 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
                           SkyPortals::Build(*scene.source, std::move(triangles)));
     sampler->portals_ = sampler->own_portals_.get();
     return sampler;
+}
+
+StatusOr<std::vector<std::array<Vec3f, 3>>> LightSampler::GatherPortals(
+    RankGroup& ranks, const std::vector<std::array<Vec3f, 3>>& triangles,
+    const std::vector<uint32_t>& bricks) {
+    // Each process found the portals of its own bricks, brick by brick in order; all of them, in
+    // the order of their bricks, are what one process finds (the order numbers the triangles the
+    // portals sample).
+    struct Found {
+        uint32_t brick;
+        std::array<Vec3f, 3> triangle;
+    };
+    static_assert(sizeof(Found) == sizeof(uint32_t) + 9 * sizeof(float));
+    std::vector<Found> mine(triangles.size());
+    for (size_t i = 0; i < triangles.size(); ++i) mine[i] = {bricks[i], triangles[i]};
+    NAVE_ASSIGN_OR_RETURN(std::vector<std::byte> all,
+                          ranks.GatherEverywhere(std::as_bytes(std::span<const Found>(mine))));
+    if (all.size() % sizeof(Found) != 0) {
+        return InternalError("portals gathered from the processes: {} bytes, not whole triangles",
+                             all.size());
+    }
+    std::vector<Found> found(all.size() / sizeof(Found));
+    std::memcpy(found.data(), all.data(), all.size());
+    std::stable_sort(found.begin(), found.end(),
+                     [](const Found& a, const Found& b) { return a.brick < b.brick; });
+    std::vector<std::array<Vec3f, 3>> out(found.size());
+    for (size_t i = 0; i < found.size(); ++i) out[i] = found[i].triangle;
+    return out;
 }
 
 double LightSampler::TypicalWindowLight(const RenderScene& scene) {

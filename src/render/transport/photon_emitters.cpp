@@ -23,6 +23,14 @@ StatusOr<std::unique_ptr<PhotonEmitters>> PhotonEmitters::Build(const RenderScen
 }
 
 Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
+    // The passes below read this process's bricks only in a distributed render, whose emitters
+    // would have to be gathered from every process (photon mode is refused under mpirun).
+    if (scheduler.ranks() != nullptr) {
+        return UnsupportedError(
+            "photon mode's emitters are not gathered from the {} processes of a distributed "
+            "render",
+            scheduler.ranks()->size());
+    }
     const Bounds3f& bounds = scene_.source->bounds();
     scene_center_ = bounds.Center();
     scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));

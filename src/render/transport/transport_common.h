@@ -132,8 +132,9 @@ inline bool Bounce(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, bool spec
 /// whose cell holds its centroid. At ScanDetail::kCoarsest the triangles are a level's, which
 /// may differ from the full surface by the level's error and, at a cell's face, miss or repeat a
 /// sliver: fit for what only guides sampling under a density that stays consistent with the set
-/// (the portals), not for light sources. Errors: a brick that cannot be pinned. Call from the
-/// render's thread, not during a Drain.
+/// (the portals), not for light sources. In a distributed render, this process's bricks only
+/// (StreamScheduler::ForEachBrick). Errors: a brick that cannot be pinned. Call from the render's
+/// thread, not during a Drain.
 Status ForEachOwnedTriangle(
     const RenderScene& scene, StreamScheduler& scheduler, ScanDetail detail,
     const std::function<bool(const SurfaceMaterial&)>& want,
