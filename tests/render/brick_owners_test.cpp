@@ -71,5 +71,34 @@ TEST(BrickOwners, RanksGetRunsOfNeighbouringBricksOfAboutEqualSize) {
     }
 }
 
+// Re-balancing: cut by measured work, a rank whose bricks took most of the time gets fewer of
+// them, each rank's share of the work lies within a brick's of the mean, and the runs stay runs.
+TEST(BrickOwners, MeasuredWorkCutsRunsOfAboutEqualWork) {
+    const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 64, .quads_y = 64});
+    auto source = testing::GridSource(mesh, testing::NamedMaterials({"a"}), {4, 4, 1});
+    ASSERT_TRUE(source != nullptr);
+    const uint32_t bricks = source->brick_count();
+    // The first rank's bricks by size took ten times longer each than the others.
+    const std::vector<int> by_size = BrickOwners(*source, 2);
+    std::vector<uint64_t> work(bricks);
+    for (uint32_t b = 0; b < bricks; ++b) work[b] = by_size[b] == 0 ? 10000 : 1000;
+    const std::vector<int> owners = BrickOwnersByWork(*source, 2, work);
+    EXPECT_EQ(owners, BrickOwnersByWork(*source, 2, work));  // deterministic
+    std::vector<uint64_t> share(2, 0);
+    int rank0_bricks = 0, rank0_before = 0;
+    for (uint32_t b = 0; b < bricks; ++b) {
+        share[size_t(owners[b])] += work[b];
+        rank0_bricks += owners[b] == 0;
+        rank0_before += by_size[b] == 0;
+    }
+    EXPECT_LT(rank0_bricks, rank0_before);
+    const uint64_t total = share[0] + share[1];
+    for (int r = 0; r < 2; ++r)
+        EXPECT_NEAR(double(share[size_t(r)]), double(total) / 2, 10000.0) << "rank " << r;
+    // Without measured work, as by size.
+    EXPECT_EQ(BrickOwnersByWork(*source, 2, std::vector<uint64_t>(bricks, 0)).size(),
+              source->slot_count());
+}
+
 }  // namespace
 }  // namespace nave::render

@@ -92,9 +92,11 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     int s_end = std::min(spp, s + group);
     // The guide learns from every pass and updates its distributions after passes 1, 2, 4,
     // 8...: each update follows a complete drain, so that what it learned from does not depend
-    // on the waves, the memory budget or the threads.
-    const int next_update = owned_guide_ ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
-    const bool update = owned_guide_ && s_end >= next_update;
+    // on the waves, the memory budget or the threads. The processes of a distributed render
+    // re-balance their bricks at the same points (StreamScheduler::Rebalance).
+    const bool learns = owned_guide_ || scheduler_.ranks() != nullptr;
+    const int next_update = learns ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
+    const bool update = learns && s_end >= next_update;
     if (update) s_end = next_update;
     NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
         *this, pixels, wave, StreamScheduler::LastWave::kTailInFlight,
@@ -108,12 +110,12 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     // senders would wait for it): the round ends with a complete drain there.
     const bool collective_check = checks && scheduler_.ranks() != nullptr;
     if (update || boundaries || collective_check) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
-    if (update) {
-        if (RankGroup* ranks = scheduler_.ranks()) {
-            // Each process credited the paths it traced: all of them learn from all.
-            NAVE_RETURN_IF_ERROR(owned_guide_->ShareCredits(
-                [&](std::span<uint64_t> values) { return ranks->SumEverywhere(values); }));
-        }
+    if (update && scheduler_.ranks() != nullptr) {
+        // Each process credited the paths it traced: all of them learn from all.
+        NAVE_RETURN_IF_ERROR(ShareState(*scheduler_.ranks()));
+        NAVE_RETURN_IF_ERROR(scheduler_.Rebalance());
+    }
+    if (update && owned_guide_) {
         owned_guide_->Update();
         log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
                    owned_guide_->cells_used(), owned_guide_->cells_guiding());

@@ -92,6 +92,7 @@ RenderSummary::RenderSummary(const RenderSettings& settings, const RenderStats& 
         Add(kStats, "bytes_between_ranks", Unit::kBytes, stats.exchange.bytes_sent);
         AddReal(kStats, "ranks_idle", Unit::kSeconds, stats.exchange.idle_seconds);
         Add(kTerminalOnly, "termination_rounds", Unit::kCount, stats.exchange.termination_rounds);
+        Add(kStats, "rebalances", Unit::kCount, uint64_t(stats.rebalances));
     }
 
     // The terminal's own: rates, and counts the metadata leaves to the settings or leaves out.
@@ -209,10 +210,11 @@ std::vector<std::string> RenderSummary::TerminalLines(const std::string& memory_
     if (ranks_ > 1) {
         lines.push_back(fmt::format(
             "ranks {}: {} rays sent between them in {} messages ({}), idle {} in all, {} rounds "
-            "to find the ends of drains; the counts above are all ranks', the bricks below rank "
-            "0's",
+            "to find the ends of drains, bricks re-balanced {} times by measured work; the counts "
+            "above are all ranks', the bricks below rank 0's",
             stat("ranks"), stat("rays_between_ranks"), stat("messages_between_ranks"),
-            stat("bytes_between_ranks"), stat("ranks_idle"), own("termination_rounds")));
+            stat("bytes_between_ranks"), stat("ranks_idle"), own("termination_rounds"),
+            stat("rebalances")));
     }
 
     const RenderFact& budget = Get(kStatisticsAttribute, "brick_budget");

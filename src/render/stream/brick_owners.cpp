@@ -4,8 +4,12 @@
 
 namespace nave::render {
 
-std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
-    // Leaves in depth-first order: each run of them is a subtree or a few neighbouring ones.
+namespace {
+
+/// The slots' owners from runs of the leaves in depth-first order (each run a subtree or a few
+/// neighbouring ones) of about equal `weight` per brick.
+std::vector<int> OwnersOfRuns(const BrickSource& source, int ranks,
+                              const std::vector<double>& weight) {
     std::vector<uint32_t> order;
     const auto& nodes = source.tree().nodes();
     std::vector<uint32_t> stack;
@@ -20,9 +24,8 @@ std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
         stack.push_back(node.child[1]);
         stack.push_back(node.child[0]);
     }
-    std::vector<double> weight(source.brick_count(), 0.0);
     double total = 0;
-    for (uint32_t b : order) total += weight[b] = double(source.EstimatedResidentBytes(b)) + 1.0;
+    for (uint32_t b : order) total += weight[b];
     std::vector<int> brick_owner(source.brick_count(), 0);
     double before = 0;
     for (uint32_t b : order) {
@@ -34,6 +37,23 @@ std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
     std::vector<int> owners(source.slot_count());
     for (uint32_t s = 0; s < owners.size(); ++s) owners[s] = brick_owner[source.BrickOfSlot(s)];
     return owners;
+}
+
+}  // namespace
+
+std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
+    std::vector<double> weight(source.brick_count(), 0.0);
+    for (uint32_t b = 0; b < source.brick_count(); ++b)
+        weight[b] = double(source.EstimatedResidentBytes(b)) + 1.0;
+    return OwnersOfRuns(source, ranks, weight);
+}
+
+std::vector<int> BrickOwnersByWork(const BrickSource& source, int ranks,
+                                   const std::vector<uint64_t>& work) {
+    std::vector<double> weight(source.brick_count(), 1.0);
+    for (uint32_t b = 0; b < source.brick_count() && b < work.size(); ++b)
+        weight[b] = double(work[b]) + 1.0;
+    return OwnersOfRuns(source, ranks, weight);
 }
 
 }  // namespace nave::render

@@ -15,5 +15,10 @@ namespace nave::render {
 /// brick): the brick tree's leaves in depth-first order, cut into `ranks` runs of about equal
 /// EstimatedResidentBytes at full detail. Deterministic: every rank computes the same.
 std::vector<int> BrickOwners(const BrickSource& source, int ranks);
+/// The same runs cut by `work` per brick (measured: the time its batches took, in any unit) in
+/// place of the estimated memory: what re-balancing between passes uses. Bricks without work
+/// weigh one unit. Deterministic for the same `work`.
+std::vector<int> BrickOwnersByWork(const BrickSource& source, int ranks,
+                                   const std::vector<uint64_t>& work);
 
 }  // namespace nave::render

@@ -71,7 +71,7 @@ struct MpiRayExchange::Impl {
     MPI_Comm rays_comm = MPI_COMM_NULL;  // point-to-point ray messages
     MPI_Comm sum_comm = MPI_COMM_NULL;   // the termination rounds' sums
     int rank = 0, size = 1;
-    const std::vector<int> owners;
+    std::vector<int> owners;  // SetOwners replaces them between drains
     BrickQueues<RayRecord>& queues;
     const MpiExchangeOptions options;
     std::vector<std::unique_ptr<Outgoing>> outgoing;  // per rank
@@ -360,6 +360,28 @@ StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
             return false;
         }
     }
+}
+
+Status MpiRayExchange::SetOwners(std::vector<int> owners) {
+    Impl& m = *impl_;
+    if (owners.size() != m.owners.size()) {
+        return InvalidArgumentError("ray exchange: {} new owners for {} brick slots", owners.size(),
+                                    m.owners.size());
+    }
+    for (size_t s = 0; s < owners.size(); ++s) {
+        if (owners[s] < 0 || owners[s] >= m.size) {
+            return InvalidArgumentError(
+                "ray exchange: brick slot {} given to rank {} (expected [0, {}))", s, owners[s],
+                m.size);
+        }
+    }
+    for (const auto& out : m.outgoing) {
+        std::lock_guard<std::mutex> lock(out->mutex);
+        if (!out->filling.empty() || !out->ready.empty())
+            return InternalError("ray exchange: bricks change owners while rays are on their way");
+    }
+    m.owners = std::move(owners);
+    return Status::Ok();
 }
 
 void MpiRayExchange::ShareProgress(ProgressBar* bar) {

@@ -52,6 +52,9 @@ class MpiRayExchange final : public RayExchange {
     /// The rank that owns slot `slot`.
     int Owner(uint32_t slot) const;
     bool Owns(uint32_t slot) const override { return Owner(slot) == rank(); }
+    /// Errors: a slot count other than the queues', an owner outside [0, ranks), a message not yet
+    /// sent.
+    Status SetOwners(std::vector<int> owners) override;
 
     /// Queues rays of this rank's slots; appends the others to their owner's next message.
     void Send(uint32_t slot, std::span<const RayRecord> rays) override;

@@ -473,6 +473,16 @@ void Pager::BatchDone() {
     resident_guard_.MakeRoom(options_.memory_bytes / 16);
 }
 
+bool Pager::Evict(uint32_t id) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (id >= state_.size() || state_[id] != State::kResident || !source_.Evict(id)) return false;
+    state_[id] = State::kAbsent;
+    committed_bytes_ -= bytes_[id];
+    bytes_[id] = 0;
+    ++stats_.evictions;
+    return true;
+}
+
 void Pager::Stalled(uint32_t id, std::chrono::steady_clock::time_point start) {
     const auto end = std::chrono::steady_clock::now();
     stats_.stall_seconds += std::chrono::duration<double>(end - start).count();

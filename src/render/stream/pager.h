@@ -183,6 +183,9 @@ class Pager {
     /// The scheduler released its pin on the batch's brick: a loader waiting for room may retry;
     /// the allocator's free pages go back if the process nears memory_bytes.
     void BatchDone();
+    /// Drops brick `id` from memory if it is resident and nobody pins it (a brick this process
+    /// no longer owns in a distributed render); returns whether it went.
+    bool Evict(uint32_t id);
     PagerStats stats() const;
     const PagerOptions& options() const { return options_; }
 

@@ -45,6 +45,13 @@ class RayExchange {
     virtual void Send(uint32_t brick, std::span<const RayRecord> rays) = 0;
     /// Whether this process owns brick `brick` (traces its rays).
     virtual bool Owns(uint32_t brick) const = 0;
+    /// Hands the bricks to new owners (`owners[s]`: the process of slot s), the same in every
+    /// process. Only between drains, with no ray waiting or in flight anywhere. One process:
+    /// Unsupported (it owns every brick).
+    virtual Status SetOwners(std::vector<int> owners) {
+        (void)owners;
+        return UnsupportedError("one process owns every brick");
+    }
     /// Delivers the rays that have arrived from elsewhere to their queues; called between batches.
     virtual Status Progress() { return Status::Ok(); }
     /// For a process whose queues are empty: waits until rays arrive (false) or no process has a

@@ -4,8 +4,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
+#include <numeric>
 
 #include "src/core/check.h"
+#include "src/core/log.h"
 #include "src/core/progress.h"
 #include "src/core/trace.h"
 #include "src/render/bricks/brick_walk.h"
@@ -29,7 +32,8 @@ StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64
       wave_paths_(wave_paths),
       queues_(source.slot_count()),
       ranks_(ranks),
-      max_batch_(MaxBatchRays(0)) {}
+      max_batch_(MaxBatchRays(0)),
+      work_us_(source.slot_count(), 0) {}
 
 StreamScheduler::~StreamScheduler() {
     pager_.reset();  // joins the loaders before the cache they use goes
@@ -45,9 +49,9 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
     std::unique_ptr<StreamScheduler> scheduler(
         new StreamScheduler(source, std::move(picker), wave_paths, ranks));
     if (ranks != nullptr) {
-        NAVE_ASSIGN_OR_RETURN(
-            scheduler->distributed_exchange_,
-            ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
+        scheduler->owners_ = BrickOwners(source, ranks->size());
+        NAVE_ASSIGN_OR_RETURN(scheduler->distributed_exchange_,
+                              ranks->MakeExchange(scheduler->owners_, scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
     NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
@@ -199,6 +203,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         const uint32_t b = picker_ ? picker_(waiting, source_) : pager_->Pick(waiting);
         NAVE_CHECK(b < waiting.size() && waiting[b] > 0)
             << "the brick picker chose brick " << b << " which has no rays waiting";
+        const auto batch_start = std::chrono::steady_clock::now();
         // If b must be loaded now, the loader loads the next brick meanwhile: two loads at once
         // while the workers would idle anyway.
         if (!source_.IsResident(b)) pager_->Prefetch(waiting, b, 0);
@@ -222,6 +227,9 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
                 Flush(out);
             });
         handle.Reset();
+        work_us_[b] += uint64_t(std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::steady_clock::now() - batch_start)
+                                    .count());
         pager_->BatchDone();
         NAVE_RETURN_IF_ERROR(exchange_->Progress());
     }
@@ -283,6 +291,45 @@ Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
     return Status::Ok();
 }
 
+Status StreamScheduler::Rebalance() {
+    if (ranks_ == nullptr) return Status::Ok();
+    // Brick by brick (a brick's levels go together), summed over the processes: each brick's
+    // owner measured it. Integers, so that every process sums the same and decides the same.
+    const uint32_t bricks = source_.brick_count();
+    std::vector<uint64_t> work(bricks, 0);
+    for (uint32_t s = 0; s < work_us_.size(); ++s) work[source_.BrickOfSlot(s)] += work_us_[s];
+    std::fill(work_us_.begin(), work_us_.end(), 0);
+    NAVE_RETURN_IF_ERROR(ranks_->SumEverywhere(std::span<uint64_t>(work)));
+    const int n = ranks_->size();
+    auto loads = [&](auto owner_of_brick) {
+        std::vector<uint64_t> per_rank(size_t(n), 0);
+        for (uint32_t b = 0; b < bricks; ++b) per_rank[size_t(owner_of_brick(b))] += work[b];
+        return per_rank;
+    };
+    // Every level of a brick goes with it: level 0's slot names the owner.
+    const std::vector<uint64_t> before =
+        loads([&](uint32_t b) { return owners_[source_.SlotOf(b, 0)]; });
+    const uint64_t total = std::accumulate(before.begin(), before.end(), uint64_t(0));
+    const uint64_t busiest = *std::max_element(before.begin(), before.end());
+    if (total == 0 || double(busiest) <= kRebalanceRatio * double(total) / n) return Status::Ok();
+    std::vector<int> next = BrickOwnersByWork(source_, n, work);
+    const std::vector<uint64_t> after =
+        loads([&](uint32_t b) { return next[source_.SlotOf(b, 0)]; });
+    const uint64_t busiest_after = *std::max_element(after.begin(), after.end());
+    if (busiest_after >= busiest) return Status::Ok();
+    NAVE_RETURN_IF_ERROR(exchange_->SetOwners(next));
+    for (uint32_t s = 0; s < next.size(); ++s) {
+        if (owners_[s] == ranks_->rank() && next[s] != ranks_->rank()) pager_->Evict(s);
+    }
+    log::Debug(
+        "ranks: bricks re-balanced by measured work: the busiest rank had {:.2f}x the mean, "
+        "now {:.2f}x",
+        double(busiest) * n / double(total), double(busiest_after) * n / double(total));
+    owners_ = std::move(next);
+    ++rebalances_;
+    return Status::Ok();
+}
+
 size_t StreamScheduler::WaveOverlap() const {
     if (pager_->options().in_core()) return 0;
     return size_t(pager_->options().wave_overlap * double(wave_paths_));
@@ -302,6 +349,7 @@ Status StreamScheduler::SumStatsOverRanks(StreamStats* stats) const {
     stats->bytes_read = counts[5];
     stats->spilled_rays = counts[6];
     stats->ranks = ranks_->size();
+    stats->rebalances = rebalances_;
     NAVE_ASSIGN_OR_RETURN(stats->exchange, exchange_->TotalCounts());
     return Status::Ok();
 }

@@ -157,6 +157,17 @@ class StreamScheduler {
     /// was received. Collective. One process: nothing to do.
     Status SumStatsOverRanks(StreamStats* stats) const;
 
+    /// In a distributed render, after a complete drain (collective): when the busiest process
+    /// spent more than kRebalanceRatio times the mean on its batches since the last call (their
+    /// time summed over the processes, brick by brick), the bricks go to new owners cut by that
+    /// work (BrickOwnersByWork), if that makes the busiest lighter; bricks a process no longer
+    /// owns leave its memory. One process: nothing to do.
+    Status Rebalance();
+    /// The busiest process's work over the mean above which Rebalance moves bricks.
+    static constexpr double kRebalanceRatio = 1.2;
+    /// Times Rebalance moved bricks.
+    int rebalances() const { return rebalances_; }
+
     /// The bricks the rays are scheduled over (slots: bricks at their levels of detail).
     const BrickSource& source() const { return source_; }
     /// The source's brick tree, along which rays are routed.
@@ -193,6 +204,11 @@ class StreamScheduler {
     // Declared after queues_, so destroyed first: its loader thread reads the queues until joined.
     std::unique_ptr<Pager> pager_;
     TraceRecorder* trace_ = nullptr;
+    // Per slot, microseconds of this process's batches of it (pinning, loads waited for and
+    // tracing) since the last Rebalance: the work that re-balancing shares out.
+    std::vector<uint64_t> work_us_;
+    std::vector<int> owners_;  // with ranks_: the process of each slot
+    int rebalances_ = 0;
     std::atomic<uint64_t> segments_traced_{0}, shadow_segments_{0}, brick_moves_{0}, batches_{0},
         rays_{0};
 };

@@ -37,6 +37,7 @@ struct StreamStats {
     // summed over them (the counts above are summed too; residency is this process's).
     int ranks = 1;
     ExchangeCounts exchange;
+    int rebalances = 0;  ///< times the bricks went to new owners (StreamScheduler::Rebalance)
 };
 
 }  // namespace nave::render
