@@ -133,6 +133,7 @@ TEST(BrickSource, ConcurrentPinsNeverLoseTheirBrick) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     std::atomic<int> wrong{0};
     std::vector<std::thread> readers;
+    readers.reserve(kReaders);
     for (int t = 0; t < kReaders; ++t) {
         readers.emplace_back([&, t] {
             for (int i = 0; i < kPins || (evictions.load() < kMinEvictions &&

@@ -48,10 +48,7 @@ class RayExchange {
     /// Hands the bricks to new owners (`owners[s]`: the process of slot s), the same in every
     /// process. Only between drains, with no ray waiting or in flight anywhere. One process:
     /// Unsupported (it owns every brick).
-    virtual Status SetOwners(std::vector<int> owners) {
-        (void)owners;
-        return UnsupportedError("one process owns every brick");
-    }
+    virtual Status SetOwners(std::vector<int> owners) = 0;
     /// Delivers the rays that have arrived from elsewhere to their queues; called between batches.
     virtual Status Progress() { return Status::Ok(); }
     /// For a process whose queues are empty: waits until rays arrive (false) or no process has a
@@ -105,6 +102,9 @@ class LocalRayExchange final : public RayExchange {
         queues_.Push(brick, rays.data(), rays.size());
     }
     bool Owns(uint32_t) const override { return true; }
+    Status SetOwners(std::vector<int> /*owners*/) override {
+        return UnsupportedError("one process owns every brick");
+    }
 
   private:
     BrickQueues<RayRecord>& queues_;
