@@ -11,6 +11,7 @@
 #include "src/cli/distributed.h"
 #include "src/cli/interrupt.h"
 #include "src/cli/render_checkpoint.h"
+#include "src/core/duration.h"
 #include "src/core/file.h"
 #include "src/core/hash.h"
 #include "src/core/log.h"
@@ -47,6 +48,7 @@ struct RenderOptions {
     std::string pager;       // --pager TUNABLES
     std::string trace;       // --trace FILE.json
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
+    std::string rank_timeout = "10m";  // --rank-timeout: under mpirun, the longest wait for rays
     bool no_textures = false;
     std::string lod;
     CheckpointFlags checkpoint;  // --checkpoint, --checkpoint-every, --resume, --stop-after
@@ -289,7 +291,9 @@ Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(CheckOptions(o));
     const std::filesystem::path out = o.output;
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, BuildConfig(o));
-    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks, JoinRanks());
+    NAVE_ASSIGN_OR_RETURN(const double rank_timeout_s,
+                          ParseDuration(o.rank_timeout, "--rank-timeout"));
+    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks, JoinRanks(rank_timeout_s));
     if (ranks != nullptr) NAVE_RETURN_IF_ERROR(CheckDistributed(o, config));
     std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
@@ -406,6 +410,10 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option(
         "--pager", opts->pager,
         "Pager tunables, comma separated (docs/pager.md): " + std::string(render::kPagerTunables));
+    cmd->add_option("--rank-timeout", opts->rank_timeout,
+                    "Under mpirun: how long a rank with no ray to trace waits for rays or for the "
+                    "others to finish their batches before it ends the job as hung, as 90s, 10m "
+                    "or 1h (0: for ever; docs/distributed.md). Default 10m");
     cmd->add_option(
         "--temp-dir", opts->temp_dir,
         "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "

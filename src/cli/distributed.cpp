@@ -43,7 +43,7 @@ int LaunchedRanks() {
     return 1;
 }
 
-StatusOr<render::RankGroup*> JoinRanks() {
+StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s) {
     if (LaunchedRanks() <= 1) return static_cast<render::RankGroup*>(nullptr);
 #ifdef NAVE_HAVE_MPI
     Distributed& state = State();
@@ -52,7 +52,9 @@ StatusOr<render::RankGroup*> JoinRanks() {
                               render::MpiRuntime::Init(nullptr, nullptr));
         state.runtime = std::make_unique<render::MpiRuntime>(std::move(runtime));
         state.host = state.runtime->host();
-        NAVE_ASSIGN_OR_RETURN(state.group, render::MpiRankGroup::Create());
+        render::MpiExchangeOptions exchange;
+        exchange.stall_timeout_s = rank_timeout_s;
+        NAVE_ASSIGN_OR_RETURN(state.group, render::MpiRankGroup::Create(exchange));
         // One terminal for the job: rank 0 reports progress and the summary, the others only
         // their errors (which name the rank).
         if (state.group->rank() != 0) {
@@ -62,6 +64,7 @@ StatusOr<render::RankGroup*> JoinRanks() {
     }
     return static_cast<render::RankGroup*>(state.group.get());
 #else
+    (void)rank_timeout_s;
     return UnsupportedError(
         "started by mpirun as one of {} ranks, but this nave was built without MPI: install "
         "libopenmpi-dev and openmpi-bin (scripts/setup-debian.sh does) and build again, or run "

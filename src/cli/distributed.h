@@ -17,7 +17,7 @@ int LaunchedRanks();
 /// The ranks of this job, MPI initialized on the first call (and finalized at exit); null when
 /// this process is the only one. Errors: a job of several ranks and a nave built without MPI
 /// (names what to install), MPI that cannot start.
-StatusOr<render::RankGroup*> JoinRanks();
+StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s = 600);
 
 /// Where a failed rank is named: "rank 2 of 4 on node7" ("" outside a distributed render).
 std::string RankName();

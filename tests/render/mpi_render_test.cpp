@@ -319,44 +319,83 @@ std::vector<pid_t> Children(pid_t pid) {
     return children;
 }
 
+// A job started in the background: mpirun's pid and its two ranks', once both run.
+struct BackgroundJob {
+    pid_t mpirun = -1;
+    std::vector<pid_t> ranks;
+};
+BackgroundJob StartJob(const std::string& command) {
+    BackgroundJob job;
+    job.mpirun = ::fork();
+    if (job.mpirun == 0) {
+        ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    if (job.mpirun < 0) return job;
+    // `timeout` runs mpirun, which runs the ranks: wait for both ranks to be rendering.
+    for (int i = 0; i < 200 && job.ranks.size() < 2; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        job.ranks.clear();
+        for (pid_t launcher : Children(job.mpirun))
+            for (pid_t rank : Children(launcher)) job.ranks.push_back(rank);
+    }
+    return job;
+}
+
+std::string ReadAll(const fs::path& path) {
+    std::ifstream in(path);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 // A rank killed outright mid-render (out of memory, an operator's kill -9): mpirun ends the whole
 // job, naming the rank and the signal, and no image is written.
 TEST_F(MpiRender, ARankKilledMidRenderEndsTheJob) {
     const fs::path log = *dir_ / "killed.log";
     // In-core, and long enough (256 samples) to be killed mid-render.
-    const std::string command = "exec env " + Mpirun(2) + NAVE_BINARY + " render " + Store() +
-                                " -c " + Config() +
-                                " --mode path --resolution 96x64 --spp 256 -o " +
-                                (*dir_ / "killed.exr").string() + " > " + log.string() + " 2>&1";
-    const pid_t mpirun = ::fork();
-    ASSERT_GE(mpirun, 0);
-    if (mpirun == 0) {
-        ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-        ::_exit(127);
-    }
-    // `timeout` runs mpirun, which runs the ranks: wait for both ranks to be rendering.
-    std::vector<pid_t> ranks;
-    for (int i = 0; i < 200 && ranks.size() < 2; ++i) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        ranks.clear();
-        for (pid_t launcher : Children(mpirun))
-            for (pid_t rank : Children(launcher)) ranks.push_back(rank);
-    }
-    ASSERT_EQ(ranks.size(), 2u) << "the ranks did not start";
+    const BackgroundJob job =
+        StartJob("exec env " + Mpirun(2) + NAVE_BINARY + " render " + Store() + " -c " + Config() +
+                 " --mode path --resolution 96x64 --spp 256 -o " + (*dir_ / "killed.exr").string() +
+                 " > " + log.string() + " 2>&1");
+    ASSERT_GE(job.mpirun, 0);
+    ASSERT_EQ(job.ranks.size(), 2u) << "the ranks did not start";
     std::this_thread::sleep_for(std::chrono::seconds(2));
     const auto start = std::chrono::steady_clock::now();
-    ::kill(ranks[1], SIGKILL);
+    ::kill(job.ranks[1], SIGKILL);
     int status = 0;
-    ASSERT_EQ(::waitpid(mpirun, &status, 0), mpirun);
+    ASSERT_EQ(::waitpid(job.mpirun, &status, 0), job.mpirun);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::ifstream in(log);
-    const std::string output((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
+    const std::string output = ReadAll(log);
     EXPECT_TRUE(!WIFEXITED(status) || WEXITSTATUS(status) != 0) << output;
     EXPECT_NE(output.find("signal 9"), std::string::npos) << output;
     EXPECT_LT(seconds, 30) << "the job did not end soon after the rank was killed";
     EXPECT_FALSE(fs::exists(*dir_ / "killed.exr"));
+}
+
+// A rank that stops without dying (SIGSTOP standing for a hung rank): the others wait for it
+// --rank-timeout at most, then end the job naming the wait; no image, never a hang.
+TEST_F(MpiRender, AHungRankEndsTheJobAfterTheRankTimeout) {
+    const fs::path log = *dir_ / "hung.log";
+    const BackgroundJob job =
+        StartJob("exec env " + Mpirun(2) + NAVE_BINARY + " render " + Store() + " -c " + Config() +
+                 " --mode path --resolution 96x64 --spp 256 --rank-timeout 3s -o " +
+                 (*dir_ / "hung.exr").string() + " > " + log.string() + " 2>&1");
+    ASSERT_GE(job.mpirun, 0);
+    ASSERT_EQ(job.ranks.size(), 2u) << "the ranks did not start";
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    const auto start = std::chrono::steady_clock::now();
+    ::kill(job.ranks[1], SIGSTOP);
+    int status = 0;
+    ASSERT_EQ(::waitpid(job.mpirun, &status, 0), job.mpirun);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ::kill(job.ranks[1], SIGKILL);  // if mpirun left it stopped
+    const std::string output = ReadAll(log);
+    EXPECT_TRUE(!WIFEXITED(status) || WEXITSTATUS(status) != 0) << output;
+    EXPECT_NE(output.find("error on rank 0 of 2"), std::string::npos) << output;
+    EXPECT_NE(output.find("has stopped or hangs"), std::string::npos) << output;
+    EXPECT_LT(seconds, 60) << "the job did not end after the rank timeout";
+    EXPECT_FALSE(fs::exists(*dir_ / "hung.exr"));
 }
 
 }  // namespace

@@ -189,8 +189,18 @@ Status MpiRayExchange::Impl::PostReady(bool all) {
         for (Message& m : ready) {
             // At most max_sends_in_flight to one rank: wait for the oldest, receiving meanwhile
             // (the rank we wait for may itself be waiting to send to us).
+            auto last_sign = std::chrono::steady_clock::now();
             while (int(posted[size_t(dest)].size()) >= options.max_sends_in_flight) {
                 NAVE_ASSIGN_OR_RETURN(bool progressed, Step());
+                if (progressed) {
+                    last_sign = std::chrono::steady_clock::now();
+                } else if (options.stall_timeout_s > 0 &&
+                           SecondsSince(last_sign) > options.stall_timeout_s) {
+                    return InternalError(
+                        "rank {} of {} waited {:.0f} s for rank {} to take its rays, and it took "
+                        "none: that rank has stopped or hangs (--rank-timeout sets this wait)",
+                        rank, size, SecondsSince(last_sign), dest);
+                }
                 if (!progressed) std::this_thread::sleep_for(std::chrono::microseconds(50));
             }
             Posted& p = posted[size_t(dest)].emplace_back();
@@ -337,11 +347,25 @@ StatusOr<bool> MpiRayExchange::WaitForRaysOrEnd() {
                       "MPI_Iallreduce"));
         m.counts.termination_rounds += 1;
         int done = 0;
+        auto last_sign = std::chrono::steady_clock::now();  // of the other ranks' life
         while (true) {
             NAVE_RETURN_IF_ERROR(
                 MpiStatus(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
             if (done) break;
+            const uint64_t received = m.counts.messages_received;
             NAVE_ASSIGN_OR_RETURN(bool progressed, m.Step());
+            if (m.counts.messages_received != received) {
+                last_sign = std::chrono::steady_clock::now();
+            } else if (m.options.stall_timeout_s > 0 &&
+                       SecondsSince(last_sign) > m.options.stall_timeout_s) {
+                // Another rank neither sends rays nor joins the sum: stopped, stuck, or in a
+                // batch longer than the timeout. The error ends the job (MPI_Abort).
+                return InternalError(
+                    "rank {} of {} waited {:.0f} s for rays or for the other ranks to finish "
+                    "their batches, and none came: a rank has stopped or hangs (--rank-timeout "
+                    "sets this wait)",
+                    m.rank, m.size, SecondsSince(last_sign));
+            }
             // Ranks may share cores (mpirun --oversubscribe): a waiting rank yields them.
             if (!progressed) std::this_thread::sleep_for(std::chrono::microseconds(50));
         }

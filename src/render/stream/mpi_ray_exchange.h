@@ -29,6 +29,10 @@ struct MpiExchangeOptions {
     /// Sends to one rank posted and not yet complete, at most: past it, Progress waits (receiving
     /// meanwhile), so a slow rank holds its senders back instead of their memory filling up.
     int max_sends_in_flight = 8;
+    /// A rank with no ray to trace that waits this long with nothing arriving and no round of the
+    /// end-of-drain sum completing ends the job with an error naming itself and the wait (a rank
+    /// that stopped, or a batch longer than this): a job never hangs. 0: waits for ever.
+    double stall_timeout_s = 600;
 };
 
 /// The exchange between the ranks of MPI_COMM_WORLD (on a duplicate of it, so that its messages
@@ -64,7 +68,9 @@ class MpiRayExchange final : public RayExchange {
     Status Progress() override;
     /// For a rank whose queues are empty: sends what its messages hold, then waits until rays
     /// arrive (returns false: trace them, then call again) or every rank is idle with no ray in
-    /// flight (returns true, on every rank in the same call). Collective.
+    /// flight (returns true, on every rank in the same call). Collective. Errors: kInternal after
+    /// stall_timeout_s with nothing arriving and no round completing, naming this rank and the
+    /// wait.
     StatusOr<bool> WaitForRaysOrEnd() override;
     /// Every rank's counts summed, and the closing check: every record sent was received. Errors:
     /// kInternal naming both sums when they differ. Collective; call after WaitForRaysOrEnd
