@@ -382,7 +382,10 @@ TEST_F(MpiRender, AHungRankEndsTheJobAfterTheRankTimeout) {
                  (*dir_ / "hung.exr").string() + " > " + log.string() + " 2>&1");
     ASSERT_GE(job.mpirun, 0);
     ASSERT_EQ(job.ranks.size(), 2u) << "the ranks did not start";
-    std::this_thread::sleep_for(std::chrono::seconds(2));
+    // Once rank 0's bar shows the render going (past start-up and the model scan, slow under the
+    // sanitizers).
+    for (int i = 0; i < 600 && ReadAll(log).find("info: render ") == std::string::npos; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto start = std::chrono::steady_clock::now();
     ::kill(job.ranks[1], SIGSTOP);
     int status = 0;

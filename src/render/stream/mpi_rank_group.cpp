@@ -3,8 +3,10 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <limits>
+#include <thread>
 
 #include "src/render/stream/mpi_runtime.h"
 
@@ -16,15 +18,42 @@ struct MpiRankGroup::Comm {
 
 namespace {
 
+// Waits for the collective `request` (`call` names it), giving the cores to the other ranks
+// meanwhile; a wait longer than `timeout_s` (0: none) means a rank never joined: an error naming
+// this rank, so that the job ends instead of hanging (--rank-timeout).
+Status WaitForCollective(MPI_Request* request, const char* call, MPI_Comm comm, double timeout_s) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int spins = 0;; ++spins) {
+        int done = 0;
+        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Test(request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        if (done) return Status::Ok();
+        const double waited =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (timeout_s > 0 && waited > timeout_s) {
+            int rank = 0, size = 0;
+            MPI_Comm_rank(comm, &rank);
+            MPI_Comm_size(comm, &size);
+            return InternalError(
+                "rank {} of {} waited {:.0f} s in {} for the other ranks, and one never came: a "
+                "rank has stopped or hangs (--rank-timeout sets this wait)",
+                rank, size, waited, call);
+        }
+        // The first spins answer a collective the others have all joined at once.
+        if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+}
+
 // Sums `values` of MPI type `type` over the ranks in place, in parts whose count fits MPI's int.
 template <typename T>
-Status SumInParts(MPI_Comm comm, std::span<T> values, MPI_Datatype type) {
+Status SumInParts(MPI_Comm comm, std::span<T> values, MPI_Datatype type, double timeout_s) {
     constexpr size_t kPart = size_t(1) << 28;
     for (size_t at = 0; at < values.size(); at += kPart) {
         const int count = int(std::min(kPart, values.size() - at));
-        NAVE_RETURN_IF_ERROR(
-            MpiStatus(MPI_Allreduce(MPI_IN_PLACE, values.data() + at, count, type, MPI_SUM, comm),
-                      "MPI_Allreduce"));
+        MPI_Request request = MPI_REQUEST_NULL;
+        NAVE_RETURN_IF_ERROR(MpiStatus(
+            MPI_Iallreduce(MPI_IN_PLACE, values.data() + at, count, type, MPI_SUM, comm, &request),
+            "MPI_Iallreduce"));
+        NAVE_RETURN_IF_ERROR(WaitForCollective(&request, "a sum", comm, timeout_s));
     }
     return Status::Ok();
 }
@@ -58,25 +87,28 @@ StatusOr<std::unique_ptr<RayExchange>> MpiRankGroup::MakeExchange(std::vector<in
 }
 
 Status MpiRankGroup::SumEverywhere(std::span<double> values) {
-    return SumInParts(comm_->comm, values, MPI_DOUBLE);
+    return SumInParts(comm_->comm, values, MPI_DOUBLE, options_.stall_timeout_s);
 }
 Status MpiRankGroup::SumEverywhere(std::span<float> values) {
-    return SumInParts(comm_->comm, values, MPI_FLOAT);
+    return SumInParts(comm_->comm, values, MPI_FLOAT, options_.stall_timeout_s);
 }
 Status MpiRankGroup::SumEverywhere(std::span<uint32_t> values) {
-    return SumInParts(comm_->comm, values, MPI_UINT32_T);
+    return SumInParts(comm_->comm, values, MPI_UINT32_T, options_.stall_timeout_s);
 }
 Status MpiRankGroup::SumEverywhere(std::span<uint64_t> values) {
-    return SumInParts(comm_->comm, values, MPI_UINT64_T);
+    return SumInParts(comm_->comm, values, MPI_UINT64_T, options_.stall_timeout_s);
 }
 
 StatusOr<std::vector<std::byte>> MpiRankGroup::GatherEverywhere(std::span<const std::byte> mine) {
     const int64_t size = int64_t(mine.size());
     const auto ranks = static_cast<size_t>(size_);
     std::vector<int64_t> sizes(ranks, 0);
+    MPI_Request request = MPI_REQUEST_NULL;
+    NAVE_RETURN_IF_ERROR(MpiStatus(
+        MPI_Iallgather(&size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, comm_->comm, &request),
+        "MPI_Iallgather"));
     NAVE_RETURN_IF_ERROR(
-        MpiStatus(MPI_Allgather(&size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, comm_->comm),
-                  "MPI_Allgather"));
+        WaitForCollective(&request, "a gather", comm_->comm, options_.stall_timeout_s));
     std::vector<int> counts(ranks), offsets(ranks);
     int64_t total = 0;
     for (int r = 0; r < size_; ++r) {
@@ -91,9 +123,11 @@ StatusOr<std::vector<std::byte>> MpiRankGroup::GatherEverywhere(std::span<const 
     }
     std::vector<std::byte> all(static_cast<size_t>(total));
     NAVE_RETURN_IF_ERROR(
-        MpiStatus(MPI_Allgatherv(mine.data(), int(mine.size()), MPI_BYTE, all.data(), counts.data(),
-                                 offsets.data(), MPI_BYTE, comm_->comm),
-                  "MPI_Allgatherv"));
+        MpiStatus(MPI_Iallgatherv(mine.data(), int(mine.size()), MPI_BYTE, all.data(),
+                                  counts.data(), offsets.data(), MPI_BYTE, comm_->comm, &request),
+                  "MPI_Iallgatherv"));
+    NAVE_RETURN_IF_ERROR(
+        WaitForCollective(&request, "a gather", comm_->comm, options_.stall_timeout_s));
     return all;
 }
 
