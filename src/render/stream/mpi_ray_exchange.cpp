@@ -250,20 +250,23 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
                       "MPI_Recv"));
         const std::string what =
             fmt::format("rays from rank {} to rank {}", status.MPI_SOURCE, rank);
+        // Whole and for this rank's bricks only, before any ray is queued: a damaged message
+        // delivers nothing.
         uint32_t foreign_slot = UINT32_MAX;
-        NAVE_ASSIGN_OR_RETURN(uint64_t rays,
-                              ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
-                                              [&](uint32_t slot, std::span<const RayRecord> group) {
-                                                  if (owners[slot] != rank) {
-                                                      foreign_slot = slot;
-                                                      return;
-                                                  }
-                                                  queues.Push(slot, group.data(), group.size());
-                                              }));
+        NAVE_RETURN_IF_ERROR(ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
+                                             [&](uint32_t slot, std::span<const RayRecord>) {
+                                                 if (owners[slot] != rank) foreign_slot = slot;
+                                             })
+                                 .status());
         if (foreign_slot != UINT32_MAX) {
             return DataLossError("{}: brick slot {} belongs to rank {}, not this one", what,
                                  foreign_slot, owners[foreign_slot]);
         }
+        NAVE_ASSIGN_OR_RETURN(const uint64_t rays,
+                              ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
+                                              [&](uint32_t slot, std::span<const RayRecord> group) {
+                                                  queues.Push(slot, group.data(), group.size());
+                                              }));
         counts.records_received += rays;
         counts.messages_received += 1;
         counts.bytes_received += uint64_t(bytes);
