@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "src/render/stream/mpi_runtime.h"
+#include "src/render/stream/mpi_wait.h"
 
 namespace nave::render {
 
@@ -17,31 +18,6 @@ struct MpiRankGroup::Comm {
 };
 
 namespace {
-
-// Waits for the collective `request` (`call` names it), giving the cores to the other ranks
-// meanwhile; a wait longer than `timeout_s` (0: none) means a rank never joined: an error naming
-// this rank, so that the job ends instead of hanging (--rank-timeout).
-Status WaitForCollective(MPI_Request* request, const char* call, MPI_Comm comm, double timeout_s) {
-    const auto start = std::chrono::steady_clock::now();
-    for (int spins = 0;; ++spins) {
-        int done = 0;
-        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Test(request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
-        if (done) return Status::Ok();
-        const double waited =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (timeout_s > 0 && waited > timeout_s) {
-            int rank = 0, size = 0;
-            MPI_Comm_rank(comm, &rank);
-            MPI_Comm_size(comm, &size);
-            return InternalError(
-                "rank {} of {} waited {:.0f} s in {} for the other ranks, and one never came: a "
-                "rank has stopped or hangs (--rank-timeout sets this wait)",
-                rank, size, waited, call);
-        }
-        // The first spins answer a collective the others have all joined at once.
-        if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
-    }
-}
 
 // Sums `values` of MPI type `type` over the ranks in place, in parts whose count fits MPI's int.
 template <typename T>

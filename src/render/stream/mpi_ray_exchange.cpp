@@ -14,6 +14,7 @@
 
 #include "src/core/progress.h"
 #include "src/render/stream/mpi_runtime.h"
+#include "src/render/stream/mpi_wait.h"
 #include "src/render/stream/ray_message.h"
 
 namespace nave::render {
@@ -426,9 +427,12 @@ Status MpiRayExchange::FinishProgress() {
     m.reports.clear();
     // Every report sent is received before the bar goes: rank 0 learns how many there were.
     uint64_t sent = 0;
-    NAVE_RETURN_IF_ERROR(
-        MpiStatus(MPI_Allreduce(&m.reports_sent, &sent, 1, MPI_UINT64_T, MPI_SUM, m.sum_comm),
-                  "MPI_Allreduce"));
+    MPI_Request request = MPI_REQUEST_NULL;
+    NAVE_RETURN_IF_ERROR(MpiStatus(
+        MPI_Iallreduce(&m.reports_sent, &sent, 1, MPI_UINT64_T, MPI_SUM, m.sum_comm, &request),
+        "MPI_Iallreduce"));
+    NAVE_RETURN_IF_ERROR(WaitForCollective(&request, "the sum of progress reports", m.sum_comm,
+                                           m.options.stall_timeout_s));
     while (m.rank == 0 && m.reports_received < sent) {
         uint64_t gained = 0;
         NAVE_RETURN_IF_ERROR(
@@ -448,12 +452,18 @@ StatusOr<ExchangeCounts> MpiRayExchange::TotalCounts() const {
                                c.messages_received, c.bytes_sent,       c.bytes_received,
                                c.termination_rounds};
     uint64_t sums[7] = {};
-    NAVE_RETURN_IF_ERROR(MpiStatus(
-        MPI_Allreduce(local, sums, 7, MPI_UINT64_T, MPI_SUM, impl_->sum_comm), "MPI_Allreduce"));
     double idle = 0;
-    NAVE_RETURN_IF_ERROR(
-        MpiStatus(MPI_Allreduce(&c.idle_seconds, &idle, 1, MPI_DOUBLE, MPI_SUM, impl_->sum_comm),
-                  "MPI_Allreduce"));
+    MPI_Request requests[2] = {MPI_REQUEST_NULL, MPI_REQUEST_NULL};
+    NAVE_RETURN_IF_ERROR(MpiStatus(
+        MPI_Iallreduce(local, sums, 7, MPI_UINT64_T, MPI_SUM, impl_->sum_comm, &requests[0]),
+        "MPI_Iallreduce"));
+    NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Iallreduce(&c.idle_seconds, &idle, 1, MPI_DOUBLE, MPI_SUM,
+                                                  impl_->sum_comm, &requests[1]),
+                                   "MPI_Iallreduce"));
+    for (MPI_Request& r : requests) {
+        NAVE_RETURN_IF_ERROR(WaitForCollective(&r, "the closing sum of the exchange",
+                                               impl_->sum_comm, impl_->options.stall_timeout_s));
+    }
     ExchangeCounts total{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], idle};
     if (total.records_sent != total.records_received ||
         total.messages_sent != total.messages_received) {

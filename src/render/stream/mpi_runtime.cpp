@@ -2,7 +2,11 @@
 
 #include <mpi.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <thread>
+
+#include "src/render/stream/mpi_wait.h"
 
 namespace nave::render {
 
@@ -57,6 +61,28 @@ Status MpiStatus(int code, std::string_view call) {
 void MpiRuntime::AbortAll(int exit_code) {
     MPI_Abort(MPI_COMM_WORLD, exit_code);
     std::abort();  // MPI_Abort does not return; if it did, this rank still ends
+}
+
+Status WaitForCollective(MPI_Request* request, const char* what, MPI_Comm comm, double timeout_s) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int spins = 0;; ++spins) {
+        int done = 0;
+        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Test(request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        if (done) return Status::Ok();
+        const double waited =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (timeout_s > 0 && waited > timeout_s) {
+            int rank = 0, size = 0;
+            MPI_Comm_rank(comm, &rank);
+            MPI_Comm_size(comm, &size);
+            return InternalError(
+                "rank {} of {} waited {:.0f} s in {} for the other ranks, and one never came: a "
+                "rank has stopped or hangs (--rank-timeout sets this wait)",
+                rank, size, waited, what);
+        }
+        // The first spins answer a collective the others have all joined at once.
+        if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
 }
 
 }  // namespace nave::render
