@@ -347,6 +347,26 @@ std::string ReadAll(const fs::path& path) {
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+// How a job ended after its rank 1 got `signal`: mpirun's exit, the seconds it took from the
+// signal, and what the job printed to `log`.
+struct EndedJob {
+    bool failed = false;  // killed, or a non-zero exit
+    double seconds = 0;
+    std::string output;
+};
+EndedJob SignalRankAndWait(const BackgroundJob& job, int signal, const fs::path& log) {
+    EndedJob ended;
+    const auto start = std::chrono::steady_clock::now();
+    ::kill(job.ranks[1], signal);
+    int status = 0;
+    EXPECT_EQ(::waitpid(job.mpirun, &status, 0), job.mpirun);
+    ended.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (signal == SIGSTOP) ::kill(job.ranks[1], SIGKILL);  // if mpirun left it stopped
+    ended.failed = !WIFEXITED(status) || WEXITSTATUS(status) != 0;
+    ended.output = ReadAll(log);
+    return ended;
+}
+
 // A rank killed outright mid-render (out of memory, an operator's kill -9): mpirun ends the whole
 // job, naming the rank and the signal, and no image is written.
 TEST_F(MpiRender, ARankKilledMidRenderEndsTheJob) {
@@ -359,16 +379,10 @@ TEST_F(MpiRender, ARankKilledMidRenderEndsTheJob) {
     ASSERT_GE(job.mpirun, 0);
     ASSERT_EQ(job.ranks.size(), 2u) << "the ranks did not start";
     std::this_thread::sleep_for(std::chrono::seconds(2));
-    const auto start = std::chrono::steady_clock::now();
-    ::kill(job.ranks[1], SIGKILL);
-    int status = 0;
-    ASSERT_EQ(::waitpid(job.mpirun, &status, 0), job.mpirun);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string output = ReadAll(log);
-    EXPECT_TRUE(!WIFEXITED(status) || WEXITSTATUS(status) != 0) << output;
-    EXPECT_NE(output.find("signal 9"), std::string::npos) << output;
-    EXPECT_LT(seconds, 30) << "the job did not end soon after the rank was killed";
+    const EndedJob ended = SignalRankAndWait(job, SIGKILL, log);
+    EXPECT_TRUE(ended.failed) << ended.output;
+    EXPECT_NE(ended.output.find("signal 9"), std::string::npos) << ended.output;
+    EXPECT_LT(ended.seconds, 30) << "the job did not end soon after the rank was killed";
     EXPECT_FALSE(fs::exists(*dir_ / "killed.exr"));
 }
 
@@ -386,18 +400,11 @@ TEST_F(MpiRender, AHungRankEndsTheJobAfterTheRankTimeout) {
     // sanitizers).
     for (int i = 0; i < 600 && ReadAll(log).find("info: render ") == std::string::npos; ++i)
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    const auto start = std::chrono::steady_clock::now();
-    ::kill(job.ranks[1], SIGSTOP);
-    int status = 0;
-    ASSERT_EQ(::waitpid(job.mpirun, &status, 0), job.mpirun);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    ::kill(job.ranks[1], SIGKILL);  // if mpirun left it stopped
-    const std::string output = ReadAll(log);
-    EXPECT_TRUE(!WIFEXITED(status) || WEXITSTATUS(status) != 0) << output;
-    EXPECT_NE(output.find("error on rank 0 of 2"), std::string::npos) << output;
-    EXPECT_NE(output.find("has stopped or hangs"), std::string::npos) << output;
-    EXPECT_LT(seconds, 60) << "the job did not end after the rank timeout";
+    const EndedJob ended = SignalRankAndWait(job, SIGSTOP, log);
+    EXPECT_TRUE(ended.failed) << ended.output;
+    EXPECT_NE(ended.output.find("error on rank 0 of 2"), std::string::npos) << ended.output;
+    EXPECT_NE(ended.output.find("has stopped or hangs"), std::string::npos) << ended.output;
+    EXPECT_LT(ended.seconds, 60) << "the job did not end after the rank timeout";
     EXPECT_FALSE(fs::exists(*dir_ / "hung.exr"));
 }
 

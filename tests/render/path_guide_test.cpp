@@ -174,6 +174,21 @@ class TwoProcessSum {
     std::vector<uint64_t> offered_[2];
 };
 
+// Updates the guide of one process and those of two processes that shared their credits, and
+// expects the two to hold the one's state, bit for bit.
+void ExpectUpdatesAlike(PathGuide& one, PathGuide& a, PathGuide& b) {
+    one.Update();
+    a.Update();
+    b.Update();
+    ByteWriter state_one, state_a, state_b;
+    one.SaveState(&state_one);
+    a.SaveState(&state_a);
+    b.SaveState(&state_b);
+    const std::string expected = state_one.Take();
+    EXPECT_EQ(state_a.Take(), expected);
+    EXPECT_EQ(state_b.Take(), expected);
+}
+
 TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
     std::mt19937 rng(11);
     PathGuide one(kBox, 4, 16, 1.0), a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
@@ -189,16 +204,8 @@ TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
             half.Credit(half.CreditKey(p, kSide, w), v);
         }
         sum.Share(a, b);
-        one.Update();
-        a.Update();
-        b.Update();
-        ByteWriter state_one, state_a, state_b;
-        one.SaveState(&state_one);
-        a.SaveState(&state_a);
-        b.SaveState(&state_b);
-        const std::string bytes = state_one.Take();
-        EXPECT_EQ(state_a.Take(), bytes) << "pass " << pass;
-        EXPECT_EQ(state_b.Take(), bytes) << "pass " << pass;
+        SCOPED_TRACE(::testing::Message() << "pass " << pass);
+        ExpectUpdatesAlike(one, a, b);
     }
     EXPECT_TRUE(one.Guides(points[0], kSide));
 }
@@ -238,16 +245,7 @@ TEST(PathGuide, ProcessesResumedFromASharedCheckpointShareOnlyNewCredits) {
     credit(1500, c, d);
     TwoProcessSum after;
     after.Share(c, d);
-    one.Update();
-    c.Update();
-    d.Update();
-    ByteWriter state_one, state_c, state_d;
-    one.SaveState(&state_one);
-    c.SaveState(&state_c);
-    d.SaveState(&state_d);
-    const std::string expected = state_one.Take();
-    EXPECT_EQ(state_c.Take(), expected);
-    EXPECT_EQ(state_d.Take(), expected);
+    ExpectUpdatesAlike(one, c, d);
     EXPECT_TRUE(one.Guides(p, kSide));
 }
 

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstring>
 #include <deque>
-#include <iterator>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -29,6 +28,18 @@ constexpr double kProgressReportSeconds = 0.5;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Whether every slot's owner is one of the `ranks` ranks; the error names the first that is not.
+Status CheckOwners(const std::vector<int>& owners, int ranks) {
+    for (size_t s = 0; s < owners.size(); ++s) {
+        if (owners[s] < 0 || owners[s] >= ranks) {
+            return InvalidArgumentError(
+                "ray exchange: brick slot {} owned by rank {} (expected [0, {}))", s, owners[s],
+                ranks);
+        }
+    }
+    return Status::Ok();
 }
 
 }  // namespace
@@ -57,8 +68,9 @@ struct MpiRayExchange::Impl {
 
     // Posts the full messages (and, with `all`, the partly filled ones too).
     Status PostReady(bool all);
-    // Completes the finished sends to `dest`; returns whether any completed.
-    StatusOr<bool> CompleteSends(int dest);
+    // Completes the finished sends of `list` (to one rank, or the progress reports); returns
+    // whether any completed.
+    StatusOr<bool> CompleteSends(std::deque<Posted>& list);
     // Receives and queues every message that has arrived; returns whether any did.
     StatusOr<bool> Receive();
     // One step of progress with nothing else to do: sends and receipts.
@@ -68,6 +80,8 @@ struct MpiRayExchange::Impl {
     // adds the reports that have arrived to its bar.
     Status Report(bool now);
     Status ReceiveReports();
+    // Receives one report from `source` (MPI_ANY_SOURCE: any rank) and adds it to the bar.
+    Status TakeReport(int source);
 
     MPI_Comm rays_comm = MPI_COMM_NULL;  // point-to-point ray messages
     MPI_Comm sum_comm = MPI_COMM_NULL;   // the termination rounds' sums
@@ -114,13 +128,7 @@ StatusOr<std::unique_ptr<MpiRayExchange>> MpiRayExchange::Create(
     MPI_Comm_set_errhandler(impl->sum_comm, MPI_ERRORS_RETURN);
     MPI_Comm_rank(impl->rays_comm, &impl->rank);
     MPI_Comm_size(impl->rays_comm, &impl->size);
-    for (size_t s = 0; s < impl->owners.size(); ++s) {
-        if (impl->owners[s] < 0 || impl->owners[s] >= impl->size) {
-            return InvalidArgumentError(
-                "ray exchange: brick slot {} owned by rank {} (expected [0, {}))", s,
-                impl->owners[s], impl->size);
-        }
-    }
+    NAVE_RETURN_IF_ERROR(CheckOwners(impl->owners, impl->size));
     impl->outgoing.resize(size_t(impl->size));
     for (auto& o : impl->outgoing) o = std::make_unique<Impl::Outgoing>();
     impl->posted.resize(size_t(impl->size));
@@ -217,9 +225,8 @@ Status MpiRayExchange::Impl::PostReady(bool all) {
     return Status::Ok();
 }
 
-StatusOr<bool> MpiRayExchange::Impl::CompleteSends(int dest) {
+StatusOr<bool> MpiRayExchange::Impl::CompleteSends(std::deque<Posted>& list) {
     bool any = false;
-    auto& list = posted[size_t(dest)];
     for (auto it = list.begin(); it != list.end();) {
         int done = 0;
         NAVE_RETURN_IF_ERROR(
@@ -276,12 +283,7 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
 }
 
 Status MpiRayExchange::Impl::Report(bool now) {
-    for (auto it = reports.begin(); it != reports.end();) {
-        int done = 0;
-        NAVE_RETURN_IF_ERROR(
-            MpiStatus(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
-        it = done ? reports.erase(it) : std::next(it);
-    }
+    NAVE_RETURN_IF_ERROR(CompleteSends(reports).status());
     if (bar == nullptr || rank == 0) return Status::Ok();
     if (!now && SecondsSince(last_report) < kProgressReportSeconds) return Status::Ok();
     const uint64_t done = bar->done();
@@ -307,14 +309,18 @@ Status MpiRayExchange::Impl::ReceiveReports() {
         NAVE_RETURN_IF_ERROR(MpiStatus(
             MPI_Iprobe(MPI_ANY_SOURCE, kProgressTag, rays_comm, &arrived, &status), "MPI_Iprobe"));
         if (!arrived) return Status::Ok();
-        uint64_t gained = 0;
-        NAVE_RETURN_IF_ERROR(
-            MpiStatus(MPI_Recv(&gained, int(sizeof(gained)), MPI_BYTE, status.MPI_SOURCE,
-                               kProgressTag, rays_comm, MPI_STATUS_IGNORE),
-                      "MPI_Recv"));
-        ++reports_received;
-        if (bar != nullptr) bar->Add(gained);
+        NAVE_RETURN_IF_ERROR(TakeReport(status.MPI_SOURCE));
     }
+}
+
+Status MpiRayExchange::Impl::TakeReport(int source) {
+    uint64_t gained = 0;
+    NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Recv(&gained, int(sizeof(gained)), MPI_BYTE, source,
+                                            kProgressTag, rays_comm, MPI_STATUS_IGNORE),
+                                   "MPI_Recv"));
+    ++reports_received;
+    if (bar != nullptr) bar->Add(gained);
+    return Status::Ok();
 }
 
 StatusOr<bool> MpiRayExchange::Impl::Step() {
@@ -323,7 +329,7 @@ StatusOr<bool> MpiRayExchange::Impl::Step() {
     bool any = false;
     for (int dest = 0; dest < size; ++dest) {
         if (dest == rank) continue;
-        NAVE_ASSIGN_OR_RETURN(bool completed, CompleteSends(dest));
+        NAVE_ASSIGN_OR_RETURN(bool completed, CompleteSends(posted[size_t(dest)]));
         any = any || completed;
     }
     NAVE_ASSIGN_OR_RETURN(bool received, Receive());
@@ -396,13 +402,7 @@ Status MpiRayExchange::SetOwners(std::vector<int> owners) {
         return InvalidArgumentError("ray exchange: {} new owners for {} brick slots", owners.size(),
                                     m.owners.size());
     }
-    for (size_t s = 0; s < owners.size(); ++s) {
-        if (owners[s] < 0 || owners[s] >= m.size) {
-            return InvalidArgumentError(
-                "ray exchange: brick slot {} given to rank {} (expected [0, {}))", s, owners[s],
-                m.size);
-        }
-    }
+    NAVE_RETURN_IF_ERROR(CheckOwners(owners, m.size));
     for (const auto& out : m.outgoing) {
         std::lock_guard<std::mutex> lock(out->mutex);
         if (!out->filling.empty() || !out->ready.empty())
@@ -433,15 +433,8 @@ Status MpiRayExchange::FinishProgress() {
         "MPI_Iallreduce"));
     NAVE_RETURN_IF_ERROR(WaitForCollective(&request, "the sum of progress reports", m.sum_comm,
                                            m.options.stall_timeout_s));
-    while (m.rank == 0 && m.reports_received < sent) {
-        uint64_t gained = 0;
-        NAVE_RETURN_IF_ERROR(
-            MpiStatus(MPI_Recv(&gained, int(sizeof(gained)), MPI_BYTE, MPI_ANY_SOURCE, kProgressTag,
-                               m.rays_comm, MPI_STATUS_IGNORE),
-                      "MPI_Recv"));
-        ++m.reports_received;
-        if (m.bar != nullptr) m.bar->Add(gained);
-    }
+    while (m.rank == 0 && m.reports_received < sent)
+        NAVE_RETURN_IF_ERROR(m.TakeReport(MPI_ANY_SOURCE));
     m.bar = nullptr;
     return Status::Ok();
 }

@@ -54,7 +54,7 @@ class MpiRayExchange final : public RayExchange {
     int rank() const;
     int size() const;
     /// The rank that owns slot `slot`.
-    int Owner(uint32_t slot) const;
+    int Owner(uint32_t slot) const override;
     bool Owns(uint32_t slot) const override { return Owner(slot) == rank(); }
     /// Errors: a slot count other than the queues', an owner outside [0, ranks), a message not yet
     /// sent.

@@ -45,6 +45,8 @@ class RayExchange {
     virtual void Send(uint32_t brick, std::span<const RayRecord> rays) = 0;
     /// Whether this process owns brick `brick` (traces its rays).
     virtual bool Owns(uint32_t brick) const = 0;
+    /// The process that owns brick `brick` (0 in a render of one process).
+    virtual int Owner(uint32_t brick) const = 0;
     /// Hands the bricks to new owners (`owners[s]`: the process of slot s), the same in every
     /// process. Only between drains, with no ray waiting or in flight anywhere. One process:
     /// Unsupported (it owns every brick).
@@ -102,6 +104,7 @@ class LocalRayExchange final : public RayExchange {
         queues_.Push(brick, rays.data(), rays.size());
     }
     bool Owns(uint32_t) const override { return true; }
+    int Owner(uint32_t) const override { return 0; }
     Status SetOwners(std::vector<int> /*owners*/) override {
         return UnsupportedError("one process owns every brick");
     }

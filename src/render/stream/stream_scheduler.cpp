@@ -49,9 +49,9 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
     std::unique_ptr<StreamScheduler> scheduler(
         new StreamScheduler(source, std::move(picker), wave_paths, ranks));
     if (ranks != nullptr) {
-        scheduler->owners_ = BrickOwners(source, ranks->size());
-        NAVE_ASSIGN_OR_RETURN(scheduler->distributed_exchange_,
-                              ranks->MakeExchange(scheduler->owners_, scheduler->queues_));
+        NAVE_ASSIGN_OR_RETURN(
+            scheduler->distributed_exchange_,
+            ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
     NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
@@ -308,7 +308,7 @@ Status StreamScheduler::Rebalance() {
     };
     // Every level of a brick goes with it: level 0's slot names the owner.
     const std::vector<uint64_t> before =
-        loads([&](uint32_t b) { return owners_[source_.SlotOf(b, 0)]; });
+        loads([&](uint32_t b) { return exchange_->Owner(source_.SlotOf(b, 0)); });
     const uint64_t total = std::accumulate(before.begin(), before.end(), uint64_t(0));
     const uint64_t busiest = *std::max_element(before.begin(), before.end());
     if (total == 0 || double(busiest) <= kRebalanceRatio * double(total) / n) return Status::Ok();
@@ -317,15 +317,14 @@ Status StreamScheduler::Rebalance() {
         loads([&](uint32_t b) { return next[source_.SlotOf(b, 0)]; });
     const uint64_t busiest_after = *std::max_element(after.begin(), after.end());
     if (busiest_after >= busiest) return Status::Ok();
-    NAVE_RETURN_IF_ERROR(exchange_->SetOwners(next));
     for (uint32_t s = 0; s < next.size(); ++s) {
-        if (owners_[s] == ranks_->rank() && next[s] != ranks_->rank()) pager_->Evict(s);
+        if (exchange_->Owns(s) && next[s] != ranks_->rank()) pager_->Evict(s);
     }
+    NAVE_RETURN_IF_ERROR(exchange_->SetOwners(std::move(next)));
     log::Debug(
         "ranks: bricks re-balanced by measured work: the busiest rank had {:.2f}x the mean, "
         "now {:.2f}x",
         double(busiest) * n / double(total), double(busiest_after) * n / double(total));
-    owners_ = std::move(next);
     ++rebalances_;
     return Status::Ok();
 }

@@ -207,7 +207,6 @@ class StreamScheduler {
     // Per slot, microseconds of this process's batches of it (pinning, loads waited for and
     // tracing) since the last Rebalance: the work that re-balancing shares out.
     std::vector<uint64_t> work_us_;
-    std::vector<int> owners_;  // with ranks_: the process of each slot
     int rebalances_ = 0;
     std::atomic<uint64_t> segments_traced_{0}, shadow_segments_{0}, brick_moves_{0}, batches_{0},
         rays_{0};
