@@ -273,20 +273,6 @@ void PrintSummary(const RenderOptions& o, const std::filesystem::path& out,
     std::fputs(text.c_str(), stderr);
 }
 
-/// What a distributed render does not do yet (docs/distributed.md): refused before anything is
-/// read, so that no rank waits for another that stopped.
-Status CheckDistributed(const RenderOptions& o, const render::SceneConfig& config) {
-    const char* missing = nullptr;
-    if (config.render.mode == render::RenderSettings::Mode::kPhoton) {
-        missing = "photon mode (--mode photon)";
-    }
-    if (missing == nullptr) return Status::Ok();
-    return InvalidArgumentError(
-        "under mpirun nave renders in path mode; {} is not distributed yet: run it as one "
-        "process",
-        missing);
-}
-
 Status RunRender(const RenderOptions& o) {
     NAVE_RETURN_IF_ERROR(CheckOptions(o));
     const std::filesystem::path out = o.output;
@@ -294,7 +280,6 @@ Status RunRender(const RenderOptions& o) {
     NAVE_ASSIGN_OR_RETURN(const double rank_timeout_s,
                           ParseDuration(o.rank_timeout, "--rank-timeout"));
     NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks, JoinRanks(rank_timeout_s));
-    if (ranks != nullptr) NAVE_RETURN_IF_ERROR(CheckDistributed(o, config));
     std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
@@ -364,7 +349,7 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a brick store with spectral ray streams over its bricks (path tracing or SPPM). "
-        "Under mpirun (path mode, fixed --spp) the ranks share the bricks and send rays to each "
+        "Under mpirun the ranks share the bricks and send rays and photons to each "
         "other; rank 0 writes the image (docs/distributed.md)");
     cmd->add_option("model", opts->model, "The model (.nave store from `nave preprocess`)");
     cmd->add_option("--procedural", opts->procedural,

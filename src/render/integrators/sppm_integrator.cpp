@@ -57,6 +57,7 @@ SppmIntegrator::SppmIntegrator(const RenderScene& scene, Film* film, StreamSched
           scene.settings.alpha, UsesCausticPoints(scene.settings, scene.materials))),
       gather_guide_(std::move(gather_guide)),
       camera_pass_(scene, film, scheduler, *lights_, visible_.get(), gather_guide_.get()),
+      deposit_to_fixed_(4294967296.0 / std::max(1e-30, emitters_->typical_photon_power())),
       sky_direct_photons_(scene.settings.sky_direct == RenderSettings::SkyDirect::kPhotons),
       final_gather_(scene.settings.final_gather) {}
 
@@ -64,6 +65,8 @@ Status SppmIntegrator::Restore(const RenderSession& session) {
     NAVE_ASSIGN_OR_RETURN(std::string_view points, session.Section("visible_points"));
     ByteReader points_in(points, session.resume_name() + " section visible_points");
     NAVE_RETURN_IF_ERROR(visible_->LoadState(&points_in));
+    // The checkpoint's density sums are every process's: one process holds them, as its film.
+    if (scheduler_.ranks() != nullptr && scheduler_.ranks()->rank() != 0) visible_->ClearSums();
     NAVE_ASSIGN_OR_RETURN(std::string_view learned, session.Section("photon_emitters"));
     ByteReader learned_in(learned, session.resume_name() + " section photon_emitters");
     NAVE_RETURN_IF_ERROR(emitters_->LoadState(&learned_in));
@@ -115,15 +118,30 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
                                 [&](uint64_t first, uint64_t last) {
                                     return camera_pass_.GenerateCameraRays(first, last, 0);
                                 }));
-    visible_->BuildBrickGrids(scheduler_.tree());
-    deposited_.assign(emitters_->learned_photons(), 0.f);
+    RankGroup* ranks = scheduler_.ranks();
+    if (ranks != nullptr) {
+        // Photons traced here reach the points in this process's bricks, wherever they were made.
+        const RayExchange& exchange = scheduler_.exchange();
+        NAVE_RETURN_IF_ERROR(visible_->ShareWithOwners(
+            *ranks, scheduler_.tree(), [&](uint32_t brick) { return exchange.Owner(brick); },
+            scene_.materials));
+        visible_->BuildBrickGrids(scheduler_.tree(),
+                                  [&](uint32_t brick) { return exchange.Owns(brick); });
+    } else {
+        visible_->BuildBrickGrids(scheduler_.tree());
+    }
+    deposited_.assign(emitters_->learned_photons(), 0);
     NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
         *this, photons, wave, StreamScheduler::LastWave::kDrained,
         [&](uint64_t first, uint64_t last) {
             emitters_->EmitPhotons(first, last, iteration_, visible_->radius(), scheduler_);
             return Status::Ok();
         }));
-    emitters_->Learn(deposited_);
+    if (ranks != nullptr) NAVE_RETURN_IF_ERROR(ShareLearning(*ranks));
+    std::vector<float> deposited(deposited_.size());
+    for (size_t k = 0; k < deposited.size(); ++k)
+        deposited[k] = float(double(deposited_[k]) / deposit_to_fixed_);
+    emitters_->Learn(deposited);
     if (SkyWindows* windows = lights_->sky_windows()) windows->Update();
     if (gather_guide_) {
         gather_guide_->Update();
@@ -131,7 +149,8 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
                    iteration_ + 1, gather_guide_->cells_used(), gather_guide_->cells_guiding());
     }
     visible_->EndIteration(Film::SampleHalf(iteration_));
-    if (progress_ != nullptr) progress_->Add(1);
+    // An iteration is the whole job's: in a distributed render the first process counts it.
+    if (progress_ != nullptr && (ranks == nullptr || ranks->rank() == 0)) progress_->Add(1);
     return done + 1;
 }
 
@@ -143,9 +162,19 @@ Status SppmIntegrator::Finish(int done, RenderStats* stats) {
     // count holds.
     film_->SetSamplesPerPixel(done);
     const double emitted = double(photons) * done;
-    for (uint64_t p = 0; p < pixels; ++p) {
-        film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done),
-                      Film::kNoHalf);
+    RankGroup* ranks = scheduler_.ranks();
+    if (ranks != nullptr) {
+        // Every process's deposits in every process, for the noise estimate once the films are
+        // summed (RenderStreams); the first process alone adds them to its film, so that the
+        // films' sum counts them once.
+        NAVE_RETURN_IF_ERROR(
+            visible_->CombineSums([&](std::span<double> v) { return ranks->SumEverywhere(v); }));
+    }
+    if (ranks == nullptr || ranks->rank() == 0) {
+        for (uint64_t p = 0; p < pixels; ++p) {
+            film_->AddXYZ(uint32_t(p), visible_->IndirectXYZ(uint32_t(p), emitted) * double(done),
+                          Film::kNoHalf);
+        }
     }
     stats->noise_relmse = NoiseEstimate(done);
     stats->iterations = done;
@@ -157,11 +186,28 @@ Status SppmIntegrator::Finish(int done, RenderStats* stats) {
     return Status::Ok();
 }
 
+Status SppmIntegrator::ShareLearning(RankGroup& ranks) {
+    // What each process learned from the photons it traced, summed in integers: every process
+    // then learns the same as one process would.
+    NAVE_RETURN_IF_ERROR(ranks.SumEverywhere(std::span<uint64_t>(deposited_)));
+    if (SkyWindows* windows = lights_->sky_windows()) {
+        NAVE_RETURN_IF_ERROR(windows->ShareRecords(
+            [&](std::span<const std::byte> mine) { return ranks.GatherEverywhere(mine); }));
+    }
+    if (gather_guide_) {
+        NAVE_RETURN_IF_ERROR(gather_guide_->ShareCredits(
+            [&](std::span<uint64_t> values) { return ranks.SumEverywhere(values); }));
+    }
+    return Status::Ok();
+}
+
 Status SppmIntegrator::ShareState(RankGroup& ranks) {
-    return UnsupportedError(
-        "photon mode's visible points and guides are not shared between the {} processes of a "
-        "distributed render",
-        ranks.size());
+    // Between iterations the guides and windows are every process's already (ShareLearning): the
+    // density sums go to the first process, as the films do (RenderSession::AtBoundary).
+    NAVE_RETURN_IF_ERROR(
+        visible_->CombineSums([&](std::span<double> v) { return ranks.SumEverywhere(v); }));
+    if (ranks.rank() != 0) visible_->ClearSums();
+    return Status::Ok();
 }
 
 double SppmIntegrator::NoiseEstimate(int iterations) const {
@@ -230,8 +276,11 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
             scheduler_.source().BrickOfSlot(b), h.p, h.ng, wo, r.beta, r.lambda,
             VisiblePoints::PhotonChannel(r.pixel, uint64_t(scene_.settings.photons_per_iteration)),
             (r.flags & kSpecularChain) != 0);
-        // One writer per photon: a photon is traced by one thread at a time.
-        if (r.pixel < deposited_.size()) deposited_[r.pixel] += added;
+        // One writer per photon: a photon is traced by one thread at a time. In fixed point, so
+        // that a photon's deposits in several processes add up to one process's sum exactly.
+        if (r.pixel < deposited_.size())
+            deposited_[r.pixel] +=
+                uint64_t(std::llround(std::clamp(double(added) * deposit_to_fixed_, 0.0, 1e18)));
     }
     // One sky photon in kLearnWindowEvery teaches the windows: enough to learn them in an
     // iteration of the abbey, for a quarter of the cost (a ray through the portals' scene each).

@@ -37,8 +37,8 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     /// From the two halves of the film's samples and of the photons (visible_points.h).
     double NoiseEstimate(int iterations) const override;
     std::array<double, 2> HalfLuminances(uint32_t pixel, int iterations) const override;
-    /// Photon mode is not distributed yet (refused under mpirun before anything is read): an
-    /// Unsupported error.
+    /// The visible points' density sums into the first process's (the guides and windows are
+    /// shared after every iteration).
     Status ShareState(RankGroup& ranks) override;
     void Save(Checkpoint* checkpoint) const override;
     /// Adds the photon estimate of the `done` iterations to the film.
@@ -56,6 +56,10 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     /// A sky photon at its first diffuse hit `h`: teaches the sky's next-event estimation which
     /// window lights that region (SkyWindows).
     void LearnWindow(const RayRecord& r, const SurfaceHit& h);
+    /// In a distributed render, after a photon pass: what every process learned (the photons'
+    /// deposits, the windows' records, the gather guide's credits), in every process.
+    /// Collective.
+    Status ShareLearning(RankGroup& ranks);
     static constexpr uint32_t kLearnWindowEvery = 4;
 
     const RenderScene& scene_;
@@ -69,8 +73,10 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
     std::unique_ptr<PathGuide> gather_guide_;
     VisiblePointPass camera_pass_;
     // Per photon of the pass (the first PhotonEmitters::learned_photons()), the luminance it
-    // brought to the visible points, for the emitters to learn from.
-    std::vector<float> deposited_;
+    // brought to the visible points, for the emitters to learn from: in fixed point, 2^32 units
+    // to a typical photon's power (deposit_to_fixed_ units per unit of luminance).
+    std::vector<uint64_t> deposited_;
+    const double deposit_to_fixed_;
     uint32_t iteration_ = 0;
     const bool sky_direct_photons_;  // render.sky_direct = "photons"
     const bool final_gather_;        // render.final_gather

@@ -107,4 +107,52 @@ StatusOr<std::vector<std::byte>> MpiRankGroup::GatherEverywhere(std::span<const 
     return all;
 }
 
+StatusOr<std::vector<std::byte>> MpiRankGroup::SendToEach(
+    std::span<const std::vector<std::byte>> to_rank) {
+    const auto ranks = static_cast<size_t>(size_);
+    if (to_rank.size() != ranks) {
+        return InternalError("MPI: {} parts to send to {} ranks", to_rank.size(), size_);
+    }
+    // How much each sends each: then the bytes, with int counts and offsets on both sides.
+    std::vector<int64_t> send_sizes(ranks), receive_sizes(ranks, 0);
+    for (size_t r = 0; r < ranks; ++r) send_sizes[r] = int64_t(to_rank[r].size());
+    MPI_Request request = MPI_REQUEST_NULL;
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Ialltoall(send_sizes.data(), 1, MPI_INT64_T, receive_sizes.data(), 1,
+                                MPI_INT64_T, comm_->comm, &request),
+                  "MPI_Ialltoall"));
+    NAVE_RETURN_IF_ERROR(
+        WaitForCollective(&request, "an exchange", comm_->comm, options_.stall_timeout_s));
+    std::vector<int> send_counts(ranks), send_offsets(ranks), receive_counts(ranks),
+        receive_offsets(ranks);
+    int64_t sent = 0, received = 0;
+    for (size_t r = 0; r < ranks; ++r) {
+        send_offsets[r] = int(sent);
+        send_counts[r] = int(send_sizes[r]);
+        sent += send_sizes[r];
+        receive_offsets[r] = int(received);
+        receive_counts[r] = int(receive_sizes[r]);
+        received += receive_sizes[r];
+        if (std::max(sent, received) > int64_t(std::numeric_limits<int>::max())) {
+            return ResourceExhaustedError(
+                "MPI: {} bytes to send and {} to receive between {} ranks, more than the {} one "
+                "exchange can count",
+                sent, received, size_, std::numeric_limits<int>::max());
+        }
+    }
+    std::vector<std::byte> out(static_cast<size_t>(sent)), in(static_cast<size_t>(received));
+    for (size_t r = 0; r < ranks; ++r) {
+        std::copy(to_rank[r].begin(), to_rank[r].end(),
+                  out.begin() + std::ptrdiff_t(send_offsets[r]));
+    }
+    NAVE_RETURN_IF_ERROR(
+        MpiStatus(MPI_Ialltoallv(out.data(), send_counts.data(), send_offsets.data(), MPI_BYTE,
+                                 in.data(), receive_counts.data(), receive_offsets.data(), MPI_BYTE,
+                                 comm_->comm, &request),
+                  "MPI_Ialltoallv"));
+    NAVE_RETURN_IF_ERROR(
+        WaitForCollective(&request, "an exchange", comm_->comm, options_.stall_timeout_s));
+    return in;
+}
+
 }  // namespace nave::render

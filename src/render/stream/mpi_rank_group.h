@@ -25,6 +25,8 @@ class MpiRankGroup final : public RankGroup {
     Status SumEverywhere(std::span<uint32_t> values) override;
     Status SumEverywhere(std::span<uint64_t> values) override;
     StatusOr<std::vector<std::byte>> GatherEverywhere(std::span<const std::byte> mine) override;
+    StatusOr<std::vector<std::byte>> SendToEach(
+        std::span<const std::vector<std::byte>> to_rank) override;
 
   private:
     MpiRankGroup() = default;

@@ -91,6 +91,11 @@ class RankGroup {
     /// Every process's `mine` put end to end in rank order, in every process. Errors: more than
     /// 2 GiB in all (MPI counts bytes in an int). Collective.
     virtual StatusOr<std::vector<std::byte>> GatherEverywhere(std::span<const std::byte> mine) = 0;
+    /// Sends `to_rank[r]` to process r (one entry per process; this process's own is kept as
+    /// is) and returns what every process sent to this one, end to end in rank order. Errors:
+    /// more than 2 GiB to send or to receive (MPI counts bytes in an int). Collective.
+    virtual StatusOr<std::vector<std::byte>> SendToEach(
+        std::span<const std::vector<std::byte>> to_rank) = 0;
 };
 
 /// The exchange of a single process: it owns every brick, and rays sent to a brick wait in its

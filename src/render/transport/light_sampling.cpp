@@ -102,26 +102,15 @@ StatusOr<std::unique_ptr<LightSampler>> LightSampler::Create(const RenderScene& 
 StatusOr<std::vector<std::array<Vec3f, 3>>> LightSampler::GatherPortals(
     RankGroup& ranks, const std::vector<std::array<Vec3f, 3>>& triangles,
     const std::vector<uint32_t>& bricks) {
-    // Each process found the portals of its own bricks, brick by brick in order; all of them, in
-    // the order of their bricks, are what one process finds (the order numbers the triangles the
-    // portals sample).
+    // The order numbers the triangles the portals sample: every process's must be one process's.
     struct Found {
         uint32_t brick;
         std::array<Vec3f, 3> triangle;
     };
-    static_assert(sizeof(Found) == sizeof(uint32_t) + 9 * sizeof(float));
     std::vector<Found> mine(triangles.size());
     for (size_t i = 0; i < triangles.size(); ++i) mine[i] = {bricks[i], triangles[i]};
-    NAVE_ASSIGN_OR_RETURN(std::vector<std::byte> all,
-                          ranks.GatherEverywhere(std::as_bytes(std::span<const Found>(mine))));
-    if (all.size() % sizeof(Found) != 0) {
-        return InternalError("portals gathered from the processes: {} bytes, not whole triangles",
-                             all.size());
-    }
-    std::vector<Found> found(all.size() / sizeof(Found));
-    std::memcpy(found.data(), all.data(), all.size());
-    std::stable_sort(found.begin(), found.end(),
-                     [](const Found& a, const Found& b) { return a.brick < b.brick; });
+    NAVE_ASSIGN_OR_RETURN(const std::vector<Found> found,
+                          GatherInBrickOrder(ranks, std::span<const Found>(mine)));
     std::vector<std::array<Vec3f, 3>> out(found.size());
     for (size_t i = 0; i < found.size(); ++i) out[i] = found[i].triangle;
     return out;

@@ -123,16 +123,16 @@ class LightSampler {
     /// radiance x the panes' transmittance x |cos θ| / the pdf of its direction. Nothing without
     /// sky_windows(). Thread-safe.
     void LearnFromSkyShadow(const RayRecord& shadow) const;
-
-  private:
-    explicit LightSampler(const RenderScene& scene) : scene_(scene) {}
-    /// The order of a shadow ray's estimate of a window's light in `scene` (SkyWindows' scale).
-    static double TypicalWindowLight(const RenderScene& scene);
     /// The portal triangles of every process of a distributed render, in the order one process
     /// finds them, from this process's `triangles` and the brick of each. Collective.
     static StatusOr<std::vector<std::array<Vec3f, 3>>> GatherPortals(
         RankGroup& ranks, const std::vector<std::array<Vec3f, 3>>& triangles,
         const std::vector<uint32_t>& bricks);
+
+  private:
+    explicit LightSampler(const RenderScene& scene) : scene_(scene) {}
+    /// The order of a shadow ray's estimate of a window's light in `scene` (SkyWindows' scale).
+    static double TypicalWindowLight(const RenderScene& scene);
 
     // Sky next-event estimation toward the portals: this share of the samples, the rest uniform
     // (which keeps light that enters elsewhere, and vertices outside, sampled).

@@ -23,14 +23,6 @@ StatusOr<std::unique_ptr<PhotonEmitters>> PhotonEmitters::Build(const RenderScen
 }
 
 Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
-    // The passes below read this process's bricks only in a distributed render, whose emitters
-    // would have to be gathered from every process (photon mode is refused under mpirun).
-    if (scheduler.ranks() != nullptr) {
-        return UnsupportedError(
-            "photon mode's emitters are not gathered from the {} processes of a distributed "
-            "render",
-            scheduler.ranks()->size());
-    }
     const Bounds3f& bounds = scene_.source->bounds();
     scene_center_ = bounds.Center();
     scene_radius_ = std::max(1e-3f, 0.5f * Length(bounds.Diagonal()));
@@ -63,31 +55,56 @@ Status PhotonEmitters::Gather(StreamScheduler& scheduler) {
         // The portals only aim photons (their density mixes them with the whole disc and counts
         // the same triangles), so the coarsest levels serve; light sources are read at full
         // detail, in a second pass only when the model has any.
+        // In a distributed render each process reads its own bricks, and all gather what all
+        // found in the order one process finds it.
+        RankGroup* ranks = scheduler.ranks();
         if (want_portals) {
+            std::vector<uint32_t> bricks;  // of each triangle
             NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
                 scene_, scheduler, ScanDetail::kCoarsest,
                 [](const SurfaceMaterial& sm) { return sm.portal; },
-                [&](const ResidentMesh& m, size_t t, uint32_t) {
+                [&](const ResidentMesh& m, size_t t, uint32_t b) {
                     portal_triangles.push_back(m.TrianglePositions(t));
+                    bricks.push_back(b);
                 }));
+            if (ranks != nullptr) {
+                NAVE_ASSIGN_OR_RETURN(portal_triangles, LightSampler::GatherPortals(
+                                                            *ranks, portal_triangles, bricks));
+            }
         }
         if (any_emissive) {
+            struct Found {
+                uint32_t brick, material, has_uv;
+                std::array<Vec3f, 3> p;
+                std::array<std::array<float, 2>, 3> uv;
+            };
+            std::vector<Found> found;
             NAVE_RETURN_IF_ERROR(ForEachOwnedTriangle(
                 scene_, scheduler, ScanDetail::kFull,
                 [](const SurfaceMaterial& sm) { return sm.emissive; },
-                [&](const ResidentMesh& m, size_t t, uint32_t) {
-                    const SurfaceMaterial& sm = scene_.materials[m.material_ids[t]];
-                    std::array<std::array<float, 2>, 3> uv{};
+                [&](const ResidentMesh& m, size_t t, uint32_t b) {
+                    Found f{b, m.material_ids[t], m.HasUvs() ? 1u : 0u, m.TrianglePositions(t), {}};
                     if (m.HasUvs()) {
-                        for (int k = 0; k < 3; ++k) uv[k] = m.uvs[m.indices[3 * t + k]];
+                        for (int k = 0; k < 3; ++k) f.uv[size_t(k)] = m.uvs[m.indices[3 * t + k]];
                     }
-                    std::optional<TriangleLight> light =
-                        TriangleLight::Make(m.TrianglePositions(t), sm, m.HasUvs() ? &uv : nullptr,
-                                            power[m.material_ids[t]]);
-                    if (!light) return;
-                    triangles.push_back(std::move(*light));
-                    triangle_weights.push_back(triangles.back().Power(PhotonTarget()));
+                    found.push_back(f);
                 }));
+            if (ranks != nullptr) {
+                NAVE_ASSIGN_OR_RETURN(found,
+                                      GatherInBrickOrder(*ranks, std::span<const Found>(found)));
+            }
+            for (const Found& f : found) {
+                if (f.material >= scene_.materials.size()) {
+                    return InternalError("an emissive triangle of material {} of {}", f.material,
+                                         scene_.materials.size());
+                }
+                std::optional<TriangleLight> light =
+                    TriangleLight::Make(f.p, scene_.materials[f.material],
+                                        f.has_uv ? &f.uv : nullptr, power[f.material]);
+                if (!light) continue;
+                triangles.push_back(std::move(*light));
+                triangle_weights.push_back(triangles.back().Power(PhotonTarget()));
+            }
         }
     }
     for (const std::unique_ptr<Light>& l : scene_.lights) {
@@ -317,6 +334,8 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
             r.beta /= p_choice;
             if (r.beta.IsZero()) continue;
 
+            // In a distributed render the process owning the photon's first brick traces it.
+            if (!scheduler.MakesHere(r, i)) continue;
             // Queued at the first brick along it; a photon that misses the model carries nothing.
             ++out.counts.rays;
             const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);

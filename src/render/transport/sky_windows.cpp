@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "src/core/sampling.h"
 #include "src/render/transport/light_sampling.h"
@@ -85,6 +86,33 @@ void SkyWindows::RecordFixed(const Vec3f& p, int side, uint32_t triangle, double
     Sum& s = pending_->local.local()[key];
     s.fixed += uint64_t(std::llround(std::min(fixed, 1e15)));
     s.photons += 1;
+}
+
+Status SkyWindows::ShareRecords(
+    const std::function<StatusOr<std::vector<std::byte>>(std::span<const std::byte>)>& gather) {
+    struct Record {
+        uint64_t key, fixed, photons;
+    };
+    std::vector<Record> mine;
+    for (auto& local : pending_->local) {
+        for (const auto& [key, s] : local) mine.push_back({key, s.fixed, s.photons});
+        local.clear();
+    }
+    NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> all,
+                          gather(std::as_bytes(std::span<const Record>(mine))));
+    if (all.size() % sizeof(Record) != 0) {
+        return InternalError("sky window records from the processes: {} bytes, not whole records",
+                             all.size());
+    }
+    auto& into = pending_->local.local();
+    for (size_t at = 0; at < all.size(); at += sizeof(Record)) {
+        Record r;
+        std::memcpy(&r, all.data() + at, sizeof(r));
+        Sum& s = into[r.key];
+        s.fixed += r.fixed;
+        s.photons += uint32_t(r.photons);
+    }
+    return Status::Ok();
 }
 
 void SkyWindows::Update() {

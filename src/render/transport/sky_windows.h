@@ -20,8 +20,11 @@
 // iteration of the abbey at 480 x 320) and teach the regions the camera sees from the first
 // iteration.
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <span>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -78,6 +81,12 @@ class SkyWindows {
     }
     /// Makes what was recorded so far the regions' choices. Not concurrent with anything else.
     void Update();
+    /// In a distributed render, before Update: every process's records since the last Update,
+    /// put together in every process by `gather` (RankGroup::GatherEverywhere), so that all learn
+    /// the same choices from all the records (integer sums: the same as one process's). Not
+    /// concurrent with anything else. Errors: gather's, and bytes that are not whole records.
+    Status ShareRecords(
+        const std::function<StatusOr<std::vector<std::byte>>(std::span<const std::byte>)>& gather);
     /// The learned choice at `p` on a surface of side `side`, or null where none was learned.
     const Region* Find(const Vec3f& p, int side) const;
     /// A point on a window that `region` chose with `u_window`, on one of its triangles chosen by

@@ -5,9 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
+#include <span>
+#include <type_traits>
+#include <vector>
 
 #include "src/core/status.h"
 #include "src/render/bricks/brick_walk.h"
@@ -139,6 +144,26 @@ Status ForEachOwnedTriangle(
     const RenderScene& scene, StreamScheduler& scheduler, ScanDetail detail,
     const std::function<bool(const SurfaceMaterial&)>& want,
     const std::function<void(const ResidentMesh&, size_t, uint32_t)>& visit);
+
+/// What every process of a distributed render found in its own bricks (ForEachOwnedTriangle):
+/// `mine`, records with a `brick` field found brick by brick in order, put together in every
+/// process in the order one process finds them (by brick; within a brick, in its finder's order).
+/// Collective. Errors: the gather's.
+template <typename Found>
+StatusOr<std::vector<Found>> GatherInBrickOrder(RankGroup& ranks, std::span<const Found> mine) {
+    static_assert(std::is_trivially_copyable_v<Found>);
+    NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> all,
+                          ranks.GatherEverywhere(std::as_bytes(mine)));
+    if (all.size() % sizeof(Found) != 0) {
+        return InternalError("gathered from the processes: {} bytes, not whole records of {}",
+                             all.size(), sizeof(Found));
+    }
+    std::vector<Found> found(all.size() / sizeof(Found));
+    std::memcpy(found.data(), all.data(), all.size());
+    std::stable_sort(found.begin(), found.end(),
+                     [](const Found& a, const Found& b) { return a.brick < b.brick; });
+    return found;
+}
 
 /// Where `r`'s segment in `brick` starts. At a coarse level the segment reaches back past the
 /// cell's face by kLevelOverlap times the level's error: where the ray crossed from a brick at

@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <numeric>
+#include <type_traits>
 
 #include "src/core/atomic_add.h"
 #include "src/core/byte_stream.h"
 #include "src/core/color.h"
 #include "src/render/scene/scene.h"
+#include "src/render/stream/ray_exchange.h"
 #include "src/render/transport/rng.h"
 #include "src/render/transport/transport_common.h"
 
@@ -132,17 +135,87 @@ uint64_t VisiblePoints::CellKey(const Vec3f& p, float cell) const {
     return HashCombine(HashCombine(MixBits(uint64_t(x)), uint64_t(y)), uint64_t(z));
 }
 
-void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree) {
+Bounds3f VisiblePoints::GatherBox(const Vec3f& p) const {
+    const float r = radius_;
+    return Bounds3f(p - Vec3f(r, r, r), p + Vec3f(r, r, r));
+}
+
+namespace {
+
+// A visible point on its way to another process: its index among the points and its material's
+// among the scene's, then the point itself with its material pointer cleared.
+struct WireHeader {
+    uint32_t index;
+    uint32_t material;
+};
+
+}  // namespace
+
+Status VisiblePoints::ShareWithOwners(RankGroup& ranks, const store::BrickTree& tree,
+                                      const std::function<int(uint32_t)>& owner,
+                                      std::span<const SurfaceMaterial> materials) {
+    static_assert(std::is_trivially_copyable_v<Point>);
+    constexpr size_t kWireBytes = sizeof(WireHeader) + sizeof(Point);
+    const auto size = static_cast<size_t>(ranks.size());
+    const int me = ranks.rank();
+    std::vector<std::vector<std::byte>> to_rank(size);
+    std::vector<uint32_t> bricks;
+    std::vector<bool> sent(size);
+    for (size_t i = 0; i < points_.size(); ++i) {
+        const Point& vp = points_[i];
+        if (!vp.valid || radius_ <= 0) continue;
+        tree.BricksOverlapping(GatherBox(vp.p), &bricks);
+        std::fill(sent.begin(), sent.end(), false);
+        for (uint32_t b : bricks) {
+            const int r = owner(b);
+            if (r == me || sent[size_t(r)]) continue;
+            sent[size_t(r)] = true;
+            const WireHeader header{uint32_t(i), uint32_t(vp.material - materials.data())};
+            Point copy = vp;
+            copy.material = nullptr;
+            std::vector<std::byte>& out = to_rank[size_t(r)];
+            const size_t at = out.size();
+            out.resize(at + kWireBytes);
+            std::memcpy(out.data() + at, &header, sizeof(header));
+            std::memcpy(out.data() + at + sizeof(header), &copy, sizeof(copy));
+        }
+    }
+    NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> received, ranks.SendToEach(to_rank));
+    to_rank.clear();
+    if (received.size() % kWireBytes != 0) {
+        return InternalError("visible points from the other processes: {} bytes, not whole points",
+                             received.size());
+    }
+    for (size_t at = 0; at < received.size(); at += kWireBytes) {
+        WireHeader header;
+        std::memcpy(&header, received.data() + at, sizeof(header));
+        if (header.index >= points_.size() || header.material >= materials.size()) {
+            return InternalError(
+                "a visible point from another process: point {} of {}, material {} of {}",
+                header.index, points_.size(), header.material, materials.size());
+        }
+        // One camera path per pixel: no other process made this pixel's point.
+        Point& vp = points_[header.index];
+        std::memcpy(&vp, received.data() + at + sizeof(header), sizeof(Point));
+        vp.material = &materials[header.material];
+    }
+    return Status::Ok();
+}
+
+void VisiblePoints::BuildBrickGrids(const store::BrickTree& tree,
+                                    const std::function<bool(uint32_t)>& keep) {
     if (radius_ <= 0) return;
     for (BrickGrid& g : grids_) g.cell = 2 * radius_;
     std::vector<uint32_t> bricks;
+    // In the points' order, whichever process made them: a cell lists its points in the same order
+    // in every process, and a photon adds to them in that order.
     for (size_t i = 0; i < points_.size(); ++i) {
         const Point& vp = points_[i];
         if (!vp.valid) continue;
-        const float r = radius_;
-        Bounds3f box(vp.p - Vec3f(r, r, r), vp.p + Vec3f(r, r, r));
+        const Bounds3f box = GatherBox(vp.p);
         tree.BricksOverlapping(box, &bricks);
         for (uint32_t b : bricks) {
+            if (keep && !keep(b)) continue;
             BrickGrid& g = grids_[b];
             int lo[3], hi[3];
             for (int a = 0; a < 3; ++a) {
@@ -259,6 +332,31 @@ Status VisiblePoints::LoadState(ByteReader* in) {
         pixels_[i].density_sum_y_half0 = sums[4 * i + 3];
     }
     return in->ExpectEnd();
+}
+
+Status VisiblePoints::CombineSums(const std::function<Status(std::span<double>)>& sum) {
+    // The deposits' count rides along, exact in a double up to 2^53.
+    std::vector<double> sums(pixel_count_ * 4 + 1);
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        for (int c = 0; c < 3; ++c) sums[4 * i + c] = pixels_[i].density_sum[c];
+        sums[4 * i + 3] = pixels_[i].density_sum_y_half0;
+    }
+    sums.back() = double(deposits_.load(std::memory_order_relaxed));
+    NAVE_RETURN_IF_ERROR(sum(sums));
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        for (int c = 0; c < 3; ++c) pixels_[i].density_sum[c] = sums[4 * i + c];
+        pixels_[i].density_sum_y_half0 = sums[4 * i + 3];
+    }
+    deposits_.store(uint64_t(sums.back()), std::memory_order_relaxed);
+    return Status::Ok();
+}
+
+void VisiblePoints::ClearSums() {
+    for (size_t i = 0; i < pixel_count_; ++i) {
+        pixels_[i].density_sum = Vec3d();
+        pixels_[i].density_sum_y_half0 = 0;
+    }
+    deposits_.store(0, std::memory_order_relaxed);
 }
 
 Vec3d VisiblePoints::IndirectXYZ(uint32_t pixel, double photons_emitted) const {

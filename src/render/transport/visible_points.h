@@ -37,7 +37,10 @@
 //
 // Visible points are kept per brick: a point is registered in every brick whose cell its gather
 // sphere overlaps, so a photon landing in a brick finds all the points it can reach in that brick's
-// own grid.
+// own grid. In a distributed render (docs/distributed.md) a point is made by the process that owns
+// the brick the camera path stopped in, which sends it to the owners of the other bricks its sphere
+// overlaps; each process registers points in its own bricks only, and its pixels' density sums
+// hold the deposits it made: the image's are their sums over the processes.
 //
 // With final gathering (render.final_gather) the visible point lies one bounce past the first
 // diffuse vertex, and light reaching that vertex through a chain of specular bounces (a caustic:
@@ -52,7 +55,9 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -67,6 +72,7 @@ namespace nave::render {
 
 struct SurfaceMaterial;
 struct RenderSettings;
+class RankGroup;
 
 class VisiblePoints {
   public:
@@ -109,9 +115,18 @@ class VisiblePoints {
                     const SurfaceMaterial& material, const std::array<float, 2>* uv,
                     const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
                     const SampledWavelengths& lambda);
+    /// In a distributed render, after the camera pass: sends each visible point this process made
+    /// to the processes owning a brick its gather sphere overlaps (`owner` of a brick), and keeps
+    /// the points the others send, so that every photon traced here finds every point it can
+    /// reach. `materials`: the scene's, which the points refer to. Collective. Errors: the
+    /// exchange's, and a received point that names no pixel or material (InternalError).
+    Status ShareWithOwners(RankGroup& ranks, const store::BrickTree& tree,
+                           const std::function<int(uint32_t brick)>& owner,
+                           std::span<const SurfaceMaterial> materials);
     /// Registers every visible point in the bricks its gather sphere overlaps (after the camera
-    /// pass).
-    void BuildBrickGrids(const store::BrickTree& tree);
+    /// pass), of those `keep` accepts (empty: all; in a distributed render, this process's).
+    void BuildBrickGrids(const store::BrickTree& tree,
+                         const std::function<bool(uint32_t brick)>& keep = {});
     /// A photon of power `beta` at its wavelengths `lambda` arriving from direction `wi` (pointing
     /// away from the surface) at `p`, on a surface of geometric normal `ng`, in brick `brick`: adds
     /// the XYZ of beta * f * (camera throughput) to every visible point of that brick within the
@@ -146,6 +161,11 @@ class VisiblePoints {
     void SaveState(ByteWriter* out) const;
     /// Replaces what SaveState saved. Errors: DataLoss for another pixel count or truncated bytes.
     Status LoadState(ByteReader* in);
+    /// In a distributed render, where each process holds the density sums of the deposits it
+    /// made: replaces them by their sums over the processes (`sum`), in every process.
+    Status CombineSums(const std::function<Status(std::span<double>)>& sum);
+    /// Forgets the density sums (radius and iteration stay): a process whose sums another holds.
+    void ClearSums();
     /// The gather radius of the current iteration (metres).
     float radius() const { return radius_; }
     uint64_t deposits() const { return deposits_.load(std::memory_order_relaxed); }
@@ -187,6 +207,8 @@ class VisiblePoints {
         std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
     };
     uint64_t CellKey(const Vec3f& p, float cell) const;
+    /// The box around `p` that its gather sphere of the current radius fits in.
+    Bounds3f GatherBox(const Vec3f& p) const;
     void Set(Point* point, uint32_t pixel, const Vec3f& p, const Vec3f& ns, const Vec3f& wo,
              const SurfaceMaterial& material, const std::array<float, 2>* uv,
              const imaging::TextureFootprint& footprint, const SampledSpectrum& beta,
