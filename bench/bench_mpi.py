@@ -38,30 +38,15 @@ def rgb(path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--nave", default=nb.default_nave())
-    ap.add_argument("--dir", default="/tmp/nave-bench-mpi")
-    ap.add_argument("--detail", type=int, default=30)
-    ap.add_argument("--store", default="")
-    ap.add_argument("--config", default="configs/abbey.toml")
-    ap.add_argument("--view", default="nave")
-    ap.add_argument("--resolution", default="320x213")
-    ap.add_argument("--spp", type=int, default=4)
+    nb.add_abbey_run_arguments(ap, "/tmp/nave-bench-mpi")
     ap.add_argument("--memory", default="", help="each rank's --memory (default: in-core)")
     ap.add_argument("--runs", default="1x2,2x1,4x1", help="RANKSxTHREADS, comma separated; 1x... is one process")
     args = ap.parse_args()
     os.makedirs(args.dir, exist_ok=True)
     os.environ.update(MPI_ENV)
     log = open(os.path.join(args.dir, "mpi.log"), "a")
-    store = args.store or os.path.join(args.dir, f"abbey{args.detail}.nave")
-    if not os.path.exists(store):
-        p = nb.run_logged([args.nave, "preprocess", "--generate", f"abbey:detail={args.detail}", "-q", "-o", store], log)
-        if p.returncode != 0:
-            raise SystemExit(f"preprocess failed: see {log.name}")
-    config = os.path.join(args.dir, f"{args.view}.toml")
-    with open(args.config) as f:
-        text = nb.config_for_view(f.read(), args.view)
-    with open(config, "w") as f:
-        f.write(text)
+    store, config = nb.abbey_store_and_view(args.nave, args.dir, args.detail, args.store, args.config, args.view,
+                                            log)
     rows, reference = [], None
     for run in args.runs.split(","):
         ranks, threads = (int(x) for x in run.split("x"))

@@ -249,3 +249,32 @@ def worst_region_ratio(result):
         if ref > 0 and abs(a / ref - 1) > abs(worst - 1):
             worst = a / ref
     return worst
+
+
+def abbey_store_and_view(nave, out_dir, detail, store, config, view, log):
+    """The store to render (`store`, or the procedural abbey of `detail` generated into `out_dir` once) and a
+    config for `view` written beside it from `config`: -> (store path, config path)."""
+    store = store or os.path.join(out_dir, f"abbey{detail}.nave")
+    if not os.path.exists(store):
+        p = run_logged([nave, "preprocess", "--generate", f"abbey:detail={detail}", "-q", "-o", store], log)
+        if p.returncode != 0:
+            raise SystemExit(f"preprocess failed: see {log.name}")
+    view_config = os.path.join(out_dir, f"{view}.toml")
+    with open(config) as f:
+        text = config_for_view(f.read(), view)
+    with open(view_config, "w") as f:
+        f.write(text)
+    return store, view_config
+
+
+def add_abbey_run_arguments(ap, out_dir):
+    """The options of a bench that renders the procedural abbey (or --store) from one view: the nave binary,
+    the output directory (default `out_dir`), the model, the config and view, the resolution and samples."""
+    ap.add_argument("--nave", default=default_nave())
+    ap.add_argument("--dir", default=out_dir)
+    ap.add_argument("--detail", type=int, default=30)
+    ap.add_argument("--store", default="")
+    ap.add_argument("--config", default="configs/abbey.toml")
+    ap.add_argument("--view", default="nave")
+    ap.add_argument("--resolution", default="320x213")
+    ap.add_argument("--spp", type=int, default=4)

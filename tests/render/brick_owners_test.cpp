@@ -10,6 +10,7 @@
 #include <set>
 
 #include "render_test_util.h"
+#include "src/render/stream/stream_scheduler.h"
 #include "store/testing/store_testing.h"
 
 namespace nave::render {
@@ -47,19 +48,10 @@ TEST(BrickOwners, RanksGetRunsOfNeighbouringBricksOfAboutEqualSize) {
         for (int r = 0; r < ranks; ++r)
             EXPECT_NEAR(bytes[size_t(r)], total / ranks, largest) << "rank " << r;
         // Runs in the tree's depth-first order: walking it, the rank never goes back.
-        std::vector<uint32_t> order;
-        std::vector<uint32_t> stack = {0};
-        const auto& nodes = source->tree().nodes();
-        while (!stack.empty()) {
-            const store::BrickTreeNode& node = nodes[stack.back()];
-            stack.pop_back();
-            if (node.IsLeaf()) {
-                if (node.brick != store::kNoBrick) order.push_back(node.brick);
-                continue;
-            }
-            stack.push_back(node.child[1]);
-            stack.push_back(node.child[0]);
-        }
+        const std::vector<uint32_t> order = BricksDepthFirst(*source);
+        ASSERT_EQ(order.size(), source->brick_count());
+        EXPECT_EQ(std::set<uint32_t>(order.begin(), order.end()).size(), order.size())
+            << "a brick listed twice";
         std::set<int> seen;
         for (size_t i = 0; i < order.size(); ++i) {
             const int r = owners[order[i]];
@@ -98,6 +90,32 @@ TEST(BrickOwners, MeasuredWorkCutsRunsOfAboutEqualWork) {
     // Without measured work, as by size.
     EXPECT_EQ(BrickOwnersByWork(*source, 2, std::vector<uint64_t>(bricks, 0)).size(),
               source->slot_count());
+}
+
+// For a trace (bench/replay_mpi.py): the rays a batch sent, per other brick, a level of a brick
+// counting as the brick, in brick order.
+TEST(SentPerBrick, CountsTheRaysSentToEachOtherBrick) {
+    const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 64, .quads_y = 64});
+    store::LevelOptions levels;
+    levels.relative_errors = {0.02};
+    levels.lock_borders = false;
+    auto source =
+        testing::GridSourceWithLevels(mesh, testing::NamedMaterials({"a"}), {4, 1, 1}, levels);
+    ASSERT_TRUE(source != nullptr);
+    ASSERT_TRUE(source->UseLevels(2).ok());
+    ASSERT_EQ(source->brick_count(), 4u);
+    RayOutbox out;
+    const RayRecord r{};
+    const uint32_t from = source->SlotOf(1, 0);
+    for (int i = 0; i < 3; ++i) out.Send(source->SlotOf(2, 0), from, r);
+    out.Send(source->SlotOf(2, 1), from, r);  // brick 2 at its coarse level
+    out.Send(source->SlotOf(0, 1), from, r);
+    out.Send(source->SlotOf(1, 1), from, r);  // its own brick at another level: not sent elsewhere
+    SentPerBrick sent;
+    EXPECT_EQ(sent.Text(), "");
+    sent.Count(*source, from, out);
+    sent.Count(*source, source->SlotOf(1, 1), out);  // another task of a batch of the same brick
+    EXPECT_EQ(sent.Text(), "0:2 2:8");
 }
 
 }  // namespace

@@ -10,20 +10,7 @@ namespace {
 /// neighbouring ones) of about equal `weight` per brick.
 std::vector<int> OwnersOfRuns(const BrickSource& source, int ranks,
                               const std::vector<double>& weight) {
-    std::vector<uint32_t> order;
-    const auto& nodes = source.tree().nodes();
-    std::vector<uint32_t> stack;
-    if (!nodes.empty()) stack.push_back(0);
-    while (!stack.empty()) {
-        const store::BrickTreeNode& node = nodes[stack.back()];
-        stack.pop_back();
-        if (node.IsLeaf()) {
-            if (node.brick < source.brick_count()) order.push_back(node.brick);
-            continue;
-        }
-        stack.push_back(node.child[1]);
-        stack.push_back(node.child[0]);
-    }
+    const std::vector<uint32_t> order = BricksDepthFirst(source);
     double total = 0;
     for (uint32_t b : order) total += weight[b];
     std::vector<int> brick_owner(source.brick_count(), 0);
@@ -40,6 +27,24 @@ std::vector<int> OwnersOfRuns(const BrickSource& source, int ranks,
 }
 
 }  // namespace
+
+std::vector<uint32_t> BricksDepthFirst(const BrickSource& source) {
+    std::vector<uint32_t> order;
+    const auto& nodes = source.tree().nodes();
+    std::vector<uint32_t> stack;
+    if (!nodes.empty()) stack.push_back(0);
+    while (!stack.empty()) {
+        const store::BrickTreeNode& node = nodes[stack.back()];
+        stack.pop_back();
+        if (node.IsLeaf()) {
+            if (node.brick < source.brick_count()) order.push_back(node.brick);
+            continue;
+        }
+        stack.push_back(node.child[1]);
+        stack.push_back(node.child[0]);
+    }
+    return order;
+}
 
 std::vector<int> BrickOwners(const BrickSource& source, int ranks) {
     std::vector<double> weight(source.brick_count(), 0.0);

@@ -11,6 +11,9 @@
 
 namespace nave::render {
 
+/// The bricks of `source` as the leaves of its brick tree in depth-first order: the order in which
+/// BrickOwners cuts runs.
+std::vector<uint32_t> BricksDepthFirst(const BrickSource& source);
 /// The rank (0 to `ranks` - 1) of every slot of `source` (every level of a brick goes with the
 /// brick): the brick tree's leaves in depth-first order, cut into `ranks` runs of about equal
 /// EstimatedResidentBytes at full detail. Deterministic: every rank computes the same.

@@ -92,7 +92,18 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
         max_batch_ = MaxBatchRays(queue_memory_);
     }
     trace_ = paging.trace;
-    if (trace_ != nullptr) trace_->NameThread("scheduler");
+    if (trace_ != nullptr) {
+        trace_->NameThread("scheduler");
+        // For a replay of the render over several processes (bench/replay_mpi.py): the order in
+        // which BrickOwners cuts runs of bricks, and how many slots there are to a brick.
+        std::string order;
+        for (uint32_t b : BricksDepthFirst(source_)) {
+            if (!order.empty()) order += ' ';
+            order += std::to_string(b);
+        }
+        trace_->Instant("bricks", "scheduler",
+                        {{"bricks", source_.brick_count()}, {"depth_first", order}});
+    }
     NAVE_ASSIGN_OR_RETURN(
         pager_, Pager::Create(source_, paging, [this](uint32_t b) { return queues_.Waiting(b); }));
     return Status::Ok();
@@ -158,6 +169,26 @@ uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) co
     return source_.SlotOf(s.brick, level);
 }
 
+void SentPerBrick::Count(const BrickSource& source, uint32_t from_slot, const RayOutbox& out) {
+    const uint32_t from = source.BrickOfSlot(from_slot);
+    std::map<uint32_t, uint64_t> mine;
+    for (const auto& [slot, ray] : out.rays) {
+        const uint32_t to = source.BrickOfSlot(slot);
+        if (to != from) ++mine[to];
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [to, n] : mine) counts_[to] += n;
+}
+
+std::string SentPerBrick::Text() const {
+    std::string text;
+    for (const auto& [to, n] : counts_) {
+        if (!text.empty()) text += ' ';
+        text += std::to_string(to) + ':' + std::to_string(n);
+    }
+    return text;
+}
+
 void StreamScheduler::Flush(RayOutbox& out) {
     std::vector<std::pair<uint32_t, RayRecord>>& rays = out.rays;
     std::sort(rays.begin(), rays.end(),
@@ -217,6 +248,9 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         TraceSpan span(trace_, "batch", "scheduler");
         span.AddArg({"brick", b});
         span.AddArg({"rays", batch.size()});
+        // Traced: the rays this batch sent to each other brick, which a replay of the render over
+        // several processes needs (bench/replay_mpi.py).
+        SentPerBrick sent;
         tbb::parallel_for(
             tbb::blocked_range<size_t>(0, batch.size(), kChunk),
             [&](const tbb::blocked_range<size_t>& range) {
@@ -224,8 +258,10 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
                 processor.ProcessBatch(
                     b, brick,
                     std::span<const RayRecord>(batch).subspan(range.begin(), range.size()), out);
+                if (trace_ != nullptr) sent.Count(source_, b, out);
                 Flush(out);
             });
+        if (trace_ != nullptr) span.AddArg({"sent", sent.Text()});
         handle.Reset();
         work_us_[b] += uint64_t(std::chrono::duration_cast<std::chrono::microseconds>(
                                     std::chrono::steady_clock::now() - batch_start)

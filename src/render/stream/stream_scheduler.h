@@ -10,8 +10,11 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <span>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -55,6 +58,20 @@ struct RayOutbox {
 
     std::vector<std::pair<uint32_t, RayRecord>> rays;  ///< (brick, ray), in the order sent
     RayCounts counts;
+};
+
+/// For a trace: the rays one batch sent to each other brick (levels of a brick count as the
+/// brick). Count is thread-safe.
+class SentPerBrick {
+  public:
+    /// Counts the rays of `out`, made by a batch of slot `from_slot`.
+    void Count(const BrickSource& source, uint32_t from_slot, const RayOutbox& out);
+    /// "brick:rays brick:rays ...", by brick.
+    std::string Text() const;
+
+  private:
+    std::mutex mutex_;
+    std::map<uint32_t, uint64_t> counts_;
 };
 
 /// The work on the rays of one brick: what Drain does with a batch.
