@@ -20,6 +20,8 @@ Markdown table for docs/render.md.
     /usr/bin/python3 bench/bench_reference.py                       # hours: 2 h references, 2 min renders
     /usr/bin/python3 bench/bench_reference.py --ref-time 30 --time 10 --resolution 240x160 --views nave
                                                                     # checks the recipe in about 2 minutes
+    /usr/bin/python3 bench/bench_reference.py --lod --detail 30 --modes path --memory "" ...
+                                                                    # levels of detail against full detail
 
 The reference's error must be well below the errors it measures (the table says both); a reference of two
 hours of path tracing on two cores reaches about 0.005 on RGB at 960x640 on the nave view.
@@ -46,27 +48,32 @@ def main():
     ap.add_argument("--memory", default="620M", help="--memory of every render (the main job's)")
     ap.add_argument("--render-args", default="",
                     help="more nave render arguments, given with '=': --render-args='--threads 2'")
+    ap.add_argument("--detail", type=int, default=1, help="the generated abbey's detail (without --store)")
+    ap.add_argument("--lod", action="store_true",
+                    help="a store with levels of detail: every mode is measured at full detail and with "
+                         "--lod auto, against a full-detail reference (the bias of coarse geometry)")
     args = ap.parse_args()
 
     views = nave_bench.parse_views(args.views)
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     os.makedirs(args.dir, exist_ok=True)
     log = open(os.path.join(args.dir, "runs.log"), "w")
-    store = args.store or os.path.join(args.dir, "abbey1.nave")
+    store = args.store or os.path.join(args.dir, f"abbey{args.detail}{'_levels' if args.lod else ''}.nave")
     if not os.path.exists(store):
-        p = nave_bench.run_logged([args.nave, "preprocess", "--generate", "abbey:detail=1", "--memory", "2G",
-                                   "--brick-triangles", "100000", "-o", store, "-q"], log)
+        p = nave_bench.run_logged([args.nave, "preprocess", "--generate", f"abbey:detail={args.detail}",
+                                   "--memory", "2G", "--brick-triangles", "100000", "-o", store, "-q"] +
+                                  (["--levels"] if args.lod else []), log)
         if p.returncode != 0:
             sys.exit(f"preprocess failed: {p.stdout.strip()}")
     base_text = open(args.config).read()
     extra = args.render_args.split()
 
-    def render(config, out, mode, seed, seconds):
+    def render(config, out, mode, seed, seconds, lod="full"):
         # A --spp / --iterations far beyond the time: the time limit ends every render.
         cmd = [args.nave, "render", store, "--config", config, "-o", out, "--mode", mode,
                "--seed", str(seed), "--time-limit", str(seconds), "--resolution", args.resolution,
-               "--memory", args.memory, "-q"] + (["--spp", "1000000"] if mode == "path" else
-                                                 ["--iterations", "1000000"]) + extra
+               "--lod", lod, "-q"] + (["--memory", args.memory] if args.memory else []) + \
+            (["--spp", "1000000"] if mode == "path" else ["--iterations", "1000000"]) + extra
         p = nave_bench.run_logged(cmd, log)
         if p.returncode != 0:
             sys.exit(f"render failed ({' '.join(cmd)}): {p.stdout.strip()}")
@@ -82,15 +89,16 @@ def main():
                 print(f"{view}: reference seed {seed}, {args.ref_time:.0f} s of path tracing", file=sys.stderr)
                 render(config, out, "path", 1000 + seed, args.ref_time)
         ref_pair = nave_bench.compare(args.nave, ref[0], ref[1], False, log)
-        for mode in modes:
-            outs = [os.path.join(args.dir, f"{view}_{mode}_{args.time:.0f}s_seed{s}.exr") for s in (1, 2)]
+        for mode, lod in [(m, lod) for m in modes for lod in (("full", "auto") if args.lod else ("full",))]:
+            name = mode + ("_lod" if lod == "auto" else "")
+            outs = [os.path.join(args.dir, f"{view}_{name}_{args.time:.0f}s_seed{s}.exr") for s in (1, 2)]
             for seed, out in zip((1, 2), outs):
-                print(f"{view}: {mode}, seed {seed}, {args.time:.0f} s", file=sys.stderr)
-                render(config, out, mode, seed, args.time)
+                print(f"{view}: {mode}, lod {lod}, seed {seed}, {args.time:.0f} s", file=sys.stderr)
+                render(config, out, mode, seed, args.time, lod)
             against = nave_bench.compare(args.nave, outs[0], ref[0], True, log)
             pair = nave_bench.compare(args.nave, outs[0], outs[1], False, log)
             rows.append({
-                "view": view, "mode": mode, "seconds": args.time,
+                "view": view, "mode": mode + (" (levels)" if lod == "auto" else ""), "seconds": args.time,
                 "relmse_rgb": against["relmse_against_reference_rgb"],
                 "relmse_rgb_blurred": against["relmse_against_reference_rgb_blurred"],
                 "relmse_pair_rgb": pair["relmse_of_one_rgb"],

@@ -179,7 +179,7 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound, bool all_kep
 
 // The level is chosen by the ray's footprint, never by what is resident.
 TEST_F(LevelsOfDetail, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
-TEST_F(LevelsOfDetail, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-4); }
+TEST_F(LevelsOfDetail, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }
 TEST_F(LevelsOfDetail, PagedRenderWithSomeCoarseLevelsKeptEqualsInCore) {
     ExpectPagedEqualsInCore("path", 1e-9, /*all_kept=*/false);
 }

@@ -274,7 +274,7 @@ float VisiblePoints::Deposit(uint32_t brick, const Vec3f& p, const Vec3f& ng, co
             if (f.IsZero()) continue;
             xyz = SampledToXYZ(vp.ThroughputAt(l) * f * beta * own_weight_, l);
         }
-        for (int c = 0; c < 3; ++c) AtomicAdd(px.phi[c], float(xyz[c]));
+        for (int c = 0; c < 3; ++c) AtomicAdd(px.phi[c], xyz[c]);
         added += float(xyz.y);
         deposits_.fetch_add(1, std::memory_order_relaxed);
     }

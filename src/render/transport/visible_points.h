@@ -200,7 +200,9 @@ class VisiblePoints {
     struct PixelState {
         Vec3d density_sum;               // sum over iterations of phi_i / (pi r_i^2), XYZ
         double density_sum_y_half0 = 0;  // the same in luminance over the iterations of half 0
-        std::atomic<float> phi[3];       // this iteration's flux, XYZ
+        // This iteration's flux, XYZ: in double, so that the order in which threads (and the
+        // processes of a distributed render) add their deposits hardly ever shows in the image.
+        std::atomic<double> phi[3];
     };
     struct BrickGrid {
         float cell = 1;
