@@ -33,6 +33,10 @@ import sys
 
 import nave_bench
 
+CSV_FIELDS = ["view", "mode", "seconds", "relmse_rgb", "relmse_rgb_blurred", "relmse_pair_rgb", "mean_ratio",
+              "worst_region_ratio", "reference_relmse_rgb", "reference_relmse_rgb_blurred"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--nave", default=nave_bench.default_nave())
@@ -93,6 +97,8 @@ def main():
             name = mode + ("_lod" if lod == "auto" else "")
             outs = [os.path.join(args.dir, f"{view}_{name}_{args.time:.0f}s_seed{s}.exr") for s in (1, 2)]
             for seed, out in zip((1, 2), outs):
+                if os.path.exists(out):
+                    continue  # a run before this one made it: delete DIR's images to measure again
                 print(f"{view}: {mode}, lod {lod}, seed {seed}, {args.time:.0f} s", file=sys.stderr)
                 render(config, out, mode, seed, args.time, lod)
             against = nave_bench.compare(args.nave, outs[0], ref[0], True, log)

@@ -52,10 +52,10 @@ class PhotonEmitters {
     /// How many photons of a pass Learn looks at (the first ones): a cap on its memory.
     uint64_t learned_photons() const { return photon_cells_.size(); }
     /// The bytes learning takes with `photons_per_iteration`: per learned photon its start cell
-    /// here and what it deposited (SppmIntegrator).
+    /// here and what it deposited (SppmIntegrator: in fixed point, and as the float Learn reads).
     static uint64_t LearningBytes(uint64_t photons_per_iteration) {
         return std::min(photons_per_iteration, kMaxLearnedPhotons) *
-               (sizeof(uint32_t) + sizeof(float));
+               (sizeof(uint32_t) + sizeof(uint64_t) + sizeof(float));
     }
 
     /// The windows photons are aimed through: null unless render.photon_target = "portals" found
