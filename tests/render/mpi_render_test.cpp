@@ -130,33 +130,47 @@ TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
     }
 }
 
-// The samples per pixel a render's summary reports ("after 62 samples per pixel"), or -1.
-int SamplesReported(const std::string& output) {
-    const size_t at = output.find(" samples per pixel");
+// The rounds a render's summary reports: its samples per pixel ("after 62 samples per pixel",
+// `unit` " samples per pixel") or iterations ("after 18 iterations, target", " iterations,"), or
+// -1.
+int RoundsReported(const std::string& output, const std::string& unit) {
+    const size_t at = output.find(unit);
     if (at == std::string::npos) return -1;
     const size_t start = output.rfind(' ', at - 1);
     return std::atoi(output.substr(start + 1, at - start - 1).c_str());
 }
 
 // A noise target: the ranks estimate the whole image's noise together (each holds the part of the
-// image it traced) and stop after the pass one process stops after, with its image.
+// image it traced) and stop after the pass (photon mode: the iteration) one process stops after,
+// with its image.
 TEST_F(MpiRender, ANoiseTargetStopsTheRanksWhereOneProcessStops) {
-    auto render = [&](const std::string& out) {
-        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() +
-               " --mode path --resolution 96x64 --spp 128 --noise 0.2 -o " + (*dir_ / out).string();
+    struct Case {
+        std::string settings, unit, target;
+        int most;
     };
-    const test::CommandResult one = Shell(render("noise1.exr"));
-    ASSERT_EQ(one.exit_code, 0) << one.output;
-    const test::CommandResult two = Shell(Mpirun(2) + render("noise2.exr"));
-    ASSERT_EQ(two.exit_code, 0) << two.output;
-    const int samples = SamplesReported(one.output);
-    EXPECT_GT(samples, 1) << one.output;
-    EXPECT_LT(samples, 128) << "the target should end the render early: " << one.output;
-    EXPECT_EQ(SamplesReported(two.output), samples) << two.output;
-    EXPECT_NE(two.output.find("target 0.2 reached"), std::string::npos) << two.output;
-    const std::vector<float> a = Rgb(*dir_ / "noise1.exr"), b = Rgb(*dir_ / "noise2.exr");
-    ASSERT_FALSE(a.empty());
-    EXPECT_EQ(a, b);
+    auto check = [&](const Case& c) {
+        SCOPED_TRACE(c.settings);
+        auto render = [&](const std::string& out) {
+            return std::string(NAVE_BINARY) + " render " + Store() + " -c " + Config() +
+                   c.settings + " --resolution 96x64 --noise " + c.target + " -o " +
+                   (*dir_ / out).string();
+        };
+        const test::CommandResult one = Shell(render("noise1.exr"));
+        ASSERT_EQ(one.exit_code, 0) << one.output;
+        const test::CommandResult two = Shell(Mpirun(2) + render("noise2.exr"));
+        ASSERT_EQ(two.exit_code, 0) << two.output;
+        const int rounds = RoundsReported(one.output, c.unit);
+        EXPECT_GT(rounds, 1) << one.output;
+        EXPECT_LT(rounds, c.most) << "the target should end the render early: " << one.output;
+        EXPECT_EQ(RoundsReported(two.output, c.unit), rounds) << two.output;
+        EXPECT_NE(two.output.find("target " + c.target + " reached"), std::string::npos)
+            << two.output;
+        const std::vector<float> a = Rgb(*dir_ / "noise1.exr"), b = Rgb(*dir_ / "noise2.exr");
+        ASSERT_FALSE(a.empty());
+        EXPECT_EQ(a, b);
+    };
+    check({" --mode path --spp 128", " samples per pixel", "0.2", 128});
+    check({" --mode photon --iterations 40 --photons 50000", " iterations,", "0.25", 40});
 }
 
 // A time limit: each rank's clock may pass it after a different pass, and the ranks stop together
@@ -170,7 +184,7 @@ TEST_F(MpiRender, ATimeLimitEndsTheRanksTogether) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    const int samples = SamplesReported(r.output);
+    const int samples = RoundsReported(r.output, " samples per pixel");
     EXPECT_GT(samples, 0) << r.output;
     EXPECT_LT(samples, 100000) << r.output;
     EXPECT_LT(seconds, 60) << r.output;
