@@ -4,11 +4,14 @@
 // status naming what was being read, at which offset, and how many bytes it needed.
 
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 #include "src/core/status.h"
 
@@ -16,6 +19,21 @@ namespace nave {
 
 static_assert(std::endian::native == std::endian::little,
               "byte streams are little-endian; add byte swaps");
+
+/// `bytes` read back as records of T laid end to end (as std::as_bytes of a span of T lays them:
+/// records that other processes of a distributed render sent). `what` names them in the error.
+/// Errors: Internal for bytes that are not whole records.
+template <typename T>
+StatusOr<std::vector<T>> RecordsFromBytes(std::span<const std::byte> bytes, std::string_view what) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (bytes.size() % sizeof(T) != 0) {
+        return InternalError("{}: {} bytes, not whole records of {}", what, bytes.size(),
+                             sizeof(T));
+    }
+    std::vector<T> records(bytes.size() / sizeof(T));
+    if (!bytes.empty()) std::memcpy(records.data(), bytes.data(), bytes.size());
+    return records;
+}
 
 /// Appends values to a byte string. Not thread-safe.
 class ByteWriter {

@@ -90,35 +90,39 @@ class MpiRender : public ::testing::Test {
         result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
         return result;
     }
+    static void ExpectRanksGiveTheSingleProcessImage(const std::string& mode,
+                                                     const std::string& flags,
+                                                     const std::string& progress,
+                                                     std::vector<std::string>* outputs);
     static fs::path* dir_;
 };
 fs::path* MpiRender::dir_ = nullptr;
 
-TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
-    const test::CommandResult one = Shell(Render("one.exr"));
+// Renders `mode` (with `flags`) as one process and as 2 and 3 ranks, and expects of each run of
+// ranks: the one process's image bit for bit (RGB), rank 0 alone writing it with the ranks'
+// summary, rank 0 reading fewer than the store's 64 bricks (each rank reads only its own, for the
+// render and for the scan of the model's portals), and rank 0's bar ending at `progress` (the
+// whole job's). `outputs`: each run's output, for the mode's own checks.
+void MpiRender::ExpectRanksGiveTheSingleProcessImage(const std::string& mode,
+                                                     const std::string& flags,
+                                                     const std::string& progress,
+                                                     std::vector<std::string>* outputs) {
+    const test::CommandResult one = Shell(Render(mode + "1.exr", mode) + flags);
     ASSERT_EQ(one.exit_code, 0) << one.output;
-    const std::vector<float> reference = Rgb(*dir_ / "one.exr");
+    const std::vector<float> reference = Rgb(*dir_ / (mode + "1.exr"));
     ASSERT_FALSE(reference.empty());
     for (int ranks : {2, 3}) {
         SCOPED_TRACE(::testing::Message() << ranks << " ranks");
-        const std::string name = "ranks" + std::to_string(ranks) + ".exr";
-        const test::CommandResult r = Shell(Mpirun(ranks) + Render(name));
+        const std::string name = mode + "_ranks" + std::to_string(ranks) + ".exr";
+        const test::CommandResult r = Shell(Mpirun(ranks) + Render(name, mode) + flags);
         ASSERT_EQ(r.exit_code, 0) << r.output;
-        // Rank 0 alone writes the image and the summary.
         EXPECT_NE(r.output.find("ranks " + std::to_string(ranks) + ": "), std::string::npos)
             << r.output;
         EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
-        // Each rank reads only its own bricks, for the render and for the scan of the model's
-        // portals: rank 0 loads fewer than the store's 64.
         const size_t loads = r.output.find(", loads ");
         ASSERT_NE(loads, std::string::npos) << r.output;
         EXPECT_LT(std::atoi(r.output.c_str() + loads + 8), 64) << r.output;
-        // After the complete drains of passes 1, 2 and 4 the ranks re-balance their bricks by the
-        // time their batches took when the busiest took 1.2x the mean (timing decides how often):
-        // the image stays the single process's.
-        EXPECT_NE(r.output.find("bricks re-balanced "), std::string::npos) << r.output;
-        // Paths end on every rank, and rank 0's bar counts them all: 96 x 64 x 4.
-        EXPECT_NE(r.output.find("render 100.0% 24.6 k paths"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find(progress), std::string::npos) << r.output;
         EXPECT_EQ(r.output.find("nave render: wrote", r.output.find("nave render: wrote") + 1),
                   std::string::npos)
             << "more than one rank wrote: " << r.output;
@@ -127,6 +131,19 @@ TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
         size_t differ = 0;
         for (size_t i = 0; i < image.size(); ++i) differ += image[i] != reference[i];
         EXPECT_EQ(differ, 0u) << "of " << image.size() << " values";
+        outputs->push_back(r.output);
+    }
+}
+
+TEST_F(MpiRender, RanksGiveTheSingleProcessImage) {
+    // Paths end on every rank, and rank 0's bar counts them all: 96 x 64 x 4.
+    std::vector<std::string> outputs;
+    ExpectRanksGiveTheSingleProcessImage("path", "", "render 100.0% 24.6 k paths", &outputs);
+    for (const std::string& output : outputs) {
+        // After the complete drains of passes 1, 2 and 4 the ranks re-balance their bricks by the
+        // time their batches took when the busiest took 1.2x the mean (timing decides how often):
+        // the image stays the single process's.
+        EXPECT_NE(output.find("bricks re-balanced "), std::string::npos) << output;
     }
 }
 
@@ -310,22 +327,11 @@ TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
 // one process's, bit for bit (RGB). The abbey's config is photon mode with final gathering, portals
 // and sky windows: all of it is exercised.
 TEST_F(MpiRender, RanksGiveTheSingleProcessImageInPhotonMode) {
-    const std::string photon = " --iterations 3 --photons 100000";
-    const test::CommandResult one = Shell(Render("photon1.exr", "photon") + photon);
-    ASSERT_EQ(one.exit_code, 0) << one.output;
-    const std::vector<float> reference = Rgb(*dir_ / "photon1.exr");
-    ASSERT_FALSE(reference.empty());
-    for (int ranks : {2, 3}) {
-        SCOPED_TRACE(::testing::Message() << ranks << " ranks");
-        const std::string name = "photon_ranks" + std::to_string(ranks) + ".exr";
-        const test::CommandResult r = Shell(Mpirun(ranks) + Render(name, "photon") + photon);
-        ASSERT_EQ(r.exit_code, 0) << r.output;
-        EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
-        // Iterations are the job's: rank 0's bar counts each once.
-        EXPECT_NE(r.output.find("photon mapping 100.0% 3 iterations"), std::string::npos)
-            << r.output;
-        EXPECT_EQ(Rgb(*dir_ / name), reference);
-    }
+    // Iterations are the job's: rank 0's bar counts each once.
+    std::vector<std::string> outputs;
+    ExpectRanksGiveTheSingleProcessImage("photon", " --iterations 3 --photons 100000",
+                                         "photon mapping 100.0% 3 iterations", &outputs);
+    EXPECT_EQ(outputs.size(), 2u);
 }
 
 TEST_F(MpiRender, ACorruptBrickEndsTheJobNamingTheBrickAndTheRank) {

@@ -138,10 +138,7 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
             return Status::Ok();
         }));
     if (ranks != nullptr) NAVE_RETURN_IF_ERROR(ShareLearning(*ranks));
-    std::vector<float> deposited(deposited_.size());
-    for (size_t k = 0; k < deposited.size(); ++k)
-        deposited[k] = float(double(deposited_[k]) / deposit_to_fixed_);
-    emitters_->Learn(deposited);
+    emitters_->Learn(deposited_, deposit_to_fixed_);
     if (SkyWindows* windows = lights_->sky_windows()) windows->Update();
     if (gather_guide_) {
         gather_guide_->Update();

@@ -3,10 +3,8 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
 #include <limits>
-#include <thread>
 
 #include "src/render/stream/mpi_runtime.h"
 #include "src/render/stream/mpi_wait.h"
@@ -32,6 +30,26 @@ Status SumInParts(MPI_Comm comm, std::span<T> values, MPI_Datatype type, double 
         NAVE_RETURN_IF_ERROR(WaitForCollective(&request, "a sum", comm, timeout_s));
     }
     return Status::Ok();
+}
+
+// The int counts and offsets of parts of `sizes` bytes laid end to end, as MPI's v-collectives take
+// them; returns the bytes in all. Errors: more than an int can count (`what` names the bytes).
+StatusOr<int64_t> CountsAndOffsets(const std::vector<int64_t>& sizes, std::vector<int>* counts,
+                                   std::vector<int>* offsets, const char* what) {
+    counts->resize(sizes.size());
+    offsets->resize(sizes.size());
+    int64_t total = 0;
+    for (size_t r = 0; r < sizes.size(); ++r) {
+        (*offsets)[r] = int(total);
+        (*counts)[r] = int(sizes[r]);
+        total += sizes[r];
+        if (total > int64_t(std::numeric_limits<int>::max())) {
+            return ResourceExhaustedError(
+                "MPI: {} bytes {} between {} ranks, more than the {} one collective can count",
+                total, what, sizes.size(), std::numeric_limits<int>::max());
+        }
+    }
+    return total;
 }
 
 }  // namespace
@@ -85,18 +103,9 @@ StatusOr<std::vector<std::byte>> MpiRankGroup::GatherEverywhere(std::span<const 
         "MPI_Iallgather"));
     NAVE_RETURN_IF_ERROR(
         WaitForCollective(&request, "a gather", comm_->comm, options_.stall_timeout_s));
-    std::vector<int> counts(ranks), offsets(ranks);
-    int64_t total = 0;
-    for (int r = 0; r < size_; ++r) {
-        offsets[size_t(r)] = int(total);
-        counts[size_t(r)] = int(sizes[size_t(r)]);
-        total += sizes[size_t(r)];
-        if (total > int64_t(std::numeric_limits<int>::max())) {
-            return ResourceExhaustedError(
-                "MPI: {} bytes to gather from {} ranks, more than the {} one gather can count",
-                total, size_, std::numeric_limits<int>::max());
-        }
-    }
+    std::vector<int> counts, offsets;
+    NAVE_ASSIGN_OR_RETURN(const int64_t total,
+                          CountsAndOffsets(sizes, &counts, &offsets, "to gather"));
     std::vector<std::byte> all(static_cast<size_t>(total));
     NAVE_RETURN_IF_ERROR(
         MpiStatus(MPI_Iallgatherv(mine.data(), int(mine.size()), MPI_BYTE, all.data(),
@@ -123,23 +132,11 @@ StatusOr<std::vector<std::byte>> MpiRankGroup::SendToEach(
                   "MPI_Ialltoall"));
     NAVE_RETURN_IF_ERROR(
         WaitForCollective(&request, "an exchange", comm_->comm, options_.stall_timeout_s));
-    std::vector<int> send_counts(ranks), send_offsets(ranks), receive_counts(ranks),
-        receive_offsets(ranks);
-    int64_t sent = 0, received = 0;
-    for (size_t r = 0; r < ranks; ++r) {
-        send_offsets[r] = int(sent);
-        send_counts[r] = int(send_sizes[r]);
-        sent += send_sizes[r];
-        receive_offsets[r] = int(received);
-        receive_counts[r] = int(receive_sizes[r]);
-        received += receive_sizes[r];
-        if (std::max(sent, received) > int64_t(std::numeric_limits<int>::max())) {
-            return ResourceExhaustedError(
-                "MPI: {} bytes to send and {} to receive between {} ranks, more than the {} one "
-                "exchange can count",
-                sent, received, size_, std::numeric_limits<int>::max());
-        }
-    }
+    std::vector<int> send_counts, send_offsets, receive_counts, receive_offsets;
+    NAVE_ASSIGN_OR_RETURN(const int64_t sent,
+                          CountsAndOffsets(send_sizes, &send_counts, &send_offsets, "to send"));
+    NAVE_ASSIGN_OR_RETURN(const int64_t received, CountsAndOffsets(receive_sizes, &receive_counts,
+                                                                   &receive_offsets, "to receive"));
     std::vector<std::byte> out(static_cast<size_t>(sent)), in(static_cast<size_t>(received));
     for (size_t r = 0; r < ranks; ++r) {
         std::copy(to_rank[r].begin(), to_rank[r].end(),

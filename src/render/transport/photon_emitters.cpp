@@ -215,11 +215,14 @@ float PhotonEmitters::StartDistantPhoton(const Emitter& e, const Vec3f& to, cons
     return density > 0 ? 1 / density : 0.f;
 }
 
-void PhotonEmitters::Learn(std::span<const float> deposited) {
+void PhotonEmitters::Learn(std::span<const uint64_t> deposited, double fixed_per_luminance) {
     const size_t n = std::min(deposited.size(), photon_cells_.size());
     for (size_t k = 0; k < n; ++k) {
         const uint32_t c = photon_cells_[k];
-        if (c != kNoGuideCell) guides_[c >> 16].Add(uint16_t(c & 0xffff), deposited[k]);
+        if (c != kNoGuideCell) {
+            guides_[c >> 16].Add(uint16_t(c & 0xffff),
+                                 float(double(deposited[k]) / fixed_per_luminance));
+        }
     }
     for (PhotonGuide& guide : guides_) guide.Update();
     std::fill(photon_cells_.begin(), photon_cells_.end(), kNoGuideCell);

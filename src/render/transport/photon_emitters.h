@@ -41,9 +41,9 @@ class PhotonEmitters {
     void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, float footprint,
                      StreamScheduler& scheduler);
     /// After a photon pass: learns where the sun's photons are worth starting (photon_guide.h) from
-    /// deposited[k], the luminance photon k brought to the visible points, for the first
-    /// learned_photons() photons of the pass.
-    void Learn(std::span<const float> deposited);
+    /// deposited[k], the luminance photon k brought to the visible points in fixed point
+    /// (`fixed_per_luminance` units to one), for the first learned_photons() photons of the pass.
+    void Learn(std::span<const uint64_t> deposited, double fixed_per_luminance);
     /// Appends what the guides learned to `out`, for a checkpoint.
     void SaveState(ByteWriter* out) const;
     /// Restores what SaveState saved, as after the Learn calls that learned it. Errors: DataLoss
@@ -52,10 +52,10 @@ class PhotonEmitters {
     /// How many photons of a pass Learn looks at (the first ones): a cap on its memory.
     uint64_t learned_photons() const { return photon_cells_.size(); }
     /// The bytes learning takes with `photons_per_iteration`: per learned photon its start cell
-    /// here and what it deposited (SppmIntegrator: in fixed point, and as the float Learn reads).
+    /// here and what it deposited, in fixed point (SppmIntegrator).
     static uint64_t LearningBytes(uint64_t photons_per_iteration) {
         return std::min(photons_per_iteration, kMaxLearnedPhotons) *
-               (sizeof(uint32_t) + sizeof(uint64_t) + sizeof(float));
+               (sizeof(uint32_t) + sizeof(uint64_t));
     }
 
     /// The windows photons are aimed through: null unless render.photon_target = "portals" found

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "src/core/sampling.h"
 #include "src/render/transport/light_sampling.h"
@@ -100,14 +99,10 @@ Status SkyWindows::ShareRecords(
     }
     NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> all,
                           gather(std::as_bytes(std::span<const Record>(mine))));
-    if (all.size() % sizeof(Record) != 0) {
-        return InternalError("sky window records from the processes: {} bytes, not whole records",
-                             all.size());
-    }
+    NAVE_ASSIGN_OR_RETURN(const std::vector<Record> records,
+                          RecordsFromBytes<Record>(all, "sky window records from the processes"));
     auto& into = pending_->local.local();
-    for (size_t at = 0; at < all.size(); at += sizeof(Record)) {
-        Record r;
-        std::memcpy(&r, all.data() + at, sizeof(r));
+    for (const Record& r : records) {
         Sum& s = into[r.key];
         s.fixed += r.fixed;
         s.photons += uint32_t(r.photons);

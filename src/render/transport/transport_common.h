@@ -7,13 +7,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <functional>
 #include <limits>
 #include <span>
-#include <type_traits>
 #include <vector>
 
+#include "src/core/byte_stream.h"
 #include "src/core/status.h"
 #include "src/render/bricks/brick_walk.h"
 #include "src/render/scene/scene.h"
@@ -151,15 +150,10 @@ Status ForEachOwnedTriangle(
 /// Collective. Errors: the gather's.
 template <typename Found>
 StatusOr<std::vector<Found>> GatherInBrickOrder(RankGroup& ranks, std::span<const Found> mine) {
-    static_assert(std::is_trivially_copyable_v<Found>);
     NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> all,
                           ranks.GatherEverywhere(std::as_bytes(mine)));
-    if (all.size() % sizeof(Found) != 0) {
-        return InternalError("gathered from the processes: {} bytes, not whole records of {}",
-                             all.size(), sizeof(Found));
-    }
-    std::vector<Found> found(all.size() / sizeof(Found));
-    std::memcpy(found.data(), all.data(), all.size());
+    NAVE_ASSIGN_OR_RETURN(std::vector<Found> found,
+                          RecordsFromBytes<Found>(all, "gathered from the processes"));
     std::stable_sort(found.begin(), found.end(),
                      [](const Found& a, const Found& b) { return a.brick < b.brick; });
     return found;
