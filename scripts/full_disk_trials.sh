@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # A real full disk under `nave preprocess` and `nave render` (docs/full_disk.md): a small tmpfs is
 # mounted for each trial, of a size that runs out at some point of the run, and the run writes into it
-# (the store and its work directory, preprocess's bins alone, the image, the ray-queue spill and brick
-# cache, a checkpoint). After every trial it checks that:
+# (the store and its work directory, preprocess's bins alone, the store and its textures alone, the
+# image, the ray-queue spill and brick cache, a checkpoint). After every trial it checks that:
 #   - the run either succeeded with a complete output (the store passes `nave verify`, the image is
 #     bit for bit the one rendered on a large disk) or exited 1 with a message naming the full
 #     file system's path (never another exit code, never a crash);
@@ -27,6 +27,10 @@ fail() {
     echo "  FAIL: $*"
     failures=$((failures + 1))
 }
+
+# Runs one trial's command, killed after 10 minutes: a run that never ends (a library waiting
+# forever after a failed write) is a failed check with exit code 137, not a CI that never ends.
+trial() { timeout -s KILL 600 "$@"; }
 
 unmount() { if mountpoint -q "$disk"; then umount "$disk"; fi; }
 trap unmount EXIT
@@ -88,6 +92,9 @@ judge() {
                 fail "$label: ${kept%%=*}, there before the run, changed or is gone"
             fi
         done
+    elif ((rc == 137)); then
+        outcome="KILLED"
+        fail "$label: still running after 10 minutes, killed: $(tail -2 "$log")"
     else
         outcome="EXIT $rc"
         fail "$label: exit code $rc (expected 0, or 1 with a message): $(tail -2 "$log")"
@@ -146,7 +153,7 @@ for size in $(sizes_for "$store_peak" "$old_bytes"); do
     cp -r "$work/old.nave" "$disk/abbey.nave"
     cp -r "$work/old.nave.textures" "$disk/abbey.nave.textures"
     old_sum=$(sha256sum "$disk/abbey.nave" | cut -c1-64)
-    "$nave" preprocess -q "${model_args[@]}" -o "$disk/abbey.nave" >"$work/run.log" 2>&1
+    trial "$nave" preprocess -q "${model_args[@]}" -o "$disk/abbey.nave" >"$work/run.log" 2>&1
     judge "store on a ${size}-byte disk (older store there)" $? "$work/run.log" \
         '"$nave" -q verify "$disk/abbey.nave" >/dev/null 2>&1' "$disk/abbey.nave=$old_sum"
 done
@@ -154,10 +161,23 @@ done
 for size in $(sizes_for "$bins_peak"); do
     mount_disk "$size"
     rm -rf "$work/out.nave" "$work/out.nave.textures"
-    "$nave" preprocess -q "${model_args[@]}" --temp-dir "$disk" -o "$work/out.nave" >"$work/run.log" 2>&1
+    trial "$nave" preprocess -q "${model_args[@]}" --temp-dir "$disk" -o "$work/out.nave" >"$work/run.log" 2>&1
     judge "bins on a ${size}-byte disk (--temp-dir)" $? "$work/run.log" \
         '"$nave" -q verify "$work/out.nave" >/dev/null 2>&1'
     [[ $(temporaries "$work") == "" ]] || fail "bins trial: temporaries beside the store: $(temporaries "$work")"
+done
+
+# The store and its converted textures on the small disk, the bins and the generator's texture
+# sources elsewhere: the texture conversion meets the full disk (OpenEXR's tiled writer does not
+# come back from a failed write, so preprocess must refuse before it starts one).
+textures_peak=$(peak_use "$nave" preprocess -q "${model_args[@]}" --temp-dir "$work" -o "$disk/abbey.nave")
+echo "preprocess with --temp-dir elsewhere: at most $textures_peak bytes on the disk (store, textures)"
+for size in $(sizes_for "$textures_peak"); do
+    mount_disk "$size"
+    trial "$nave" preprocess -q "${model_args[@]}" --temp-dir "$work" -o "$disk/abbey.nave" >"$work/run.log" 2>&1
+    judge "store and textures on a ${size}-byte disk" $? "$work/run.log" \
+        '"$nave" -q verify "$disk/abbey.nave" >/dev/null 2>&1'
+    [[ $(temporaries "$work") == "" ]] || fail "textures trial: temporaries beside the bins: $(temporaries "$work")"
 done
 
 # ---------------------------------------------------------------------------------------------
@@ -170,13 +190,14 @@ render=("${base[@]}" --pager prefer_resident=2)
 "${render[@]}" -q --seed 7 -o "$work/old.exr" || { echo "older render failed"; exit 1; }
 image_bytes=$(bytes_of "$work/ref.exr" "$work/ref.png")
 echo "render: the image (EXR and PNG) takes $image_bytes bytes"
-for size in $(sizes_for "$image_bytes" "$image_bytes"); do
+# The older pair takes its bytes rounded up to tmpfs's pages: two more pages than its bytes.
+for size in $(sizes_for "$image_bytes" "$((image_bytes + 8192))"); do
     mount_disk "$size"
     cp "$work/old.exr" "$disk/abbey.exr"
     cp "$work/old.png" "$disk/abbey.png"
     old_exr=$(sha256sum "$disk/abbey.exr" | cut -c1-64)
     old_png=$(sha256sum "$disk/abbey.png" | cut -c1-64)
-    "${render[@]}" -q -o "$disk/abbey.exr" >"$work/run.log" 2>&1
+    trial "${render[@]}" -q -o "$disk/abbey.exr" >"$work/run.log" 2>&1
     judge "image on a ${size}-byte disk (older image there)" $? "$work/run.log" \
         '"$nave" compare --identical "$work/ref.exr" "$disk/abbey.exr" >/dev/null 2>&1' \
         "$disk/abbey.exr=$old_exr" "$disk/abbey.png=$old_png"
@@ -195,7 +216,7 @@ spill_need=$(awk '/ray queues:/ { match($0, /at most [0-9.]+ MiB/); q = substr($
 echo "render under --memory 290M: the spill holds at most $spill_need bytes"
 for size in $(sizes_for "$spill_need"); do
     mount_disk "$size"
-    "${paged[@]}" -q --temp-dir "$disk" -o "$work/out.exr" >"$work/run.log" 2>&1
+    trial "${paged[@]}" -q --temp-dir "$disk" -o "$work/out.exr" >"$work/run.log" 2>&1
     judge "spill on a ${size}-byte disk (--temp-dir)" $? "$work/run.log" \
         '"$nave" compare --identical "$work/ref_paged.exr" "$work/out.exr" >/dev/null 2>&1'
 done
@@ -209,7 +230,7 @@ checkpointed=("${render[@]}" --checkpoint-every 0)
 ckpt_bytes=$(bytes_of "$work/ref.ckpt")
 for size in $(sizes_for "$((2 * ckpt_bytes))"); do
     mount_disk "$size"
-    "${checkpointed[@]}" -q --checkpoint "$disk/abbey.ckpt" -o "$work/out.exr" >"$work/run.log" 2>&1
+    trial "${checkpointed[@]}" -q --checkpoint "$disk/abbey.ckpt" -o "$work/out.exr" >"$work/run.log" 2>&1
     judge "checkpoint on a ${size}-byte disk" $? "$work/run.log" \
         '"$nave" compare --identical "$work/ref_ckpt.exr" "$work/out.exr" >/dev/null 2>&1 &&
          "${checkpointed[@]}" -q --resume "$disk/abbey.ckpt" --checkpoint "$work/again.ckpt" \
@@ -220,11 +241,11 @@ done
 # Out of inodes rather than bytes: the store's work directory and bins, the image's temporaries.
 for inodes in 2 3 4 6 10; do
     mount_disk 512M "$inodes"
-    "$nave" preprocess -q "${model_args[@]}" -o "$disk/abbey.nave" >"$work/run.log" 2>&1
+    trial "$nave" preprocess -q "${model_args[@]}" -o "$disk/abbey.nave" >"$work/run.log" 2>&1
     judge "store on a disk of $inodes inodes" $? "$work/run.log" \
         '"$nave" -q verify "$disk/abbey.nave" >/dev/null 2>&1'
     mount_disk 512M "$inodes"
-    "${render[@]}" -q -o "$disk/abbey.exr" >"$work/run.log" 2>&1
+    trial "${render[@]}" -q -o "$disk/abbey.exr" >"$work/run.log" 2>&1
     judge "image on a disk of $inodes inodes" $? "$work/run.log" \
         '"$nave" compare --identical "$work/ref.exr" "$disk/abbey.exr" >/dev/null 2>&1'
 done

@@ -6,7 +6,12 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <system_error>
 
 #include "src/imaging/image_io.h"
@@ -132,6 +137,7 @@ class Plugin final : public OiioPlugin {
         // Its average colour is a sum that OIIO reduces over threads in the order they finish,
         // which can change its last digits from run to run; nave does not read it.
         config.attribute("maketx:compute_average", 0);
+        NAVE_RETURN_IF_ERROR(CheckRoomFor(output, source, MostBytesOfTexture(in.spec(), config)));
         if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, in,
                                               output.string(), config))
             return IoError("{}: cannot write the texture converted from {}: {}", output.string(),
@@ -140,6 +146,53 @@ class Plugin final : public OiioPlugin {
     }
 
   private:
+    /// The most bytes a tiled, MIP-mapped texture of `source`'s size can take on disk in
+    /// `config`'s pixel type: every level uncompressed (zip keeps a tile raw when compressing
+    /// would grow it, in OpenEXR as in TIFF), each tile's header and offset, and a MiB for the
+    /// file's header.
+    static uint64_t MostBytesOfTexture(const OIIO::ImageSpec& source,
+                                       const OIIO::ImageSpec& config) {
+        const uint64_t pixel_bytes = uint64_t(source.nchannels) * config.format.size();
+        const uint64_t tile = uint64_t(config.tile_width);
+        uint64_t bytes = uint64_t(1) << 20;
+        uint64_t w = uint64_t(std::max(source.width, 1)), h = uint64_t(std::max(source.height, 1));
+        for (;;) {
+            const uint64_t tiles = ((w + tile - 1) / tile) * ((h + tile - 1) / tile);
+            bytes += w * h * pixel_bytes + tiles * 64;
+            if (w == 1 && h == 1) break;
+            w = std::max<uint64_t>(w / 2, 1);
+            h = std::max<uint64_t>(h / 2, 1);
+        }
+        return bytes;
+    }
+
+    /// Refuses to start a texture the disk has no room for. OpenEXR 3.1's tiled writer does not
+    /// come back from a full disk: a tile whose write failed keeps its buffer taken, and the next
+    /// row of tiles OpenImageIO writes waits for that buffer forever (seen in the full-disk
+    /// trials as a preprocess that never ended). So the room is taken first, with fallocate on
+    /// the output's own (temporary) name, and given back before make_texture writes: preprocess
+    /// converts textures one at a time while nothing else of it writes.
+    static Status CheckRoomFor(const std::filesystem::path& output,
+                               const std::filesystem::path& source, uint64_t bytes) {
+        const int fd = ::open(output.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0)
+            return IoError("{}: cannot create the texture converted from {}: {}", output.string(),
+                           source.string(), std::strerror(errno));
+        const int reserved = ::posix_fallocate(fd, 0, off_t(bytes));
+        const bool emptied = ::ftruncate(fd, 0) == 0;
+        ::close(fd);
+        if (reserved == ENOSPC || reserved == EDQUOT)
+            return IoError(
+                "{}: no room on the disk for the texture converted from {}: it may take up to {} "
+                "bytes",
+                output.string(), source.string(), bytes);
+        // Other refusals (a file system without fallocate) leave the check to the write itself.
+        if (!emptied)
+            return IoError("{}: cannot empty the room set aside for the texture converted from {}",
+                           output.string(), source.string());
+        return Status::Ok();
+    }
+
     /// make_texture writes through a buffered file whose last flush fails silently on a full disk:
     /// a texture cut short would pass for converted. Its levels are written largest first, so the
     /// smallest, read back whole, is at the end of the file.
