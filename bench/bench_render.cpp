@@ -63,7 +63,16 @@ struct Fixture {
     RenderScene scene;
 };
 
-std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
+/// Haze over the scene's bounds for BM_PathRaysInMedium: an optical depth of about 1 across the
+/// model, forward scattering.
+constexpr const char* kMedium = R"(
+[medium]
+sigma_s = 0.08
+sigma_a = 0.005
+g = 0.6
+)";
+
+std::unique_ptr<Fixture> MakeFixture(int split, const char* mode, const char* extra = "") {
     static const store::BrickMesh mesh = BenchMesh();
     auto f = std::make_unique<Fixture>();
     auto device = EmbreeDevice::Create();
@@ -73,17 +82,18 @@ std::unique_ptr<Fixture> MakeFixture(int split, const char* mode) {
     materials[1].name = "ball";
     materials[2].name = "chrome";
     f->source = std::make_unique<MemoryBrickSource>(*device, grid.tree, grid.meshes, materials);
-    f->config = ParseSceneConfig(fmt::format(fmt::runtime(kConfig), mode), "bench.toml").value();
+    f->config =
+        ParseSceneConfig(fmt::format(fmt::runtime(kConfig), mode) + extra, "bench.toml").value();
     f->scene = BuildRenderScene(f->config, *f->source).value();
     for (uint32_t b = 0; b < f->source->brick_count(); ++b)
         (void)f->source->Acquire(b);  // all resident
     return f;
 }
 
-void BM_PathRays(benchmark::State& state) {
-    ProgressBar::SetEnabled(false);
-    auto f = MakeFixture(int(state.range(0)), "path");
-    uint64_t rays = 0, brick_moves = 0, segments = 0;
+/// Path rays through `f`: rays/s, and the rays and time per camera path (which a medium's
+/// scatterings lengthen).
+void RunPathRays(benchmark::State& state, Fixture* f) {
+    uint64_t rays = 0, brick_moves = 0, segments = 0, paths = 0;
     for (auto _ : state) {
         Film film(f->config.camera.width, f->config.camera.height, f->config.output);
         RenderStats stats;
@@ -91,15 +101,37 @@ void BM_PathRays(benchmark::State& state) {
         rays += stats.rays;
         segments += stats.segments_traced + stats.shadow_segments;
         brick_moves += stats.brick_moves;
+        paths += stats.camera_paths;
     }
     state.counters["bricks"] = double(f->source->brick_count());
     state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
+    state.counters["paths/s"] = benchmark::Counter(double(paths), benchmark::Counter::kIsRate);
+    state.counters["rays/path"] = double(rays) / double(std::max<uint64_t>(1, paths));
     state.counters["brick_moves/ray"] = double(brick_moves) / double(std::max<uint64_t>(1, rays));
     state.counters["segments/ray"] = double(segments) / double(std::max<uint64_t>(1, rays));
+}
+
+void BM_PathRays(benchmark::State& state) {
+    ProgressBar::SetEnabled(false);
+    auto f = MakeFixture(int(state.range(0)), "path");
+    RunPathRays(state, f.get());
 }
 BENCHMARK(BM_PathRays)
     ->Arg(1)
     ->Arg(2)
+    ->Arg(4)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+
+/// The same scene in haze ([medium]): the cost of the medium per path and per ray.
+void BM_PathRaysInMedium(benchmark::State& state) {
+    ProgressBar::SetEnabled(false);
+    auto f = MakeFixture(int(state.range(0)), "path", kMedium);
+    RunPathRays(state, f.get());
+}
+BENCHMARK(BM_PathRaysInMedium)
+    ->Arg(1)
     ->Arg(4)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

@@ -28,41 +28,16 @@ class RenderTest : public ::testing::Test {
     void SetUp() override { ProgressBar::SetEnabled(false); }
 };
 
-// White furnace: inside a closed sphere of albedo a whose surface emits Le, the radiance everywhere
-// is Le / (1 - a) (the Neumann series of the rendering equation, Kajiya 1986, with constant L).
-// With a = 0.5, Le = 0.5: L = 1, and a constant spectrum of 1 has Y = 1 (CIE normalisation of
-// SampledToXYZ).
-store::BrickMesh FurnaceMesh() {
-    store::BrickMesh m;
-    AppendSphere(&m, {0, 0, 0}, 1.0f, 24, 48, 0, /*inward=*/true);
-    return m;
-}
-constexpr const char* kFurnace = R"(
-[camera]
-position = [0.1, 0.05, 0.0]
-look_at = [1, 0.2, 0.1]
-fov_deg = 90
-resolution = [16, 12]
-[materials.shell]
-reflectance = 0.5
-emission = 0.5
-[render]
-mode = "{}"
-spp = 64
-iterations = 12
-photons_per_iteration = 60000
-max_depth = 64
-seed = 3
-)";
-
 TEST_F(RenderTest, WhiteFurnacePathTracing) {
-    auto t = Render(FurnaceMesh(), {"shell"}, fmt::format(fmt::runtime(kFurnace), "path"), 1);
+    auto t = Render(testing::FurnaceMesh(), {"shell"},
+                    fmt::format(fmt::runtime(testing::kFurnace), "path"), 1);
     ASSERT_TRUE(t);
     EXPECT_NEAR(MeanY(*t->film), 1.0, 0.02);
 }
 
 TEST_F(RenderTest, WhiteFurnacePhotonMapping) {
-    auto t = Render(FurnaceMesh(), {"shell"}, fmt::format(fmt::runtime(kFurnace), "photon"), 2);
+    auto t = Render(testing::FurnaceMesh(), {"shell"},
+                    fmt::format(fmt::runtime(testing::kFurnace), "photon"), 2);
     ASSERT_TRUE(t);
     EXPECT_NEAR(MeanY(*t->film), 1.0, 0.02);
     EXPECT_GT(t->stats.photons, 0u);
@@ -486,7 +461,8 @@ TEST_F(RenderTest, MissingMaterialMappingNamesIt) {
         "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[materials.limestone]\n", "abbey.toml");
     ASSERT_TRUE(config.ok()) << config.status().ToString();
     auto scene = testing::BuildTestScene(
-        testing::GridSource(FurnaceMesh(), testing::NamedMaterials({"glass_blue"}), {1, 1, 1}),
+        testing::GridSource(testing::FurnaceMesh(), testing::NamedMaterials({"glass_blue"}),
+                            {1, 1, 1}),
         *config);
     ASSERT_FALSE(scene.ok());
     EXPECT_NE(scene.status().message().find("glass_blue"), std::string::npos)

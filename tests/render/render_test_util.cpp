@@ -101,6 +101,12 @@ std::unique_ptr<TestRender> BuildAndRender(std::unique_ptr<BrickSource> source, 
     return t;
 }
 
+store::BrickMesh FurnaceMesh() {
+    store::BrickMesh m;
+    AppendSphere(&m, {0, 0, 0}, 1.0f, 24, 48, 0, /*inward=*/true);
+    return m;
+}
+
 std::unique_ptr<TestRender> Render(const store::BrickMesh& mesh,
                                    const std::vector<std::string>& material_names,
                                    const std::string& config_text, int n_split, int threads,

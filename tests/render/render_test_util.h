@@ -32,6 +32,31 @@ namespace nave::render::testing {
 // ----------------------------------------------------------------------------------------------
 // Sources
 
+/// White furnace: inside a closed sphere of albedo a whose surface emits Le, the radiance
+/// everywhere is Le / (1 - a) (the Neumann series of the rendering equation, Kajiya 1986, with
+/// constant L). With a = 0.5, Le = 0.5 (kFurnace): L = 1, and a constant spectrum of 1 has Y = 1
+/// (CIE normalisation of SampledToXYZ). The unit sphere, material 0 ("shell"), seen from inside.
+store::BrickMesh FurnaceMesh();
+/// The furnace's config, its render mode ("path" or "photon") left as a fmt "{}"; it ends inside
+/// [render].
+inline constexpr const char* kFurnace = R"(
+[camera]
+position = [0.1, 0.05, 0.0]
+look_at = [1, 0.2, 0.1]
+fov_deg = 90
+resolution = [16, 12]
+[materials.shell]
+reflectance = 0.5
+emission = 0.5
+[render]
+mode = "{}"
+spp = 64
+iterations = 12
+photons_per_iteration = 60000
+max_depth = 64
+seed = 3
+)";
+
 /// Material records named `names`, by material id; every other field at its default.
 std::vector<store::MaterialRecord> NamedMaterials(const std::vector<std::string>& names);
 

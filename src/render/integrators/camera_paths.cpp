@@ -9,6 +9,7 @@
 
 #include "src/core/progress.h"
 #include "src/render/bricks/brick_walk.h"
+#include "src/render/transport/medium_flight.h"
 #include "src/render/transport/transport_common.h"
 
 namespace nave::render {
@@ -84,11 +85,85 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
     TraceInBrick(
         r, b, brick, scheduler_, out,
         [&](RayRecord& path, const BrickHit& hit) {
+            if (scene_.medium) {
+                path.beta *= NoScatterWeight(*scene_.medium, path, hit.t);
+                path.flags &= uint8_t(~kMediumScatter);
+            }
             const bool goes_on = ShadePath(path, b, brick, hit, out);
             if (!goes_on && progress_ != nullptr) progress_->Add(1);
+            if (goes_on) StartPathFlight(path);
             return goes_on;
         },
-        [&](const RayRecord& path) { Escape(path); });
+        [&](const RayRecord& path) { LeaveModel(path, out); });
+}
+
+void CameraPaths::StartPathFlight(RayRecord& r) const {
+    if (!scene_.medium) return;
+    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    StartFlight(*scene_.medium, rng.Uniform(kDimFlightChoice), rng.Uniform(kDimFlightDistance), &r);
+}
+
+void CameraPaths::LeaveModel(RayRecord r, RayOutbox& out) {
+    if (scene_.medium) {
+        if (r.flags & kMediumScatter) {
+            ScatterInMedium(r, out);
+            return;
+        }
+        r.beta *= NoScatterWeight(*scene_.medium, r, kInfinity);
+    }
+    Escape(r);
+}
+
+void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
+    const HomogeneousMedium& medium = *scene_.medium;
+    const Vec3f p = r.origin + r.dir * r.t_max;
+    r.beta *= ScatterWeight(medium, r);
+    r.flags &= uint8_t(~(kMediumScatter | kSkyShadow));
+    // As at surfaces (ShadePath): a vertex at max_depth ends the path before it estimates light.
+    const auto path_ends = [&] {
+        if (progress_ != nullptr) progress_->Add(1);
+    };
+    if (r.depth >= uint32_t(scene_.settings.max_depth) || r.beta.IsZero()) return path_ends();
+    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    // Next-event estimation from the medium's vertex, weighted against sampling the phase
+    // function, which is how the path goes on.
+    for (size_t i = 0; i < scene_.lights.size(); ++i) {
+        if (std::optional<RayRecord> shadow =
+                lights_.SampleLightInMedium(*scene_.lights[i], int(i), p, medium.phase(), r, rng))
+            Spawn(*shadow, store::kNoBrick, nullptr, out);
+    }
+    if (scene_.sky) {
+        if (std::optional<RayRecord> shadow = lights_.SampleSkyInMedium(p, medium.phase(), r, rng))
+            Spawn(*shadow, store::kNoBrick, nullptr, out);
+    }
+    // The phase function is sampled exactly: the throughput keeps its value.
+    const PhaseSample ps =
+        medium.phase().Sample(r.dir, Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)));
+    if (r.depth >= 2) {
+        // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1, as at surfaces.
+        const float m = r.beta.MaxValue();
+        if (m < 1) {
+            const float q = std::max(0.f, 1 - m);
+            if (rng.Uniform(kDimRoulette) < q) return path_ends();
+            r.beta /= 1 - q;
+        }
+    }
+    r.vertex += 1;
+    r.depth += 1;
+    r.flags &= uint8_t(~kSpecularBounce);
+    r.guide_side = kMediumSide;
+    r.prev_pdf = ps.pdf;
+    // A scattering widens the ray's cone as a diffuse bounce does; it leaves no surface level.
+    r.cone_width = ConeWidthAt(r, r.t_max);
+    r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
+    r.origin_level = 0;
+    r.level_reach = 0;
+    r.origin = p;
+    r.since_vertex = 0;
+    r.dir = ps.wi;
+    r.t_max = kInfinity;
+    r.t_enter = r.t_exit = 0;
+    Spawn(r, store::kNoBrick, nullptr, out);
 }
 
 void CameraPaths::Escape(const RayRecord& r) {
@@ -100,14 +175,16 @@ void CameraPaths::Escape(const RayRecord& r) {
         // vertex the direction was sampled from.
         float w = 1;
         if (r.depth > 0 && !(r.flags & kSpecularBounce)) {
-            w = PowerHeuristic(
-                r.prev_pdf, lights_.SkyPdf(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir));
+            const int side = r.guide_side == kMediumSide ? 0 : r.guide_side;
+            w = PowerHeuristic(r.prev_pdf,
+                               lights_.SkyPdf(r.origin - r.dir * r.since_vertex, side, r.dir));
         }
         const SampledSpectrum sky = scene_.sky->Radiance(r.dir, r.lambda);
         L += sky * w;
         // The sky seen through a window from the last vertex: the guide learns where windows are
         // open to it, which next-event estimation, aiming at all windows alike, does not know.
-        if (guide_ != nullptr && r.depth > 0 && !(r.flags & kSpecularBounce) && r.prev_pdf > 0) {
+        if (guide_ != nullptr && r.depth > 0 && !(r.flags & kSpecularBounce) && r.prev_pdf > 0 &&
+            r.guide_side != kMediumSide) {
             guide_->Credit(
                 guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir),
                 double(sky.Average()) / double(r.prev_pdf));
@@ -160,12 +237,21 @@ bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, f
 
 void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out) {
     ++out.counts.rays;
+    if (scene_.medium) {
+        if (r.kind == kShadowRay) {
+            // What the medium lets through to the light (a homogeneous medium's is known at once).
+            r.beta *= scene_.medium->Transmittance(r.origin, r.dir, r.t_max, r.lambda);
+            if (r.beta.IsZero()) return;
+        } else {
+            StartPathFlight(r);
+        }
+    }
     uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
     if (next == store::kNoBrick) {
         if (r.kind == kShadowRay) {
             AddShadowContribution(r);
         } else {
-            Escape(r);
+            LeaveModel(r, out);
         }
         return;
     }

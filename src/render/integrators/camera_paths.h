@@ -87,6 +87,15 @@ class CameraPaths : public RayProcessor {
     /// A path leaving the model: the sky and the sun it finds, weighted against their next-event
     /// estimation.
     void Escape(const RayRecord& r);
+    /// Path ray `r` at its end without a surface: it scatters in the medium there
+    /// (kMediumScatter) or leaves the model (Escape), weighted for the medium it crossed.
+    void LeaveModel(RayRecord r, RayOutbox& out);
+    /// Samples where path ray `r`, starting now, scatters in the scene's medium (StartFlight);
+    /// nothing without a medium.
+    void StartPathFlight(RayRecord& r) const;
+    /// Path `r` scatters in the medium at its t_max: next-event estimation of the lights and the
+    /// sky through the phase function, then the path goes on in a direction sampled from it.
+    void ScatterInMedium(RayRecord r, RayOutbox& out);
     /// Whether light found by path `r` is a caustic that photon mode's caustic points count
     /// already: a gathering path whose every bounce past its first diffuse vertex was specular
     /// (visible_points.h). Path mode never gathers.

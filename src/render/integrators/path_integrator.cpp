@@ -166,7 +166,7 @@ bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& br
         float credit_scale = 0;
         const float beta = r.beta.Average();
         if (owned_guide_ && r.depth > 0 && !(r.flags & kSpecularBounce) && beta > 0 &&
-            r.prev_pdf > 0) {
+            r.prev_pdf > 0 && r.guide_side != kMediumSide) {
             credit =
                 owned_guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir);
             credit_scale = 1 / (beta * r.prev_pdf);

@@ -211,6 +211,34 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
     return Status::Ok();
 }
 
+namespace {
+
+/// The scene's medium from [medium] (the model's bounds when it gives no box). Errors: negative
+/// coefficients, a medium in photon mode, an empty model without a box.
+Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
+    if (scene->settings.mode == RenderSettings::Mode::kPhoton)
+        return InvalidArgumentError(
+            "{}: [medium] is rendered in path mode (render.mode = \"path\"): photon mode does not "
+            "trace photons through media",
+            config.where);
+    const Spectrum sigma_a = ToSpectrum(config.sigma_a), sigma_s = ToSpectrum(config.sigma_s);
+    for (float nm = kLambdaMinNm; nm <= kLambdaMaxNm; nm += 1) {
+        for (const auto& [key, spectrum] : {std::pair{"sigma_a", &sigma_a}, {"sigma_s", &sigma_s}})
+            if (!(spectrum->Evaluate(nm) >= 0))
+                return InvalidArgumentError(
+                    "{}: medium.{} is {} at {} nm: a coefficient (m^-1) cannot be negative",
+                    config.where, key, spectrum->Evaluate(nm), nm);
+    }
+    const Bounds3f box = config.box.value_or(scene->source->bounds());
+    if (box.Empty())
+        return InvalidArgumentError("{}: [medium] has no box_min/box_max and the model is empty",
+                                    config.where);
+    scene->medium = std::make_shared<const HomogeneousMedium>(box, sigma_a, sigma_s, config.g);
+    return Status::Ok();
+}
+
+}  // namespace
+
 StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& source) {
     // First, before anything loads a brick: the levels in use decide the slots the pager sees.
     NAVE_RETURN_IF_ERROR(
@@ -275,6 +303,7 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
                                             sun.azimuth_deg, 90.0 - sun.zenith_deg);
     }
     for (const LightConfig& lc : config.lights) scene.lights.push_back(MakeLight(lc));
+    if (config.medium) NAVE_RETURN_IF_ERROR(MakeMedium(*config.medium, &scene));
     if (config.sky.kind == SkyConfig::Kind::kUniform) {
         scene.sky = std::make_unique<SkyLight>(ToSpectrum(config.sky.radiance));
     } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {

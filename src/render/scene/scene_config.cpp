@@ -444,6 +444,33 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     return r.Finish();
 }
 
+Status ParseMedium(TableReader& r, MediumConfig* m) {
+    m->where = r.WhereTable();
+    if (r.Has("box_min") != r.Has("box_max"))
+        return InvalidArgumentError(
+            "{}: {}: give both box_min and box_max, or neither (the "
+            "model's bounds)",
+            m->where, r.Name(""));
+    if (r.Has("box_min")) {
+        Bounds3f box;
+        NAVE_RETURN_IF_ERROR(r.Vec3("box_min", &box.min));
+        NAVE_RETURN_IF_ERROR(r.Vec3("box_max", &box.max));
+        if (!(box.min.x < box.max.x && box.min.y < box.max.y && box.min.z < box.max.z))
+            return InvalidArgumentError("{}: {}: box_min must be below box_max on every axis",
+                                        m->where, r.Name(""));
+        m->box = box;
+    }
+    if (!r.Has("sigma_a") && !r.Has("sigma_s"))
+        return InvalidArgumentError(
+            "{}: {}: missing 'sigma_s' and 'sigma_a' (the scattering and absorption coefficients, "
+            "m^-1)",
+            m->where, r.Name(""));
+    if (r.Has("sigma_a")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_a", &m->sigma_a));
+    if (r.Has("sigma_s")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_s", &m->sigma_s));
+    NAVE_RETURN_IF_ERROR(r.Float("g", &m->g, -0.99, 0.99));
+    return r.Finish();
+}
+
 /// The texture keys every material type takes.
 Status ParseMaterialTextures(TableReader& r, MaterialConfig* m) {
     NAVE_RETURN_IF_ERROR(r.Bool("textures", &m->textures));
@@ -713,6 +740,13 @@ StatusOr<SceneConfig> ParseSceneConfig(std::string_view text, const std::string&
             NAVE_RETURN_IF_ERROR(ParseLight(t, &l));
             config.lights.push_back(std::move(l));
         }
+    }
+    NAVE_ASSIGN_OR_RETURN(const toml::table* medium, r.Table("medium"));
+    if (medium != nullptr) {
+        TableReader t(*medium, "medium", name);
+        MediumConfig m;
+        NAVE_RETURN_IF_ERROR(ParseMedium(t, &m));
+        config.medium = std::move(m);
     }
     NAVE_ASSIGN_OR_RETURN(const toml::table* materials, r.Table("materials"));
     if (materials != nullptr) {

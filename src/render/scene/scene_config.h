@@ -121,6 +121,16 @@ struct MaterialConfig {
     std::string where;
 };
 
+/// [medium]: a homogeneous participating medium (haze, dust) filling a box, or the model's bounds.
+struct MediumConfig {
+    std::optional<Bounds3f>
+        box;  ///< box_min, box_max (model units, metres); none: the model's bounds
+    SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1
+    SpectrumSpec sigma_s = SpectrumSpec::Constant(0.f);  ///< scattering coefficient, m^-1
+    float g = 0.f;      ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
+    std::string where;  ///< file:line of the table, for messages
+};
+
 struct RenderSettings {
     enum class Mode { kPath, kPhoton };
     Mode mode = Mode::kPath;
@@ -213,6 +223,7 @@ struct SceneConfig {
     SunConfig sun;
     SkyConfig sky;
     std::vector<LightConfig> lights;
+    std::optional<MediumConfig> medium;
     std::map<std::string, MaterialConfig>
         materials;  ///< by model material name; "default" for the rest
     RenderSettings render;

@@ -32,7 +32,14 @@ enum RayFlags : uint8_t {
     /// Shadow rays toward the sky (LightSampler::SampleSky) where its windows learn
     /// (LightSampler::sky_windows): the ones that reach it teach them (LearnFromSkyShadow).
     kSkyShadow = 1 << 6,
+    /// Path rays in a medium ([medium]): the ray scatters in it at t_max unless it meets a surface
+    /// first (StartFlight, transport/medium_flight.h).
+    kMediumScatter = 1 << 7,
 };
+
+/// RayRecord::guide_side of a path whose last vertex was a scattering in a medium, which has no
+/// side and whose light the path guide does not learn.
+inline constexpr uint8_t kMediumSide = 0xff;
 
 /// Follows kSpecularChain across a bounce that was `specular` or not.
 inline uint8_t ExtendSpecularChain(uint8_t flags, bool specular) {

@@ -151,30 +151,10 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
                                                  const Vec3f& wo, const RayRecord& r,
                                                  const VertexRng& rng,
                                                  const GuidedBsdf* continuation) const {
-    const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
     const int side = PathGuide::SideSeenFrom(h.ns, wo);
-    const SkyWindows::Region* region = windows_ ? windows_->Find(h.p, side) : nullptr;
-    // With a learned region, kLearnedSkyShare of the samples from it and the rest split as
-    // without: u_strategy below kLearnedSkyShare picks a learned window, above it is rescaled.
-    float u_strategy = rng.Uniform(dim + 2);
-    const Point2f u(rng.Uniform(dim), rng.Uniform(dim + 1));
-    std::optional<Vec3f> on_window;  // the point aimed at, when a window was chosen
-    if (region != nullptr && u_strategy < kLearnedSkyShare) {
-        on_window = windows_->SamplePoint(*region, rng.Uniform(dim + 3), u);
-    } else {
-        if (region != nullptr)
-            u_strategy = (u_strategy - kLearnedSkyShare) / (1 - kLearnedSkyShare);
-        if (portals_ != nullptr && u_strategy < kPortalSkyShare)
-            on_window = portals_->SamplePoint(rng.Uniform(dim + 3), u);
-    }
-    Vec3f wi;
-    if (on_window) {
-        const float d = Length(*on_window - h.p);
-        if (!(d > 0)) return std::nullopt;
-        wi = (*on_window - h.p) / d;
-    } else {
-        wi = SkyLight::SampleUniform(u);
-    }
+    const std::optional<Vec3f> sampled = SampleSkyDirection(h.p, side, rng);
+    if (!sampled) return std::nullopt;
+    const Vec3f& wi = *sampled;
     SampledSpectrum f = bsdf.Eval(wo, wi, r.lambda) * std::abs(Dot(wi, h.ns));
     if (f.IsZero()) return std::nullopt;
     const float light_pdf = SkyPdf(h.p, side, wi);
@@ -201,6 +181,83 @@ std::optional<RayRecord> LightSampler::SampleSky(const SurfaceHit& h, const Bsdf
         s.window_estimate_scale =
             radiance.Average() * std::abs(Dot(wi, h.ns)) / (light_pdf * s.beta.Average());
     }
+    return s;
+}
+
+std::optional<Vec3f> LightSampler::SampleSkyDirection(const Vec3f& p, int side,
+                                                      const VertexRng& rng) const {
+    const uint32_t dim = kDimLight0 + 2 * uint32_t(scene_.lights.size());
+    const SkyWindows::Region* region = windows_ ? windows_->Find(p, side) : nullptr;
+    // With a learned region, kLearnedSkyShare of the samples from it and the rest split as
+    // without: u_strategy below kLearnedSkyShare picks a learned window, above it is rescaled.
+    float u_strategy = rng.Uniform(dim + 2);
+    const Point2f u(rng.Uniform(dim), rng.Uniform(dim + 1));
+    std::optional<Vec3f> on_window;  // the point aimed at, when a window was chosen
+    if (region != nullptr && u_strategy < kLearnedSkyShare) {
+        on_window = windows_->SamplePoint(*region, rng.Uniform(dim + 3), u);
+    } else {
+        if (region != nullptr)
+            u_strategy = (u_strategy - kLearnedSkyShare) / (1 - kLearnedSkyShare);
+        if (portals_ != nullptr && u_strategy < kPortalSkyShare)
+            on_window = portals_->SamplePoint(rng.Uniform(dim + 3), u);
+    }
+    if (on_window) {
+        const float d = Length(*on_window - p);
+        if (!(d > 0)) return std::nullopt;
+        return (*on_window - p) / d;
+    }
+    return SkyLight::SampleUniform(u);
+}
+
+std::optional<RayRecord> LightSampler::SampleLightInMedium(const Light& light, int index,
+                                                           const Vec3f& p,
+                                                           const HenyeyGreenstein& phase,
+                                                           const RayRecord& r,
+                                                           const VertexRng& rng) const {
+    Point2f u(rng.Uniform(kDimLight0 + 2 * index), rng.Uniform(kDimLight0 + 2 * index + 1));
+    const std::optional<LightSample> ls = light.SampleLi(p, u, r.lambda);
+    if (!ls || ls->weight.IsZero()) return std::nullopt;
+    const float f = phase.Eval(Dot(r.dir, ls->wi));
+    const float w = ls->pdf > 0 ? PowerHeuristic(ls->pdf, f) : 1.f;
+    RayRecord s = ShadowFromMedium(r, p, ls->wi, ls->t_max);
+    s.cone_spread = std::max(s.cone_spread, light.ShadowSpread());
+    s.beta = r.beta * ls->weight * (f * w);
+    return s;
+}
+
+std::optional<RayRecord> LightSampler::SampleSkyInMedium(const Vec3f& p,
+                                                         const HenyeyGreenstein& phase,
+                                                         const RayRecord& r,
+                                                         const VertexRng& rng) const {
+    // Side 0: a medium's vertex has none; the learned windows (photon mode) are not used there.
+    const std::optional<Vec3f> sampled = SampleSkyDirection(p, 0, rng);
+    if (!sampled) return std::nullopt;
+    const Vec3f& wi = *sampled;
+    const float light_pdf = SkyPdf(p, 0, wi);
+    if (!(light_pdf > 0)) return std::nullopt;
+    const float f = phase.Eval(Dot(r.dir, wi));
+    const float w = PowerHeuristic(light_pdf, f);
+    RayRecord s = ShadowFromMedium(r, p, wi, kInfinity);
+    s.cone_spread = std::max(s.cone_spread, kScatteredConeSpread);
+    s.beta = r.beta * scene_.sky->Radiance(wi, r.lambda) * (f * w / light_pdf);
+    if (s.beta.IsZero()) return std::nullopt;
+    return s;
+}
+
+RayRecord LightSampler::ShadowFromMedium(const RayRecord& r, const Vec3f& p, const Vec3f& wi,
+                                         float t_max) {
+    RayRecord s = r;
+    s.kind = kShadowRay;
+    s.flags = uint8_t(r.flags & ~(kSkyShadow | kMediumScatter));
+    s.cone_width = ConeWidthAt(r, r.t_max);
+    s.origin_level = 0;
+    s.level_reach = 0;
+    s.origin = p;
+    s.since_vertex = 0;
+    s.dir = wi;
+    s.t_max = t_max;
+    s.t_enter = s.t_exit = 0;
+    s.guide_credit = PathGuide::kNoCredit;
     return s;
 }
 

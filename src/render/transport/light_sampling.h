@@ -14,6 +14,7 @@
 #include "src/core/vecmath.h"
 #include "src/render/bricks/brick_source.h"
 #include "src/render/scene/materials/bxdf.h"
+#include "src/render/scene/media/henyey_greenstein.h"
 #include "src/render/scene/scene.h"
 #include "src/render/scene/surface_hit.h"
 #include "src/render/stream/ray.h"
@@ -106,6 +107,17 @@ class LightSampler {
     std::optional<RayRecord> SampleSky(const SurfaceHit& h, const Bsdf& bsdf, const Vec3f& wo,
                                        const RayRecord& r, const VertexRng& rng,
                                        const GuidedBsdf* continuation) const;
+    /// Next-event estimation of `light` from point `p` in a medium whose phase function is
+    /// `phase`, for the path of `r` arriving there along r.dir: the shadow ray (its contribution
+    /// before the medium's transmittance, which CameraPaths::Spawn applies), weighted against
+    /// sampling the phase function (power heuristic), or nothing.
+    std::optional<RayRecord> SampleLightInMedium(const Light& light, int index, const Vec3f& p,
+                                                 const HenyeyGreenstein& phase, const RayRecord& r,
+                                                 const VertexRng& rng) const;
+    /// Next-event estimation of the sky from point `p` in a medium, as SampleSky picks directions
+    /// (SkyPdf with side 0), weighted against the phase function as SampleLightInMedium is.
+    std::optional<RayRecord> SampleSkyInMedium(const Vec3f& p, const HenyeyGreenstein& phase,
+                                               const RayRecord& r, const VertexRng& rng) const;
     /// The solid-angle pdf with which SampleSky picks direction `w` at point `p` on a surface of
     /// side `side` (PathGuide::SideOf, turned toward the path): the mixture of uniform
     /// directions, portal sampling by area, whose pdf sums d² / (|cos θ| A_portals) over every
@@ -130,6 +142,14 @@ class LightSampler {
         const std::vector<uint32_t>& bricks);
 
   private:
+    /// A direction toward the sky from `p` on a surface of side `side`, drawn as SkyPdf says, or
+    /// nothing.
+    std::optional<Vec3f> SampleSkyDirection(const Vec3f& p, int side, const VertexRng& rng) const;
+    /// The shadow ray of path `r` from its medium vertex `p` toward `wi`, up to `t_max`, without
+    /// its contribution.
+    static RayRecord ShadowFromMedium(const RayRecord& r, const Vec3f& p, const Vec3f& wi,
+                                      float t_max);
+
     explicit LightSampler(const RenderScene& scene) : scene_(scene) {}
     /// The order of a shadow ray's estimate of a window's light in `scene` (SkyWindows' scale).
     static double TypicalWindowLight(const RenderScene& scene);

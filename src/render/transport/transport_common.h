@@ -34,6 +34,9 @@ enum RngDim : uint32_t {
     kDimLens0,
     kDimLens1,
     kDimLambda,
+    // The path stream, as a ray starts: where it scatters in a medium (StartFlight).
+    kDimFlightChoice = 5,
+    kDimFlightDistance,
     // Every scattering vertex: BSDF lobe and direction, Russian roulette.
     kDimBsdfChoice = 8,
     kDimBsdf0,
