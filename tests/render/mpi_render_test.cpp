@@ -320,6 +320,24 @@ TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
     EXPECT_EQ(a, b);
 }
 
+// The abbey in haze (a medium over the church): a path's scattering in the air happens on the
+// rank whose brick its free flight ends in, and its rays go on as any other. One process's image,
+// bit for bit.
+TEST_F(MpiRender, AMediumGivesTheSingleProcessImage) {
+    auto render = [&](const std::string& out) {
+        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + NAVE_SOURCE_DIR +
+               "/configs/abbey_haze.toml --resolution 64x48 --spp 2 -q -o " +
+               (*dir_ / out).string();
+    };
+    const test::CommandResult one = Shell(render("haze1.exr"));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const test::CommandResult two = Shell(Mpirun(2) + render("haze2.exr"));
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    const std::vector<float> a = Rgb(*dir_ / "haze1.exr"), b = Rgb(*dir_ / "haze2.exr");
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, b);
+}
+
 // Photon mode: each rank makes the visible points of its own bricks and sends each to the ranks
 // owning another brick its gather sphere reaches; photons travel between the ranks as rays do, and
 // what they teach (the sun's photon guide, the windows, the gather guide) is summed in integers, so

@@ -63,12 +63,14 @@ std::unique_ptr<BrickSource> BallGridSource() {
     return testing::GridSource(BallGrid(), testing::NamedMaterials(kNames), {4, 4, 2});
 }
 
-/// The ball grid's config in `mode` (path, photon, or "photon_gather": photon with final
-/// gathering and its guide).
+/// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
+/// and its guide, or "path_haze": path with a medium over the model).
 SceneConfig BallGridConfig(const std::string& mode) {
-    const bool gather = mode == "photon_gather";
-    auto config = ParseSceneConfig(fmt::format(fmt::runtime(kBallGrid), gather ? "photon" : mode),
-                                   "balls.toml");
+    const bool gather = mode == "photon_gather", haze = mode == "path_haze";
+    const std::string text =
+        fmt::format(fmt::runtime(kBallGrid), gather ? "photon" : (haze ? "path" : mode)) +
+        (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
+    auto config = ParseSceneConfig(text, "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     if (!config.ok()) return SceneConfig();
     config->render.final_gather = gather;
@@ -166,6 +168,9 @@ TEST_F(PagerTest, AWaveLargerThanTheQueueMemorySpillsAsItIsGenerated) {
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
+
+// A medium's scatterings happen in whichever brick a ray's free flight ends, resident or not.
+TEST_F(PagerTest, PagedRenderEqualsInCorePathInHaze) { ExpectPagedEqualsInCore("path_haze", 1e-9); }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }
 

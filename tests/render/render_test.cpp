@@ -423,6 +423,22 @@ TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImagePath) {
     EXPECT_LT(MaxRelativeDifference(*many->film, *many_more_threads->film), 1e-9);
 }
 
+TEST_F(RenderTest, OneBrickAnd64BricksRenderTheSameImageInHaze) {
+    // A medium over the model: scatterings in the air, in whichever brick they fall, and shadow
+    // rays dimmed by it, give the same image whatever the bricks and threads.
+    const std::string config = fmt::format(fmt::runtime(kClutter), "path") +
+                               "[medium]\nsigma_s = 0.3\nsigma_a = 0.05\ng = 0.4\n";
+    auto one = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 1, 1);
+    auto many = Render(ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
+    auto clear = Render(ClutterMesh(), {"floor", "ball", "chrome"},
+                        fmt::format(fmt::runtime(kClutter), "path"), 1, 1);
+    ASSERT_TRUE(one && many && clear);
+    EXPECT_GT(many->stats.brick_moves, 0u);
+    EXPECT_GT(MeanY(*one->film), 0.0);
+    EXPECT_GT(MaxRelativeDifference(*one->film, *clear->film), 0.1);  // the haze shows
+    EXPECT_LT(MaxRelativeDifference(*one->film, *many->film), 1e-9);
+}
+
 TEST_F(RenderTest, BrickOrderDoesNotChangeTheImage) {
     // Process bricks emptiest-first and highest-id-first instead of fullest-first: the same image.
     std::string config = fmt::format(fmt::runtime(kClutter), "path");
