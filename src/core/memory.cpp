@@ -109,7 +109,19 @@ void ReturnFreeMemory() {
 }
 
 bool ResidentSizeGuard::MakeRoom(uint64_t bytes) {
-    if (limit_bytes_ == 0) return false;
+    if (limit_bytes_ == 0) {
+        // No budget: only the free pages that piled up go back, measured against what the process
+        // held right after the last return (its live memory then, and its allocations since).
+        const uint64_t base = after_return_bytes_.load(std::memory_order_relaxed);
+        const uint64_t allowed = base + uint64_t(double(base) * kSlackShare) + kSlackBytes;
+        if (base != 0 && CurrentRssBytes() + bytes <= allowed) return false;
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (after_return_bytes_.load(std::memory_order_relaxed) != base) return false;  // done
+        ReturnFreeMemory();
+        returns_.fetch_add(1, std::memory_order_relaxed);
+        after_return_bytes_.store(CurrentRssBytes(), std::memory_order_relaxed);
+        return true;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     if (CurrentRssBytes() + bytes <= limit_bytes_) return false;
     ReturnFreeMemory();

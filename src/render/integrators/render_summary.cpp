@@ -234,9 +234,9 @@ std::vector<std::string> RenderSummary::TerminalLines(const std::string& memory_
                            : std::string(),
         stat("brick_evictions"), stat("brick_reloads"), stat("prefetch_loads"),
         stat("resident_hits"), own("brick_acquires"), stat("stall"),
-        memory_returns > 0
-            ? fmt::format(", free pages given back {} times near --memory", memory_returns)
-            : std::string()));
+        memory_returns > 0 ? fmt::format(", free pages given back {} times {}", memory_returns,
+                                         memory_text.empty() ? "as they piled up" : "near --memory")
+                           : std::string()));
     if (Get(kStatisticsAttribute, "spilled_rays").integer > 0) {
         lines.push_back(fmt::format(
             "ray queues: {} rays spilled to disk ({} written, at most {} on disk at "
