@@ -2,6 +2,8 @@
 // the spectral free-flight estimator, and renders against closed forms (an absorbing slab, single
 // scattering of a directional light, a white furnace filled with an albedo-1 medium).
 
+#include "src/render/scene/media/medium.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,7 +15,6 @@
 #include "src/core/sampling.h"
 #include "src/render/bricks/procedural_meshes.h"
 #include "src/render/scene/media/henyey_greenstein.h"
-#include "src/render/scene/media/homogeneous_medium.h"
 #include "src/render/transport/medium_flight.h"
 
 namespace nave::render {
@@ -71,9 +72,9 @@ Spectrum Rising() {
 }
 
 // Beer-Lambert: exp(-σt ℓ) with ℓ the length inside the box.
-TEST(HomogeneousMediumTest, TransmittanceIsBeerLambertOverTheLengthInsideTheBox) {
-    const HomogeneousMedium m(Bounds3f({0, 0, 0}, {1, 1, 1}), Spectrum::Constant(0.25f), Rising(),
-                              0.f);
+TEST(MediumTest, TransmittanceIsBeerLambertOverTheLengthInsideTheBox) {
+    const Medium m(std::make_shared<BoxDensity>(Bounds3f({0, 0, 0}, {1, 1, 1})),
+                   Spectrum::Constant(0.25f), Rising(), 0.f);
     const SampledWavelengths lambda = SampledWavelengths::SampleVisible(0.37f);
     const SampledSpectrum sigma_t = m.SigmaT(lambda);
     const Vec3f o(-1, 0.5f, 0.5f), d(1, 0, 0);
@@ -88,7 +89,7 @@ TEST(HomogeneousMediumTest, TransmittanceIsBeerLambertOverTheLengthInsideTheBox)
     EXPECT_EQ(m.Transmittance(Vec3f(-1, 2, 0.5f), d, kInf, lambda), SampledSpectrum(1.f));
     EXPECT_EQ(m.Transmittance(o, d, 0.9f, lambda), SampledSpectrum(1.f));
     // Diagonally through a corner region: the slab test's length.
-    EXPECT_NEAR(m.LengthInside(Vec3f(-0.5f, -0.5f, 0.5f), Normalize(Vec3f(1, 1, 0)), kInf),
+    EXPECT_NEAR(m.density().Integral(Vec3f(-0.5f, -0.5f, 0.5f), Normalize(Vec3f(1, 1, 0)), kInf),
                 std::sqrt(2.f), 1e-5f);
 }
 
@@ -97,8 +98,8 @@ TEST(HomogeneousMediumTest, TransmittanceIsBeerLambertOverTheLengthInsideTheBox)
 // through weighted by NoScatterWeight estimate e^(-σt L), whichever wavelength drew the distance.
 TEST(MediumFlightTest, WeightsEstimateScatteringAndTransmittanceAtEveryWavelength) {
     const float length = 1.5f;
-    const HomogeneousMedium m(Bounds3f({0, -1, -1}, {length, 1, 1}), Spectrum::Constant(0.1f),
-                              Rising(), 0.f);
+    const Medium m(std::make_shared<BoxDensity>(Bounds3f({0, -1, -1}, {length, 1, 1})),
+                   Spectrum::Constant(0.1f), Rising(), 0.f);
     RayRecord base;
     base.origin = Vec3f(-0.5f, 0, 0);
     base.dir = Vec3f(1, 0, 0);
@@ -157,6 +158,20 @@ sigma_a = 0.7
     ASSERT_TRUE(clear && hazy);
     // The view's rays lie within 0.5° of the slab's normal: up to 4e-5 longer inside it.
     EXPECT_NEAR(MeanY(*hazy->film) / MeanY(*clear->film), std::exp(-0.7), 5e-5);
+}
+
+// extinction and albedo are σt and σs / σt: the same image as the coefficients they stand for.
+TEST_F(MediumRenderTest, ExtinctionAndAlbedoAreTheCoefficientsTheyStandFor) {
+    store::BrickMesh mesh;
+    AppendSphere(&mesh, {0, 0, 0}, 1.0f, 12, 24, 0, /*inward=*/true);
+    const std::string base = fmt::format(fmt::runtime(testing::kFurnace), "path");
+    const auto coefficients =
+        Render(mesh, {"shell"}, base + "[medium]\nsigma_s = 0.8\nsigma_a = 0.2\n", 1);
+    const auto albedo =
+        Render(mesh, {"shell"}, base + "[medium]\nextinction = 1.0\nalbedo = 0.8\n", 1);
+    ASSERT_TRUE(coefficients && albedo);
+    EXPECT_LT(MeanY(*coefficients->film), 0.95);  // the medium absorbs
+    EXPECT_LT(testing::MaxRelativeDifference(*coefficients->film, *albedo->film), 1e-6);
 }
 
 // A directional light of irradiance E from above into a slab of medium, seen side-on along a
@@ -229,7 +244,10 @@ TEST(MediumConfigTest, BadMediaAreNamed) {
               std::string::npos);
     EXPECT_NE(error("sigma_s = 0.1\ng = 1").find("medium.g"), std::string::npos);
     EXPECT_NE(error("sigma_s = 0.1\ndensity = 3").find("density"), std::string::npos);
+    EXPECT_NE(error("sigma_s = 0.1\nextinction = 0.2").find("not both"), std::string::npos);
+    EXPECT_NE(error("extinction = 0.2").find("go together"), std::string::npos);
     EXPECT_EQ(error("sigma_s = 0.1\nsigma_a = 0.01\ng = 0.5"), "");
+    EXPECT_EQ(error("extinction = 0.02\nalbedo = 0.9"), "");
 }
 
 TEST_F(MediumRenderTest, PhotonModeAndNegativeCoefficientsAreRefused) {
@@ -249,6 +267,8 @@ TEST_F(MediumRenderTest, PhotonModeAndNegativeCoefficientsAreRefused) {
     };
     EXPECT_NE(build_error("sigma_s = 0.1", "photon").find("path mode"), std::string::npos);
     EXPECT_NE(build_error("sigma_s = -0.1", "path").find("medium.sigma_s is -0.1"),
+              std::string::npos);
+    EXPECT_NE(build_error("extinction = 0.1\nalbedo = 1.2", "path").find("medium.albedo is 1.2"),
               std::string::npos);
     EXPECT_EQ(build_error("sigma_s = 0.1", "path"), "");
 }

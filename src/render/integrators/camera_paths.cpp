@@ -115,7 +115,7 @@ void CameraPaths::LeaveModel(RayRecord r, RayOutbox& out) {
 }
 
 void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
-    const HomogeneousMedium& medium = *scene_.medium;
+    const Medium& medium = *scene_.medium;
     const Vec3f p = r.origin + r.dir * r.t_max;
     r.beta *= ScatterWeight(medium, r);
     r.flags &= uint8_t(~(kMediumScatter | kSkyShadow));

@@ -221,7 +221,22 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
             "{}: [medium] is rendered in path mode (render.mode = \"path\"): photon mode does not "
             "trace photons through media",
             config.where);
-    const Spectrum sigma_a = ToSpectrum(config.sigma_a), sigma_s = ToSpectrum(config.sigma_s);
+    Spectrum sigma_a = ToSpectrum(config.sigma_a), sigma_s = ToSpectrum(config.sigma_s);
+    if (config.extinction_albedo) {
+        const Spectrum sigma_t = ToSpectrum(config.extinction_albedo->first);
+        const Spectrum albedo = ToSpectrum(config.extinction_albedo->second);
+        for (float nm = kLambdaMinNm; nm <= kLambdaMaxNm; nm += 1)
+            if (!(albedo.Evaluate(nm) >= 0 && albedo.Evaluate(nm) <= 1))
+                return InvalidArgumentError(
+                    "{}: medium.albedo is {} at {} nm: a fraction of the extinction, in [0, 1]",
+                    config.where, albedo.Evaluate(nm), nm);
+        // σs = α σt and σa = (1 - α) σt (the single-scattering albedo's definition).
+        sigma_s = Spectrum::FromFunction(
+            [&](double nm) { return sigma_t.Evaluate(float(nm)) * albedo.Evaluate(float(nm)); });
+        sigma_a = Spectrum::FromFunction([&](double nm) {
+            return sigma_t.Evaluate(float(nm)) * (1 - albedo.Evaluate(float(nm)));
+        });
+    }
     for (float nm = kLambdaMinNm; nm <= kLambdaMaxNm; nm += 1) {
         for (const auto& [key, spectrum] : {std::pair{"sigma_a", &sigma_a}, {"sigma_s", &sigma_s}})
             if (!(spectrum->Evaluate(nm) >= 0))
@@ -233,7 +248,8 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
     if (box.Empty())
         return InvalidArgumentError("{}: [medium] has no box_min/box_max and the model is empty",
                                     config.where);
-    scene->medium = std::make_shared<const HomogeneousMedium>(box, sigma_a, sigma_s, config.g);
+    scene->medium = std::make_shared<const Medium>(std::make_shared<BoxDensity>(box), sigma_a,
+                                                   sigma_s, config.g);
     return Status::Ok();
 }
 

@@ -22,7 +22,7 @@
 #include "src/render/scene/materials/bxdf.h"
 #include "src/render/scene/materials/frame.h"
 #include "src/render/scene/materials/materials.h"
-#include "src/render/scene/media/homogeneous_medium.h"
+#include "src/render/scene/media/medium.h"
 #include "src/render/scene/scene_config.h"
 #include "src/render/scene/sun/sky.h"
 #include "src/render/scene/texture/surface_textures.h"
@@ -118,7 +118,7 @@ struct RenderScene {
     const SunLight& sun_light() const { return static_cast<const SunLight&>(*lights[size_t(sun)]); }
     std::unique_ptr<SkyLight> sky;  ///< uniform or physical, or null
     /// The medium filling the air ([medium]), or null. Path mode only.
-    std::shared_ptr<const HomogeneousMedium> medium;
+    std::shared_ptr<const Medium> medium;
     RenderSettings settings;
     OutputConfig output;
     std::string sun_description;  ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary

@@ -460,11 +460,26 @@ Status ParseMedium(TableReader& r, MediumConfig* m) {
                                         m->where, r.Name(""));
         m->box = box;
     }
-    if (!r.Has("sigma_a") && !r.Has("sigma_s"))
+    const bool coefficients = r.Has("sigma_a") || r.Has("sigma_s");
+    const bool extinction = r.Has("extinction") || r.Has("albedo");
+    if (coefficients && extinction)
+        return InvalidArgumentError(
+            "{}: {}: give sigma_s and sigma_a, or extinction and albedo, not both", m->where,
+            r.Name(""));
+    if (!coefficients && !extinction)
         return InvalidArgumentError(
             "{}: {}: missing 'sigma_s' and 'sigma_a' (the scattering and absorption coefficients, "
-            "m^-1)",
+            "m^-1), or 'extinction' and 'albedo'",
             m->where, r.Name(""));
+    if (extinction) {
+        if (!r.Has("extinction") || !r.Has("albedo"))
+            return InvalidArgumentError("{}: {}: 'extinction' and 'albedo' go together", m->where,
+                                        r.Name(""));
+        SpectrumSpec sigma_t, albedo;
+        NAVE_RETURN_IF_ERROR(r.Spectrum("extinction", &sigma_t));
+        NAVE_RETURN_IF_ERROR(r.Spectrum("albedo", &albedo));
+        m->extinction_albedo = std::pair{sigma_t, albedo};
+    }
     if (r.Has("sigma_a")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_a", &m->sigma_a));
     if (r.Has("sigma_s")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_s", &m->sigma_s));
     NAVE_RETURN_IF_ERROR(r.Float("g", &m->g, -0.99, 0.99));

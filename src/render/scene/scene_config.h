@@ -127,6 +127,9 @@ struct MediumConfig {
         box;  ///< box_min, box_max (model units, metres); none: the model's bounds
     SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1
     SpectrumSpec sigma_s = SpectrumSpec::Constant(0.f);  ///< scattering coefficient, m^-1
+    /// Instead of sigma_a and sigma_s: the extinction coefficient σt (m^-1) and the single-
+    /// scattering albedo σs / σt.
+    std::optional<std::pair<SpectrumSpec, SpectrumSpec>> extinction_albedo;
     float g = 0.f;      ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
     std::string where;  ///< file:line of the table, for messages
 };
