@@ -239,7 +239,7 @@ void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Ray
     ++out.counts.rays;
     if (scene_.medium) {
         if (r.kind == kShadowRay) {
-            // What the medium lets through to the light (a homogeneous medium's is known at once).
+            // What the medium lets through to the light: its density's integral is known at once.
             r.beta *= scene_.medium->Transmittance(r.origin, r.dir, r.t_max, r.lambda);
             if (r.beta.IsZero()) return;
         } else {
