@@ -32,9 +32,10 @@ foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
   endif()
 endforeach()
 
-# OpenVDB (participating media, a later stage) ships only a Find module on Debian.
+# OpenVDB (the density grids of participating media, in the plugin src/volumes/vdb) ships only a
+# Find module on Debian.
 list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
-find_package(OpenVDB QUIET)
+find_package(OpenVDB REQUIRED)
 
 # MPI (Open MPI in Debian: libopenmpi-dev, openmpi-bin): the distributed render. Optional: without it
 # nave is one process (docs/distributed.md).

@@ -131,22 +131,8 @@ TEST(MediumFlightTest, WeightsEstimateScatteringAndTransmittanceAtEveryWavelengt
 // An emitter seen through a slab of pure absorber 1 m thick: dimmed by e^(-σa), exactly (the same
 // paths and wavelengths as without the slab; absorption is a weight, not a chance).
 TEST_F(MediumRenderTest, AnAbsorbingSlabDimsWhatIsBehindItByBeerLambert) {
-    store::BrickMesh mesh;
-    AppendQuad(&mesh, {3, 0, 0}, {0, 0, 2}, {0, 2, 0}, 2, 0);
-    const std::string config = R"(
-[camera]
-position = [0, 0, 0]
-look_at = [1, 0, 0]
-fov_deg = 1
-resolution = [8, 6]
-[materials.lamp]
-type = "black"
-emission = 1
-[render]
-mode = "path"
-spp = 4
-max_depth = 4
-)";
+    const store::BrickMesh mesh = testing::LampMesh();
+    const std::string config = testing::kLampConfig;
     const auto clear = Render(mesh, {"lamp"}, config, 2);
     const auto hazy = Render(mesh, {"lamp"}, config + R"(
 [medium]

@@ -101,6 +101,12 @@ std::unique_ptr<TestRender> BuildAndRender(std::unique_ptr<BrickSource> source, 
     return t;
 }
 
+store::BrickMesh LampMesh() {
+    store::BrickMesh m;
+    AppendQuad(&m, {3, 0, 0}, {0, 0, 2}, {0, 2, 0}, 2, 0);
+    return m;
+}
+
 store::BrickMesh FurnaceMesh() {
     store::BrickMesh m;
     AppendSphere(&m, {0, 0, 0}, 1.0f, 24, 48, 0, /*inward=*/true);

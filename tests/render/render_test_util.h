@@ -57,6 +57,25 @@ max_depth = 64
 seed = 3
 )";
 
+/// A lamp (a square of radiance 1, material 0 "lamp", black otherwise) 3 m down +x, filling the
+/// narrow view of kLampConfig: what a medium between them does to it is all the image shows.
+store::BrickMesh LampMesh();
+/// LampMesh's config, path mode; it ends inside [render].
+inline constexpr const char* kLampConfig = R"(
+[camera]
+position = [0, 0, 0]
+look_at = [1, 0, 0]
+fov_deg = 1
+resolution = [8, 6]
+[materials.lamp]
+type = "black"
+emission = 1
+[render]
+mode = "path"
+spp = 4
+max_depth = 4
+)";
+
 /// Material records named `names`, by material id; every other field at its default.
 std::vector<store::MaterialRecord> NamedMaterials(const std::vector<std::string>& names);
 

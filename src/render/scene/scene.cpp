@@ -9,6 +9,7 @@
 #include "src/render/scene/lights/point_light.h"
 #include "src/render/scene/lights/spot_light.h"
 #include "src/render/scene/materials/ior.h"
+#include "src/render/scene/media/vdb_density.h"
 #include "src/render/scene/sun/sun.h"
 
 namespace nave::render {
@@ -244,12 +245,22 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
                     "{}: medium.{} is {} at {} nm: a coefficient (m^-1) cannot be negative",
                     config.where, key, spectrum->Evaluate(nm), nm);
     }
-    const Bounds3f box = config.box.value_or(scene->source->bounds());
-    if (box.Empty())
-        return InvalidArgumentError("{}: [medium] has no box_min/box_max and the model is empty",
-                                    config.where);
-    scene->medium = std::make_shared<const Medium>(std::make_shared<BoxDensity>(box), sigma_a,
-                                                   sigma_s, config.g);
+    std::shared_ptr<const DensityField> density;
+    if (!config.grid.empty()) {
+        StatusOr<std::shared_ptr<const VdbDensity>> grid =
+            VdbDensity::Load(config.grid, config.grid_name, config.density_scale);
+        if (!grid.ok())
+            return Status(grid.status().code(), fmt::format("{}: [medium] grid: {}", config.where,
+                                                            grid.status().message()));
+        density = *grid;
+    } else {
+        const Bounds3f box = config.box.value_or(scene->source->bounds());
+        if (box.Empty())
+            return InvalidArgumentError(
+                "{}: [medium] has no box_min/box_max and the model is empty", config.where);
+        density = std::make_shared<BoxDensity>(box);
+    }
+    scene->medium = std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g);
     return Status::Ok();
 }
 

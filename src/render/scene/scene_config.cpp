@@ -460,6 +460,21 @@ Status ParseMedium(TableReader& r, MediumConfig* m) {
                                         m->where, r.Name(""));
         m->box = box;
     }
+    if (r.Has("grid")) {
+        if (r.Has("box_min"))
+            return InvalidArgumentError(
+                "{}: {}: give a grid or a box (box_min, box_max), not both: a grid's medium fills "
+                "its voxels",
+                m->where, r.Name(""));
+        std::string grid;
+        NAVE_RETURN_IF_ERROR(r.String("grid", &grid));
+        m->grid = std::filesystem::path(r.file()).parent_path() / grid;
+        NAVE_RETURN_IF_ERROR(r.String("grid_name", &m->grid_name));
+        NAVE_RETURN_IF_ERROR(r.Float("density_scale", &m->density_scale, 0, 1e9));
+    } else if (r.Has("grid_name") || r.Has("density_scale")) {
+        return InvalidArgumentError("{}: {}: grid_name and density_scale need a grid", m->where,
+                                    r.Name(""));
+    }
     const bool coefficients = r.Has("sigma_a") || r.Has("sigma_s");
     const bool extinction = r.Has("extinction") || r.Has("albedo");
     if (coefficients && extinction)

@@ -123,8 +123,13 @@ struct MaterialConfig {
 
 /// [medium]: a homogeneous participating medium (haze, dust) filling a box, or the model's bounds.
 struct MediumConfig {
-    std::optional<Bounds3f>
-        box;  ///< box_min, box_max (model units, metres); none: the model's bounds
+    /// box_min, box_max (model units, metres); none: the model's bounds.
+    std::optional<Bounds3f> box;
+    /// A density grid instead of a box: an OpenVDB file (relative paths from the config's
+    /// directory), the float grid's name in it, and a factor on its values.
+    std::filesystem::path grid;
+    std::string grid_name = "density";
+    float density_scale = 1.f;
     SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1
     SpectrumSpec sigma_s = SpectrumSpec::Constant(0.f);  ///< scattering coefficient, m^-1
     /// Instead of sigma_a and sigma_s: the extinction coefficient σt (m^-1) and the single-

@@ -1,0 +1,57 @@
+#pragma once
+// The interface of nave's OpenVDB plugin (libnave_vdb.so, built from src/volumes/vdb/): scalar
+// grids read from and written to `.vdb` files, for the density of participating media. OpenVDB
+// pulls in Boost, Blosc and log4cplus; linked into `nave`, every command would load them, so it
+// lives in a plugin loaded on first use, as OpenImageIO does (src/imaging/oiio_plugin.h).
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "src/core/status.h"
+#include "src/core/vecmath.h"
+
+namespace nave::volumes {
+
+/// Bumped whenever VdbPlugin's methods or the types they take change.
+inline constexpr int kVdbPluginVersion = 1;
+
+/// A grid of voxels, each of constant value over its cell, in world space. Immutable: thread-safe.
+class ScalarGrid {
+  public:
+    virtual ~ScalarGrid() = default;
+    /// The world box of the active voxels' cells; outside it every value is the background, 0.
+    virtual Bounds3f bounds() const = 0;
+    /// Calls `visit(t0, t1, value)` for every voxel the ray o + t d (d unit) crosses with t in
+    /// [t_begin, t_end] (world units), front to back, until it returns false.
+    virtual void March(const Vec3f& o, const Vec3f& d, float t_begin, float t_end,
+                       const std::function<bool(float, float, float)>& visit) const = 0;
+};
+
+/// The OpenVDB side. Every method is thread-safe; every failure is a Status naming the file.
+class VdbPlugin {
+  public:
+    virtual ~VdbPlugin() = default;
+    /// The float grid `grid` of `file`. A file that is not OpenVDB (or is cut short) is
+    /// InvalidArgument naming it; a missing grid lists the grids there; a grid of another value
+    /// type, a transform that is not a uniform scale and translation, or a negative active value
+    /// is InvalidArgument naming the grid.
+    virtual StatusOr<std::unique_ptr<ScalarGrid>> ReadScalarGrid(const std::filesystem::path& file,
+                                                                 const std::string& grid) const = 0;
+    /// Writes a float grid named `grid` of `dims` voxels of side `voxel_m`, voxel (0, 0, 0)'s
+    /// cell starting at `origin`, with value(i, j, k) (0 is left inactive), to `file`. IoError on
+    /// failure.
+    virtual Status WriteScalarGrid(const std::filesystem::path& file, const std::string& grid,
+                                   const Vec3f& origin, float voxel_m, const Vec3i& dims,
+                                   const std::function<float(int, int, int)>& value) const = 0;
+};
+
+/// The plugin, loaded once on first call: NAVE_VDB_PLUGIN if set, else libnave_vdb.so beside the
+/// executable, else at the build tree's path, else through the library search path. Thread-safe.
+StatusOr<const VdbPlugin*> LoadVdbPlugin();
+
+}  // namespace nave::volumes
+
+/// The plugin's one exported symbol: a new VdbPlugin if `version` is kVdbPluginVersion, else null.
+extern "C" nave::volumes::VdbPlugin* NaveCreateVdbPlugin(int version);
