@@ -112,21 +112,9 @@ std::vector<Bounds3f> BrickTree::BrickCells(uint32_t brick_count) const {
 void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, float t_max,
                          const std::function<bool(uint32_t, float, float)>& visit) const {
     if (nodes_.empty()) return;
-    // Clip the ray to the root box (slab test), then walk the kd-tree front to back with an
-    // explicit stack.
-    float t0 = t_min, t1 = t_max;
-    for (int a = 0; a < 3; ++a) {
-        float inv = 1.0f / dir[a];
-        float near = (bounds_.min[a] - origin[a]) * inv;
-        float far = (bounds_.max[a] - origin[a]) * inv;
-        if (near > far) std::swap(near, far);
-        if (!(near <= far)) {  // NaN: the ray is parallel to and on a slab plane; keep it
-            continue;
-        }
-        t0 = std::max(t0, near);
-        t1 = std::min(t1, far);
-        if (t0 > t1) return;
-    }
+    // Clip the ray to the root box, then walk the kd-tree front to back with an explicit stack.
+    float t0, t1;
+    if (!ClipRayToBounds(bounds_, origin, dir, t_min, t_max, &t0, &t1)) return;
     struct Item {
         uint32_t node;
         float t0, t1;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <ostream>
+#include <utility>
 
 namespace nave {
 
@@ -130,6 +131,28 @@ struct Bounds3 {
 
 using Bounds3f = Bounds3<float>;
 using Bounds3d = Bounds3<double>;
+
+/// Where the ray o + t d, t in [t_min, t_max], crosses `box`: [*t0, *t1] (possibly a single
+/// point); false when it misses. Slabs (Kay & Kajiya 1986): the ray's parameter interval between
+/// each pair of planes, intersected. An axis the ray runs along while lying on one of its planes
+/// gives NaN and is left out.
+inline bool ClipRayToBounds(const Bounds3f& box, const Vec3f& o, const Vec3f& d, float t_min,
+                            float t_max, float* t0, float* t1) {
+    float lo = t_min, hi = t_max;
+    for (int a = 0; a < 3; ++a) {
+        const float inv = 1.0f / d[a];
+        float near = (box.min[a] - o[a]) * inv;
+        float far = (box.max[a] - o[a]) * inv;
+        if (near > far) std::swap(near, far);
+        if (!(near <= far)) continue;  // NaN
+        lo = std::max(lo, near);
+        hi = std::min(hi, far);
+        if (lo > hi) return false;
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return true;
+}
 
 template <typename T>
 std::ostream& operator<<(std::ostream& os, const Bounds3<T>& b) {

@@ -44,10 +44,6 @@ float DensityOf(const std::vector<Puff>& puffs, const Vec3f& p) {
 
 }  // namespace
 
-float DustDensity(const DustOptions& options, const Vec3f& p) {
-    return DensityOf(Puffs(options), p);
-}
-
 Status WriteDriftingDust(const std::filesystem::path& file, const DustOptions& options) {
     if (!(options.voxel_m > 0) || options.box.Empty())
         return InvalidArgumentError("dust: the voxel size must be positive and the box not empty");

@@ -19,12 +19,9 @@ struct DustOptions {
     uint64_t seed = 1;
 };
 
-/// The density at `p` of the dust of `options` (0 to about 1): a sum of Gaussian puffs (radii 1.5
-/// to 5 m, heights weighted toward the floor), clamped to 1.
-float DustDensity(const DustOptions& options, const Vec3f& p);
-
-/// Writes the dust of `options` to `file` (voxel values DustDensity at the voxels' centres, those
-/// under 1e-3 left empty). Errors: the plugin's.
+/// Writes the dust of `options` to `file`: at each voxel's centre a sum of Gaussian puffs
+/// (radii 1.5 to 5 m, heights weighted toward the floor), clamped to 1; values under 1e-3 left
+/// empty. Errors: the plugin's.
 Status WriteDriftingDust(const std::filesystem::path& file, const DustOptions& options);
 
 }  // namespace nave::volumes

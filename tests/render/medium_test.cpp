@@ -111,11 +111,15 @@ TEST(MediumFlightTest, WeightsEstimateScatteringAndTransmittanceAtEveryWavelengt
     SampledSpectrum scattered, through;
     for (int k = 0; k < n; ++k) {
         RayRecord r = base;
-        StartFlight(m, rng.NextFloat(), rng.NextFloat(), &r);
+        const float u_choice = rng.NextFloat(), u_distance = rng.NextFloat();
+        const float depth = FlightDepth(m, r.lambda, u_choice, u_distance);
+        StartFlight(m, depth, &r);
         if (r.flags & kMediumScatter) {
             EXPECT_GE(r.t_max, 0.5f);
             EXPECT_LE(r.t_max, 0.5f + length);
-            scattered += ScatterWeight(m, r);
+            // The depth it aimed at is the density's integral up to where it scatters.
+            EXPECT_NEAR(m.density().Integral(r.origin, r.dir, r.t_max), depth, 1e-5f);
+            scattered += ScatterWeight(m, r, depth);
         } else {
             through += NoScatterWeight(m, r, kInf);
         }

@@ -97,10 +97,33 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
         [&](const RayRecord& path) { LeaveModel(path, out); });
 }
 
+namespace {
+
+/// Russian roulette (Arvo & Kirk 1990) past the second bounce, once the throughput is below 1:
+/// false if path `r` ends here, else its throughput is raised by the survival probability.
+bool SurvivesRoulette(RayRecord& r, const VertexRng& rng) {
+    if (r.depth < 2) return true;
+    const float m = r.beta.MaxValue();
+    if (m >= 1) return true;
+    const float q = std::max(0.f, 1 - m);
+    if (rng.Uniform(kDimRoulette) < q) return false;
+    r.beta /= 1 - q;
+    return true;
+}
+
+}  // namespace
+
+float CameraPaths::PathFlightDepth(const RayRecord& r) const {
+    // Keyed to the path's vertex, which does not change along the ray's flight: the ray's start
+    // and its scattering draw the same numbers.
+    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    return FlightDepth(*scene_.medium, r.lambda, rng.Uniform(kDimFlightChoice),
+                       rng.Uniform(kDimFlightDistance));
+}
+
 void CameraPaths::StartPathFlight(RayRecord& r) const {
     if (!scene_.medium) return;
-    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
-    StartFlight(*scene_.medium, rng.Uniform(kDimFlightChoice), rng.Uniform(kDimFlightDistance), &r);
+    StartFlight(*scene_.medium, PathFlightDepth(r), &r);
 }
 
 void CameraPaths::LeaveModel(RayRecord r, RayOutbox& out) {
@@ -117,7 +140,7 @@ void CameraPaths::LeaveModel(RayRecord r, RayOutbox& out) {
 void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
     const Medium& medium = *scene_.medium;
     const Vec3f p = r.origin + r.dir * r.t_max;
-    r.beta *= ScatterWeight(medium, r);
+    r.beta *= ScatterWeight(medium, r, PathFlightDepth(r));
     r.flags &= uint8_t(~(kMediumScatter | kSkyShadow));
     // As at surfaces (ShadePath): a vertex at max_depth ends the path before it estimates light.
     const auto path_ends = [&] {
@@ -139,15 +162,7 @@ void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
     // The phase function is sampled exactly: the throughput keeps its value.
     const PhaseSample ps =
         medium.phase().Sample(r.dir, Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)));
-    if (r.depth >= 2) {
-        // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1, as at surfaces.
-        const float m = r.beta.MaxValue();
-        if (m < 1) {
-            const float q = std::max(0.f, 1 - m);
-            if (rng.Uniform(kDimRoulette) < q) return path_ends();
-            r.beta /= 1 - q;
-        }
-    }
+    if (!SurvivesRoulette(r, rng)) return path_ends();
     r.vertex += 1;
     r.depth += 1;
     r.flags &= uint8_t(~kSpecularBounce);
@@ -318,15 +333,7 @@ bool CameraPaths::Continue(RayRecord& r, const SurfaceHit& h, const GuidedBsdf& 
         r.flags = ExtendSpecularChain(r.flags, bs->IsSpecular() && h.material->MakesCaustics());
     r.guide_side = uint8_t(side);
     r.prev_pdf = bs->pdf;
-    if (r.depth >= 2) {
-        // Russian roulette (Arvo & Kirk 1990) once the throughput is below 1.
-        float m = r.beta.MaxValue();
-        if (m < 1) {
-            float q = std::max(0.f, 1 - m);
-            if (rng.Uniform(kDimRoulette) < q) return false;
-            r.beta /= 1 - q;
-        }
-    }
+    if (!SurvivesRoulette(r, rng)) return false;
     return Bounce(r, h, bs->wi, bs->IsSpecular());
 }
 

@@ -93,6 +93,10 @@ class CameraPaths : public RayProcessor {
     /// Samples where path ray `r`, starting now, scatters in the scene's medium (StartFlight);
     /// nothing without a medium.
     void StartPathFlight(RayRecord& r) const;
+    /// The density's integral at which path ray `r` scatters in the scene's medium (FlightDepth,
+    /// from its vertex's random numbers): what StartPathFlight aimed at, known again without
+    /// walking the medium when the ray gets there.
+    float PathFlightDepth(const RayRecord& r) const;
     /// Path `r` scatters in the medium at its t_max: next-event estimation of the lights and the
     /// sky through the phase function, then the path goes on in a direction sampled from it.
     void ScatterInMedium(RayRecord r, RayOutbox& out);

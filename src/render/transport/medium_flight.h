@@ -25,18 +25,24 @@
 
 namespace nave::render {
 
-/// Samples where path ray `r` (from its origin, up to its t_max) scatters in `medium`, with
-/// uniform numbers `u_choice` (the wavelength) and `u_distance`: if before t_max, sets t_max there
-/// and kMediumScatter; else leaves the ray as it is.
-inline void StartFlight(const Medium& medium, float u_choice, float u_distance, RayRecord* r) {
-    r->flags &= uint8_t(~kMediumScatter);
+/// The density's integral from a path ray's origin to where it scatters, sampled with uniform
+/// numbers `u_choice` (the wavelength of `lambda` whose σs draws it) and `u_distance`: the inverse
+/// of that wavelength's exponential. 0 when that σs is 0 (the ray does not scatter).
+inline float FlightDepth(const Medium& medium, const SampledWavelengths& lambda, float u_choice,
+                         float u_distance) {
     const int j = std::min(int(u_choice * kNumWavelengths), kNumWavelengths - 1);
-    const float sigma_s = medium.SigmaS(r->lambda)[j];
-    if (!(sigma_s > 0)) return;
-    // Inverse of the exponential's cumulative distribution, in the density's integral.
-    const float target = -std::log1p(-u_distance) / sigma_s;
-    if (!(target > 0)) return;
-    const float t = medium.density().Reach(r->origin, r->dir, r->t_max, target);
+    const float sigma_s = medium.SigmaS(lambda)[j];
+    if (!(sigma_s > 0)) return 0.f;
+    return -std::log1p(-u_distance) / sigma_s;
+}
+
+/// Samples where path ray `r` (from its origin, up to its t_max) scatters in `medium`: where the
+/// density's integral reaches `depth` (FlightDepth). If before t_max, sets t_max there and
+/// kMediumScatter; else leaves the ray as it is.
+inline void StartFlight(const Medium& medium, float depth, RayRecord* r) {
+    r->flags &= uint8_t(~kMediumScatter);
+    if (!(depth > 0)) return;
+    const float t = medium.density().Reach(r->origin, r->dir, r->t_max, depth);
     if (!(t < r->t_max)) return;
     r->t_max = t;
     r->flags |= kMediumScatter;
@@ -58,11 +64,11 @@ inline SampledSpectrum NoScatterWeight(const Medium& medium, const RayRecord& r,
     return probability > 0 ? transmittance / probability : SampledSpectrum(0.f);
 }
 
-/// The weight of path ray `r` that scatters in `medium` at its t_max (kMediumScatter): σs
-/// exp(-σt D) over the density with which the scattering was sampled there (the medium's density
-/// at the point cancels).
-inline SampledSpectrum ScatterWeight(const Medium& medium, const RayRecord& r) {
-    const float depth = medium.density().Integral(r.origin, r.dir, r.t_max);
+/// The weight of path ray `r` that scatters in `medium` at its t_max (kMediumScatter), `depth` of
+/// the density's integral from its origin (the FlightDepth that StartFlight reached): σs exp(-σt D)
+/// over the density with which the scattering was sampled there (the medium's density at the point
+/// cancels).
+inline SampledSpectrum ScatterWeight(const Medium& medium, const RayRecord& r, float depth) {
     const SampledSpectrum sigma_t = medium.SigmaT(r.lambda), sigma_s = medium.SigmaS(r.lambda);
     SampledSpectrum transmittance;
     float density = 0;

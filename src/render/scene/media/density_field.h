@@ -23,11 +23,6 @@ class DensityField {
     virtual float Reach(const Vec3f& o, const Vec3f& d, float t_max, float target) const = 0;
 };
 
-/// Where the ray o + t d (d unit), t in [0, t_max], crosses `box`: [*t0, *t1]; false when it does
-/// not (slabs, Kay & Kajiya 1986).
-bool ClipToBox(const Bounds3f& box, const Vec3f& o, const Vec3f& d, float t_max, float* t0,
-               float* t1);
-
 /// Density 1 inside a box, 0 outside: a homogeneous medium.
 class BoxDensity final : public DensityField {
   public:
@@ -35,11 +30,11 @@ class BoxDensity final : public DensityField {
     Bounds3f bounds() const override { return box_; }
     float Integral(const Vec3f& o, const Vec3f& d, float t_max) const override {
         float t0, t1;
-        return ClipToBox(box_, o, d, t_max, &t0, &t1) ? t1 - t0 : 0.f;
+        return ClipRayToBounds(box_, o, d, 0, t_max, &t0, &t1) ? t1 - t0 : 0.f;
     }
     float Reach(const Vec3f& o, const Vec3f& d, float t_max, float target) const override {
         float t0, t1;
-        if (!ClipToBox(box_, o, d, t_max, &t0, &t1) || !(t0 + target < t1))
+        if (!ClipRayToBounds(box_, o, d, 0, t_max, &t0, &t1) || !(t0 + target < t1))
             return std::numeric_limits<float>::infinity();
         return t0 + target;
     }

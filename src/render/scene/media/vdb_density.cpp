@@ -15,7 +15,7 @@ StatusOr<std::shared_ptr<const VdbDensity>> VdbDensity::Load(const std::filesyst
 
 float VdbDensity::Integral(const Vec3f& o, const Vec3f& d, float t_max) const {
     float t0, t1;
-    if (!ClipToBox(grid_->bounds(), o, d, t_max, &t0, &t1)) return 0.f;
+    if (!ClipRayToBounds(grid_->bounds(), o, d, 0, t_max, &t0, &t1)) return 0.f;
     double sum = 0;
     grid_->March(o, d, t0, t1, [&](float a, float b, float value) {
         sum += double(value) * double(b - a);
@@ -27,7 +27,7 @@ float VdbDensity::Integral(const Vec3f& o, const Vec3f& d, float t_max) const {
 float VdbDensity::Reach(const Vec3f& o, const Vec3f& d, float t_max, float target) const {
     float t0, t1;
     float reached = std::numeric_limits<float>::infinity();
-    if (!ClipToBox(grid_->bounds(), o, d, t_max, &t0, &t1)) return reached;
+    if (!ClipRayToBounds(grid_->bounds(), o, d, 0, t_max, &t0, &t1)) return reached;
     double sum = 0;
     const double goal = double(target) / double(scale_);
     grid_->March(o, d, t0, t1, [&](float a, float b, float value) {
