@@ -13,6 +13,7 @@
 
 #include "preprocess/abbey/abbey_source.h"
 #include "preprocess/import/importer.h"
+#include "preprocess/medium_cut.h"
 #include "preprocess/partition/bin_file.h"
 #include "preprocess/partition/brick_builder.h"
 #include "preprocess/partition/partitioner.h"
@@ -38,10 +39,11 @@ std::string OptionsText(const PreprocessOptions& o, const PreprocessPlan& plan, 
     const std::vector<double>& ratios = o.encode.levels.relative_errors;
     return fmt::format(
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} "
-        "derived-normal-error={} verify-every={} level-errors={} units={}",
+        "derived-normal-error={} verify-every={} level-errors={} units={}{}",
         plan.brick_triangles, plan.memory_budget, step, plan.threads, o.encode.draco_speed,
         o.encode.derived_normal_error_deg, o.verify_every,
-        ratios.empty() ? std::string("none") : fmt::format("{}", fmt::join(ratios, ",")), units);
+        ratios.empty() ? std::string("none") : fmt::format("{}", fmt::join(ratios, ",")), units,
+        plan.medium.empty() ? std::string() : " medium-grid=" + o.medium_grid);
 }
 
 /// Removes the texture folder of a run that fails, unless it existed before the run (it may hold
@@ -67,7 +69,7 @@ class TextureFolderGuard {
 StatusOr<std::unique_ptr<TriangleSource>> OpenSource(const PreprocessOptions& options,
                                                      const PreprocessPlan& plan) {
     if (!options.generate.empty()) return OpenGenerator(options.generate, plan.generator_producers);
-    return OpenModels(options.inputs);
+    return OpenModels(plan.models);
 }
 
 /// Phase 1: streams the source into the partitioner's root bin, then takes its materials (and a
@@ -117,7 +119,7 @@ StatusOr<uint64_t> ConvertMaterialTextures(const PreprocessOptions& options,
     }
     NAVE_ASSIGN_OR_RETURN(const uint64_t reserve, PlanTextureReserve(plan));
     std::vector<std::filesystem::path> source_dirs;
-    for (const auto& input : options.inputs)
+    for (const auto& input : plan.models)
         source_dirs.push_back(input.has_parent_path() ? input.parent_path()
                                                       : std::filesystem::path("."));
     source_dirs.push_back(temp.path());  // a generator's textures (WriteGeneratedTextures)
@@ -305,6 +307,9 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     PreprocessStats stats;
     stats.threads = plan.threads;
     stats.memory_budget = plan.memory_budget;
+    // A bad medium fails the run before any model is read.
+    if (!plan.medium.empty())
+        NAVE_RETURN_IF_ERROR(CheckMediumGrid(plan.medium, options.medium_grid));
 
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<TriangleSource> source, OpenSource(options, plan));
     RemoveStaleOutputTemporaries(options.output);
@@ -338,6 +343,12 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     std::vector<store::BrickTreeNode>& nodes = partitioner.nodes();
     NAVE_RETURN_IF_ERROR(
         EncodeBricks(leaves, encode, plan.threads, grid.grid, options, nodes, *writer, &stats));
+    if (!plan.medium.empty()) {
+        NAVE_RETURN_IF_ERROR(CheckCancelled(options.interrupt));
+        NAVE_RETURN_IF_ERROR(
+            StoreMedium(plan.medium, options.medium_grid, grid.root, nodes, *writer, &stats));
+        stats.bricks += stats.medium_only_bricks;
+    }
     for (const auto& n : nodes) {
         if (n.IsLeaf() && n.brick == store::kNoBrick) ++stats.empty_cells;
     }
@@ -411,6 +422,16 @@ std::string FormatSummary(const PreprocessStats& s) {
             "\nnote:        {} bricks exceed the target (triangles too large or overlapping to "
             "split)",
             s.oversized_bricks);
+    }
+    if (!s.medium_grid.empty()) {
+        out += fmt::format(
+            "\nmedium:      grid '{}' of {}: {} voxels stored in {} bricks ({} without triangles), "
+            "{}, largest density {:.6g}; {} of the grid's {} voxels dropped outside the model's "
+            "box",
+            s.medium_grid, s.medium_file, FormatCount(double(s.medium_stored_voxels)),
+            s.medium_bricks, s.medium_only_bricks, FormatBytes(s.medium_bytes),
+            s.medium_max_density, FormatCount(double(s.medium_dropped_voxels)),
+            FormatCount(double(s.medium_voxels)));
     }
     if (s.textures_converted > 0) {
         out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}",

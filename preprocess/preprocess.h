@@ -26,10 +26,15 @@ inline constexpr uint64_t kDefaultBrickTriangles = 700'000;
 inline constexpr uint64_t kMinBrickTriangles = 1000;
 
 struct PreprocessOptions {
-    std::vector<std::filesystem::path> inputs;  ///< model files (merged)
-    std::string generate;                       ///< or a generator spec: "abbey:detail=D"
-    std::filesystem::path output;               ///< the .nave store
-    uint64_t memory_bytes = 0;                  ///< budget; 0: a quarter of physical memory
+    /// Model files (merged), and at most one OpenVDB file (.vdb) whose grid `medium_grid` is the
+    /// density of a participating medium, cut along the bricks (docs/preprocess.md, "Media").
+    std::vector<std::filesystem::path> inputs;
+    /// The medium's grid in the .vdb among `inputs` (`--medium-grid`); its world units are the
+    /// model's.
+    std::string medium_grid = "density";
+    std::string generate;          ///< or a generator spec: "abbey:detail=D"
+    std::filesystem::path output;  ///< the .nave store
+    uint64_t memory_bytes = 0;     ///< budget; 0: a quarter of physical memory
     /// Target triangles per brick; 0: kDefaultBrickTriangles, or the largest size whose encoding
     /// work fits memory_bytes when that is less.
     uint64_t brick_triangles = 0;
@@ -70,6 +75,14 @@ struct PreprocessStats {
     double seconds = 0, read_seconds = 0, split_seconds = 0, encode_seconds = 0;
     uint64_t textures_converted = 0, texture_bytes = 0;  ///< texture files written beside the store
     double texture_seconds = 0;
+    /// The medium (a .vdb among the inputs; empty names: none): the grid's active voxels, those
+    /// stored (a voxel whose cell crosses cells is stored in each), those dropped outside the
+    /// model's box, the pieces' bytes, the bricks holding a piece and how many of them hold no
+    /// triangles, and the largest density.
+    std::string medium_file, medium_grid;
+    uint64_t medium_voxels = 0, medium_stored_voxels = 0, medium_dropped_voxels = 0;
+    uint64_t medium_bytes = 0, medium_bricks = 0, medium_only_bricks = 0;
+    float medium_max_density = 0;
     std::vector<std::string> warnings;
 };
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <thread>
 
+#include "preprocess/medium_cut.h"
 #include "preprocess/partition/brick_builder.h"
 #include "src/core/memory.h"
 
@@ -27,11 +28,26 @@ MachineResources QueryMachineResources() {
 
 StatusOr<PreprocessPlan> PlanPreprocess(const PreprocessOptions& options,
                                         const MachineResources& machine) {
-    if (options.inputs.empty() == options.generate.empty()) {
-        return InvalidArgumentError(
-            "give either input files or --generate abbey[:detail=D], not {}",
-            options.inputs.empty() ? "neither" : "both");
+    PreprocessPlan plan;
+    for (const std::filesystem::path& input : options.inputs) {
+        if (!IsMediumFile(input)) {
+            plan.models.push_back(input);
+        } else if (plan.medium.empty()) {
+            plan.medium = input;
+        } else {
+            return InvalidArgumentError(
+                "two media given, {} and {}: a store holds one medium grid; give one .vdb file",
+                plan.medium.string(), input.string());
+        }
     }
+    if (plan.models.empty() == options.generate.empty()) {
+        return InvalidArgumentError(
+            "give either model files or --generate abbey[:detail=D], not {}{}",
+            plan.models.empty() ? "neither" : "both",
+            plan.medium.empty() ? "" : " (a .vdb file is a medium, not a model)");
+    }
+    if (!plan.medium.empty() && options.medium_grid.empty())
+        return InvalidArgumentError("--medium-grid: the grid's name is empty");
     if (options.output.empty()) return InvalidArgumentError("no output file given (-o MODEL.nave)");
     if (options.brick_triangles != 0 && options.brick_triangles < kMinBrickTriangles) {
         return InvalidArgumentError("--brick-triangles {}: expected at least {}",
@@ -40,7 +56,6 @@ StatusOr<PreprocessPlan> PlanPreprocess(const PreprocessOptions& options,
     if (options.precision < 0)
         return InvalidArgumentError("--precision {}: must be positive", options.precision);
 
-    PreprocessPlan plan;
     plan.threads = options.threads > 0 ? options.threads : std::max(1, machine.hardware_threads);
     plan.memory_budget =
         options.memory_bytes > 0 ? options.memory_bytes : machine.physical_memory_bytes / 4;

@@ -50,13 +50,16 @@ struct PreprocessPlan {
     /// The split's configuration (threads, buffers, fan-out); its `interrupt` is left to the run.
     PartitionConfig partition;
     std::filesystem::path temp_parent;  ///< where the run's temporary directory goes
+    /// The inputs split: model files, and the medium's .vdb (empty: none).
+    std::vector<std::filesystem::path> models;
+    std::filesystem::path medium;
 };
 
 /// The plan for `options` on `machine`, or InvalidArgument naming the option and what was expected
-/// (no input or both inputs and a generator, no output, --brick-triangles under
-/// kMinBrickTriangles, a negative --precision), or ResourceExhausted when --memory cannot hold the
-/// work of one brick (with the numbers, the --memory that would, and the largest --brick-triangles
-/// that fits).
+/// (no model or both models and a generator, two .vdb files (naming both), no output,
+/// --brick-triangles under kMinBrickTriangles, a negative --precision), or ResourceExhausted when
+/// --memory cannot hold the work of one brick (with the numbers, the --memory that would, and the
+/// largest --brick-triangles that fits).
 StatusOr<PreprocessPlan> PlanPreprocess(const PreprocessOptions& options,
                                         const MachineResources& machine);
 

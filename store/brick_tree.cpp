@@ -90,14 +90,23 @@ uint32_t BrickTree::Locate(const Vec3f& p) const {
 
 std::vector<Bounds3f> BrickTree::BrickCells(uint32_t brick_count) const {
     std::vector<Bounds3f> cells(brick_count);
-    if (nodes_.empty()) return cells;
+    for (const auto& [node, box] : LeafCells()) {
+        const uint32_t brick = nodes_[node].brick;
+        if (brick != kNoBrick && brick < brick_count) cells[brick] = box;
+    }
+    return cells;
+}
+
+std::vector<std::pair<uint32_t, Bounds3f>> BrickTree::LeafCells() const {
+    std::vector<std::pair<uint32_t, Bounds3f>> leaves;
+    if (nodes_.empty()) return leaves;
     std::vector<std::pair<uint32_t, Bounds3f>> stack{{0, bounds_}};
     while (!stack.empty()) {
         auto [n, box] = stack.back();
         stack.pop_back();
         const BrickTreeNode& node = nodes_[n];
         if (node.IsLeaf()) {
-            if (node.brick != kNoBrick && node.brick < brick_count) cells[node.brick] = box;
+            leaves.emplace_back(n, box);
             continue;
         }
         Bounds3f below = box, above = box;
@@ -106,7 +115,9 @@ std::vector<Bounds3f> BrickTree::BrickCells(uint32_t brick_count) const {
         stack.push_back({node.child[0], below});
         stack.push_back({node.child[1], above});
     }
-    return cells;
+    std::sort(leaves.begin(), leaves.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    return leaves;
 }
 
 void BrickTree::Traverse(const Vec3f& origin, const Vec3f& dir, float t_min, float t_max,

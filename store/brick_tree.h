@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "src/core/status.h"
@@ -49,6 +50,9 @@ class BrickTree {
     /// The cell (box) of every leaf, indexed by brick id (size brick_count; empty leaves are not
     /// listed).
     std::vector<Bounds3f> BrickCells(uint32_t brick_count) const;
+    /// Every leaf, with a brick or empty, as (node index, cell), in node order (of a tree that
+    /// Validate accepts).
+    std::vector<std::pair<uint32_t, Bounds3f>> LeafCells() const;
     /// The non-empty bricks whose cells overlap `box` (closed: a box touching a split plane is on
     /// both sides), into `out` (cleared first).
     void BricksOverlapping(const Bounds3f& box, std::vector<uint32_t>* out) const;

@@ -84,7 +84,7 @@ std::string EncodeHeader(const RawHeader& h) {
     w.bytes().append(kMagic, sizeof(kMagic));
     w.Put(h.major);
     w.Put(h.minor);
-    w.Put(kHeaderBytes);
+    w.Put(h.header_bytes);
     w.Put(h.file_bytes);
     w.Put(h.grid.origin.x), w.Put(h.grid.origin.y), w.Put(h.grid.origin.z);
     w.Put(h.grid.step);
@@ -102,10 +102,12 @@ std::string EncodeHeader(const RawHeader& h) {
     PutSection(w, h.tree);
     PutSection(w, h.materials);
     PutSection(w, h.levels);  // 3.1
-    NAVE_CHECK_LE(w.size(), size_t(kHeaderBytes - 8));
-    w.PutZeros(kHeaderBytes - 8 - w.size());
+    // 3.3; a header too small for it (one relabelled older, in tests) ends before it.
+    if (h.header_bytes >= kMediumHeaderBytes) PutSection(w, h.medium);
+    NAVE_CHECK_LE(w.size(), size_t(h.header_bytes - 8));
+    w.PutZeros(h.header_bytes - 8 - w.size());
     w.Put(Checksum64(w.bytes().data(), w.size()));
-    NAVE_CHECK_EQ(w.size(), size_t(kHeaderBytes));
+    NAVE_CHECK_EQ(w.size(), size_t(h.header_bytes));
     return std::move(w.bytes());
 }
 
@@ -192,6 +194,16 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
     // Before 3.1 these bytes are the zero padding: no levels table.
     if (h.major > 3 || (h.major == 3 && h.minor >= 1))
         NAVE_RETURN_IF_ERROR(GetSection(r, &h.levels));
+    // Before 3.3 the header may end here: no medium table.
+    if (h.major > 3 || (h.major == 3 && h.minor >= 3)) {
+        if (h.header_bytes < kMediumHeaderBytes) {
+            return DataLossError(
+                "{} @0x{:x}: header size {}, too small for version {}.{} (at "
+                "least {})",
+                name, 12, h.header_bytes, h.major, h.minor, kMediumHeaderBytes);
+        }
+        NAVE_RETURN_IF_ERROR(GetSection(r, &h.medium));
+    }
 
     // The checksum matched, so what follows catches writer bugs and files cut or extended after
     // writing.
@@ -218,10 +230,11 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
         const char* what;
         const SectionInfo* ref;
     };
-    for (const Named& t :
-         {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
-          Named{"tree", &h.tree}, Named{"materials", &h.materials}, Named{"levels", &h.levels}}) {
-        if (t.ref == &h.levels && t.ref->length == 0) continue;  // no levels
+    for (const Named& t : {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
+                           Named{"tree", &h.tree}, Named{"materials", &h.materials},
+                           Named{"levels", &h.levels}, Named{"medium", &h.medium}}) {
+        // No levels, or no medium.
+        if ((t.ref == &h.levels || t.ref == &h.medium) && t.ref->length == 0) continue;
         if (t.ref->offset < h.header_bytes || t.ref->offset > file_bytes ||
             t.ref->length > file_bytes - t.ref->offset) {
             return DataLossError(
@@ -484,6 +497,86 @@ Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::strin
     if (r.remaining() != 0) {
         return DataLossError("{} levels @0x{:x}: {} bytes left after {} bricks", name, r.file_pos(),
                              r.remaining(), brick_count);
+    }
+    return Status::Ok();
+}
+
+// ---- medium
+
+std::string EncodeMedium(const std::string& grid_name, const std::vector<RawBrickEntry>& entries) {
+    ByteWriter w;
+    w.Put(kMediumEntryBytes);
+    w.Put(uint32_t(entries.size()));
+    w.PutString(grid_name);
+    for (const RawBrickEntry& e : entries) {
+        const BrickMediumInfo& m = e.info.medium;
+        const size_t start = w.size();
+        PutSection(w, m.grid);
+        w.Put(m.active_voxels);
+        w.Put(m.max_density);
+        w.Put(uint32_t(0));  // reserved
+        w.Put(m.decoded_bytes);
+        NAVE_CHECK_EQ(w.size() - start, size_t(kMediumEntryBytes));
+    }
+    return std::move(w.bytes());
+}
+
+Status DecodeMedium(std::string_view bytes, const RawHeader& h, const std::string& name,
+                    std::vector<RawBrickEntry>* entries, std::string* grid_name) {
+    ByteReader r(bytes, name + " medium", h.medium.offset);
+    uint32_t entry_bytes = 0, brick_count = 0;
+    NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
+    NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
+    if (entry_bytes < kMediumEntryBytes || entry_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} medium @0x{:x}: entry size {} out of range [{}, {}]", name,
+                             h.medium.offset, entry_bytes, kMediumEntryBytes, kMaxHeaderBytes);
+    }
+    if (brick_count != h.brick_count || brick_count != entries->size()) {
+        return DataLossError("{} medium @0x{:x}: the table has {} bricks, the header says {}", name,
+                             h.medium.offset, brick_count, h.brick_count);
+    }
+    NAVE_RETURN_IF_ERROR(r.GetString(grid_name));
+    if (grid_name->empty())
+        return DataLossError("{} medium @0x{:x}: the table names no grid", name, h.medium.offset);
+    if (r.remaining() != uint64_t(brick_count) * entry_bytes) {
+        return DataLossError("{} medium @0x{:x}: {} bytes of entries, expected {} bricks x {} = {}",
+                             name, r.file_pos(), r.remaining(), brick_count, entry_bytes,
+                             uint64_t(brick_count) * entry_bytes);
+    }
+    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    for (uint32_t i = 0; i < brick_count; ++i) {
+        BrickMediumInfo& m = (*entries)[i].info.medium;
+        const uint64_t at = r.file_pos();
+        const size_t start = r.pos();
+        uint32_t reserved = 0;
+        NAVE_RETURN_IF_ERROR(GetSection(r, &m.grid));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.active_voxels));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.max_density));
+        NAVE_RETURN_IF_ERROR(r.Get(&reserved));
+        NAVE_RETURN_IF_ERROR(r.Get(&m.decoded_bytes));
+        NAVE_RETURN_IF_ERROR(r.Skip(entry_bytes - (r.pos() - start)));
+        if (m.grid.length == 0) {
+            if (m.active_voxels != 0 || m.max_density != 0 || m.decoded_bytes != 0) {
+                return DataLossError(
+                    "{} brick {} medium @0x{:x}: no section, yet {} voxels, majorant {} and {} "
+                    "decoded bytes (expected 0 for each)",
+                    name, i, at, m.active_voxels, m.max_density, m.decoded_bytes);
+            }
+            continue;
+        }
+        if (m.grid.offset < h.header_bytes || m.grid.offset > payload_end ||
+            m.grid.length > payload_end - m.grid.offset) {
+            return DataLossError(
+                "{} brick {} medium @0x{:x}: section [0x{:x}, +{}) lies outside the payload area "
+                "[0x{:x}, 0x{:x})",
+                name, i, at, m.grid.offset, m.grid.length, h.header_bytes, payload_end);
+        }
+        if (m.active_voxels == 0 || !std::isfinite(m.max_density) || m.max_density < 0) {
+            return DataLossError(
+                "{} brick {} medium @0x{:x}: {} voxels, majorant {} (expected at least 1 voxel "
+                "and a finite majorant >= 0)",
+                name, i, at, m.active_voxels, m.max_density);
+        }
     }
     return Status::Ok();
 }

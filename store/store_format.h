@@ -3,8 +3,8 @@
 // reference). Everything is little-endian. This file owns the byte layout of the header and of the
 // tables; the brick payloads (Draco + LZ4) are brick_codec's business.
 //
-//   [header, kHeaderBytes]  [brick payloads ...]  [provenance] [directory] [tree] [materials]
-//   [levels (3.1)]
+//   [header, header_bytes]  [brick payloads ...]  [provenance] [directory] [tree] [materials]
+//   [levels (3.1)] [medium (3.3)]
 //
 // The tables are written after the payloads and the header last, so a file cut anywhere fails to
 // open.
@@ -29,8 +29,14 @@ static_assert(std::endian::native == std::endian::little,
 
 /// The first 8 bytes of every store.
 inline constexpr char kMagic[8] = {'N', 'A', 'V', 'E', 'S', 'T', 'O', 'R'};
-/// Size of the version 1.0 header; the header itself records its size so a newer minor may grow it.
+/// Size of the version 1.0 header, the smallest; the header itself records its size so a newer
+/// minor may grow it.
 inline constexpr uint32_t kHeaderBytes = 256;
+/// Size of the header this nave writes: 3.3 grew it by the medium table's section (older readers
+/// take the size from the header and skip what they do not know).
+inline constexpr uint32_t kCurrentHeaderBytes = 280;
+/// The smallest header of a 3.3 store: the one that holds the medium table's section.
+inline constexpr uint32_t kMediumHeaderBytes = 280;
 /// Bytes every version has at the start of the header: magic, major, minor, header size.
 inline constexpr uint32_t kHeaderPrefixBytes = 16;
 /// Size of one directory entry and one tree node in version 1.0 (recorded in the header).
@@ -44,6 +50,12 @@ inline constexpr uint32_t kLevelEntryBytes = 56;
 /// Most levels a brick may have (more is a corrupt count).
 inline constexpr uint32_t kMaxLevels = 16;
 
+/// Bytes of the medium table's prefix (uint32 entry size, uint32 brick count; the grid's name
+/// follows) and of one brick's entry in version 3.3 (the prefix records it, so a newer minor may
+/// grow it).
+inline constexpr uint32_t kMediumPrefixBytes = 8;
+inline constexpr uint32_t kMediumEntryBytes = 48;
+
 /// Directory entry flags (also those of a level entry).
 inline constexpr uint32_t kBrickHasNormals = 1u << 0;
 inline constexpr uint32_t kBrickHasUvs = 1u << 1;
@@ -52,7 +64,7 @@ inline constexpr uint32_t kBrickHasUvs = 1u << 1;
 struct RawHeader {
     uint16_t major = kFormatMajor;
     uint16_t minor = kFormatMinor;
-    uint32_t header_bytes = kHeaderBytes;
+    uint32_t header_bytes = kCurrentHeaderBytes;
     uint64_t file_bytes = 0;
     GlobalGrid grid;
     Bounds3f bounds;
@@ -68,6 +80,7 @@ struct RawHeader {
     SectionInfo tree;
     SectionInfo materials;
     SectionInfo levels;  ///< 3.1; length 0 in stores without levels (and zero in older headers)
+    SectionInfo medium;  ///< 3.3; length 0 in stores without a medium (and zero in older headers)
 };
 
 /// A directory entry as stored: BrickInfo plus flags.
@@ -131,7 +144,8 @@ class ByteReader {
     size_t pos_ = 0;
 };
 
-/// Serializes the header into exactly `kHeaderBytes` bytes, its checksum in the last 8.
+/// Serializes the header into exactly `h.header_bytes` bytes (at least what its version's fields
+/// take), its checksum in the last 8.
 std::string EncodeHeader(const RawHeader& h);
 /// Parses and checks a header read from the start of the file: magic, version (refusing another
 /// major, naming both), size, checksum. `name` is the file name for messages; `file_bytes` its
@@ -156,6 +170,15 @@ std::string EncodeLevels(const std::vector<RawBrickEntry>& entries);
 /// increasing), decoded sizes and that each level's mesh section lies in the payload area.
 Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
                     std::vector<RawBrickEntry>* entries);
+
+/// The medium table: the grid's name and every brick's piece of it (BrickInfo::medium), in brick
+/// order.
+std::string EncodeMedium(const std::string& grid_name, const std::vector<RawBrickEntry>& entries);
+/// Fills `entries[i].info.medium` and `grid_name` from the table, checking the brick count, the
+/// name, that a piece has voxels and a finite majorant >= 0, that a brick without a piece has no
+/// counts, and that each piece's section lies in the payload area.
+Status DecodeMedium(std::string_view bytes, const RawHeader& h, const std::string& name,
+                    std::vector<RawBrickEntry>* entries, std::string* grid_name);
 
 std::string EncodeMaterials(const std::vector<MaterialRecord>& materials);
 StatusOr<std::vector<MaterialRecord>> DecodeMaterials(std::string_view bytes, const RawHeader& h,

@@ -11,13 +11,16 @@
 namespace nave::store {
 
 /// Current format version. Readers refuse another major version; a newer minor version only adds
-/// fields. The version this nave writes. 3.1: levels of detail, coarser meshes of each brick (the
+/// fields. The version this nave writes. 3.3: a medium's density grid cut along the bricks (the
+/// medium table; older readers ignore it and stores without it have no medium), and bricks without
+/// triangles that hold only a piece of it. 3.2: a level's mesh section may snap to a coarser grid.
+/// 3.1: levels of detail, coarser meshes of each brick (the
 /// levels table; older readers ignore it and stores without it have no levels). 3.0: each face's
 /// shading (stored, flat or derived normals) in the mesh section, so that smooth surfaces too may
 /// store no normals. 2.0: flat faces marked in the mesh section (no normals, shared corners). 1.1:
 /// material alpha_cutoff.
 inline constexpr uint16_t kFormatMajor = 3;
-inline constexpr uint16_t kFormatMinor = 2;
+inline constexpr uint16_t kFormatMinor = 3;
 /// The oldest major version this nave still reads (1.x stores decode as before).
 inline constexpr uint16_t kOldestReadableMajor = 1;
 
@@ -48,6 +51,16 @@ struct LevelInfo {
     SectionInfo mesh;  ///< position base + Draco mesh, as the brick's own mesh section
 };
 
+/// The brick's piece of the store's medium density grid (format 3.3): the grid's active voxels
+/// whose cells overlap the brick's cell, in OpenVDB's serialization (volumes::GridPiece::bytes).
+/// grid.length 0: none.
+struct BrickMediumInfo {
+    SectionInfo grid;
+    uint64_t active_voxels = 0;
+    float max_density = 0;       ///< the largest density in the piece: its majorant
+    uint64_t decoded_bytes = 0;  ///< memory once read (GridPiece::memory_bytes), for budgets
+};
+
 /// A brick as the directory describes it. Reading the directory never touches brick payloads.
 struct BrickInfo {
     uint32_t id = 0;
@@ -64,7 +77,12 @@ struct BrickInfo {
     /// Coarser versions of the brick, coarsest last, each with a larger error (the store's levels
     /// table, format 3.1); empty for stores without levels.
     std::vector<LevelInfo> levels;
-    uint64_t BytesOnDisk() const { return mesh.length + side.length; }
+    /// The brick's piece of the medium (the store's medium table, format 3.3). A brick may hold
+    /// a piece and no triangles: it stands for a cell of the tree where the medium is and no
+    /// surface is.
+    BrickMediumInfo medium;
+    /// The brick's own sections: its mesh, side and medium sections (not its levels').
+    uint64_t BytesOnDisk() const { return mesh.length + side.length + medium.grid.length; }
 };
 
 struct StoreHeader {
@@ -77,6 +95,9 @@ struct StoreHeader {
     uint64_t source_triangle_count =
         0;  ///< triangles in the input before duplication across bricks
     StoreProvenance provenance;
+    /// The name of the medium's density grid the bricks hold pieces of (format 3.3: the medium
+    /// table); "" when the store has no medium.
+    std::string medium_grid;
     /// XXH64 of the header's bytes as stored (which hold the checksums of every table): the
     /// store's identity, for render checkpoints.
     uint64_t header_checksum = 0;

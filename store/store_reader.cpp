@@ -35,20 +35,26 @@ struct Store::Impl {
         return bytes;
     }
 
-    // Reads one section of brick `id` and checks its checksum.
-    StatusOr<std::string> ReadSection(uint32_t id, const std::string& what,
-                                      const SectionInfo& s) const {
-        std::string bytes(s.length, '\0');
-        Status read = file.ReadAt(s.offset, bytes.data(), bytes.size());
+    // Reads one section of brick `id` into `bytes` (of its length) and checks its checksum.
+    Status ReadSectionInto(uint32_t id, const std::string& what, const SectionInfo& s,
+                           void* bytes) const {
+        Status read = file.ReadAt(s.offset, bytes, s.length);
         if (!read.ok())
             return read.WithContext(
                 fmt::format("{} brick {} @0x{:x} {} section", name, id, s.offset, what));
         bytes_read.fetch_add(s.length, std::memory_order_relaxed);
-        const uint64_t checksum = Checksum64(bytes.data(), bytes.size());
+        const uint64_t checksum = Checksum64(bytes, s.length);
         if (checksum != s.checksum) {
             return DataLossError("{} brick {} @0x{:x}: {} checksum {} != stored {}", name, id,
                                  s.offset, what, ChecksumHex(checksum), ChecksumHex(s.checksum));
         }
+        return Status::Ok();
+    }
+
+    StatusOr<std::string> ReadSection(uint32_t id, const std::string& what,
+                                      const SectionInfo& s) const {
+        std::string bytes(s.length, '\0');
+        NAVE_RETURN_IF_ERROR(ReadSectionInto(id, what, s, bytes.data()));
         return bytes;
     }
 };
@@ -108,6 +114,11 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
     if (h.levels.length > 0) {
         NAVE_ASSIGN_OR_RETURN(std::string level_bytes, impl->ReadTable("levels", h.levels));
         NAVE_RETURN_IF_ERROR(format::DecodeLevels(level_bytes, h, name, &entries));
+    }
+    if (h.medium.length > 0) {
+        NAVE_ASSIGN_OR_RETURN(std::string medium_bytes, impl->ReadTable("medium", h.medium));
+        NAVE_RETURN_IF_ERROR(
+            format::DecodeMedium(medium_bytes, h, name, &entries, &impl->header.medium_grid));
     }
 
     impl->header.major = h.major;
@@ -199,9 +210,26 @@ StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
     return mesh;
 }
 
+StatusOr<std::vector<std::byte>> Store::ReadBrickMedium(uint32_t id) const {
+    const Impl& s = *impl_;
+    if (id >= s.bricks.size()) {
+        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
+                             s.bricks.size());
+    }
+    const SectionInfo& section = s.bricks[id].medium.grid;
+    if (section.length == 0) {
+        return NotFoundError("{}: brick {} holds no piece of a medium{}", s.name, id,
+                             s.header.medium_grid.empty() ? " (the store has none)" : "");
+    }
+    std::vector<std::byte> bytes(section.length);
+    NAVE_RETURN_IF_ERROR(s.ReadSectionInto(id, "medium", section, bytes.data()));
+    return bytes;
+}
+
 Status Store::VerifyBrick(uint32_t id) const {
     NAVE_ASSIGN_OR_RETURN(BrickMesh mesh, ReadBrick(id));
     const BrickInfo& info = impl_->bricks[id];
+    if (info.medium.grid.length > 0) NAVE_RETURN_IF_ERROR(ReadBrickMedium(id).status());
     Bounds3f box;
     for (const Vec3f& p : mesh.positions) box.Extend(p);
     if (mesh.TriangleCount() > 0 && !(box == info.geometry_bounds)) {

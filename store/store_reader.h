@@ -5,6 +5,7 @@
 // Open and thread-safe: many threads may read bricks at once (positional reads, no shared file
 // offset).
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -36,8 +37,15 @@ class Store {
     /// brick or level that does not exist; DataLoss for a checksum or a decoded count that
     /// disagrees with the tables.
     StatusOr<BrickMesh> ReadBrick(uint32_t id, uint32_t level = 0) const;
-    /// Reads brick `id` and each of its levels, and checks their checksums and that they decode to
-    /// the tables' counts.
+    /// The bytes of brick `id`'s piece of the medium (BrickInfo::medium: OpenVDB's serialization of
+    /// a float grid, which volumes::VdbPlugin::ReadScalarGridBytes reads), its checksum verified.
+    /// Thread-safe. Adds the bytes read to bytes_read(). NotFound for a brick that does not exist
+    /// or holds no piece; DataLoss for a checksum that disagrees (naming the brick, the offset and
+    /// both checksums).
+    StatusOr<std::vector<std::byte>> ReadBrickMedium(uint32_t id) const;
+    /// Reads brick `id`, each of its levels and its piece of the medium, and checks their
+    /// checksums and that the meshes decode to the tables' counts (the medium's decoding is the
+    /// OpenVDB plugin's: `nave verify` does it).
     Status VerifyBrick(uint32_t id) const;
     /// Total payload bytes read from disk since Open (for statistics).
     uint64_t bytes_read() const;

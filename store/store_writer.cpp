@@ -148,12 +148,20 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     return brick;
 }
 
+EncodedBrick EmptyBrick(const Bounds3f& cell) {
+    EncodedBrick brick;
+    brick.mesh_bytes.assign(codec::kMeshPrefixBytes, '\0');
+    brick.cell = cell;
+    return brick;
+}
+
 namespace {
 
 Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
                             const StoreProvenance& provenance,
                             const std::vector<format::RawBrickEntry>& entries,
-                            const BrickTree& tree, const std::vector<MaterialRecord>& materials) {
+                            const BrickTree& tree, const std::vector<MaterialRecord>& materials,
+                            const std::string& medium_grid) {
     auto write_table = [&](const std::string& bytes, SectionInfo* ref) -> Status {
         *ref = {file.size(), bytes.size(), Checksum64(bytes.data(), bytes.size())};
         return file.Write(bytes);
@@ -166,6 +174,9 @@ Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
     const bool any_levels = std::any_of(entries.begin(), entries.end(),
                                         [](const auto& e) { return !e.info.levels.empty(); });
     if (any_levels) NAVE_RETURN_IF_ERROR(write_table(format::EncodeLevels(entries), &h.levels));
+    // Likewise a store without a medium has no medium table (as in 3.2).
+    if (!medium_grid.empty())
+        NAVE_RETURN_IF_ERROR(write_table(format::EncodeMedium(medium_grid, entries), &h.medium));
     h.file_bytes = file.size();
     const std::string header = format::EncodeHeader(h);
     NAVE_RETURN_IF_ERROR(file.WriteAt(0, header.data(), header.size()));
@@ -181,6 +192,7 @@ struct StoreWriter::Impl {
     std::vector<format::RawBrickEntry> entries;
     std::vector<uint32_t> max_material_ids;  // per brick, 0 for bricks without triangles
     bool finished = false;
+    std::string medium_grid;  // SetMediumGrid's name; empty: no medium table
 };
 
 StoreWriter::StoreWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -197,10 +209,10 @@ StatusOr<std::unique_ptr<StoreWriter>> StoreWriter::Create(const std::filesystem
     NAVE_ASSIGN_OR_RETURN(AtomicFile file, AtomicFile::Create(path));
     // A zero header: until Finish() patches it, the file has no magic and can never open as a
     // store.
-    const std::string zeros(format::kHeaderBytes, '\0');
+    const std::string zeros(format::kCurrentHeaderBytes, '\0');
     NAVE_RETURN_IF_ERROR(file.Write(zeros));
-    auto impl =
-        std::make_unique<Impl>(Impl{std::move(file), grid, std::move(provenance), {}, {}, false});
+    auto impl = std::make_unique<Impl>(
+        Impl{std::move(file), grid, std::move(provenance), {}, {}, false, {}});
     return std::unique_ptr<StoreWriter>(new StoreWriter(std::move(impl)));
 }
 
@@ -290,6 +302,49 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
     return id;
 }
 
+Status StoreWriter::SetMediumGrid(const std::string& grid) {
+    NAVE_CHECK(!impl_->finished) << "StoreWriter::SetMediumGrid after Finish";
+    const std::string& name = impl_->file.path().string();
+    if (grid.empty()) return InvalidArgumentError("{}: the medium's grid needs a name", name);
+    if (!impl_->medium_grid.empty()) {
+        return InvalidArgumentError("{}: the medium's grid is '{}' already, not '{}'", name,
+                                    impl_->medium_grid, grid);
+    }
+    impl_->medium_grid = grid;
+    return Status::Ok();
+}
+
+Status StoreWriter::AppendMedium(uint32_t id, const EncodedMedium& medium) {
+    NAVE_CHECK(!impl_->finished) << "StoreWriter::AppendMedium after Finish";
+    Impl& w = *impl_;
+    const std::string& name = w.file.path().string();
+    if (w.medium_grid.empty())
+        return InvalidArgumentError("{}: brick {}: a piece of a medium before SetMediumGrid", name,
+                                    id);
+    if (id >= w.entries.size()) {
+        return InvalidArgumentError("{}: brick {} was not appended (there are {} bricks)", name, id,
+                                    w.entries.size());
+    }
+    BrickMediumInfo& info = w.entries[id].info.medium;
+    if (info.grid.length > 0)
+        return InvalidArgumentError("{}: brick {} has a piece of the medium already", name, id);
+    if (medium.grid_bytes.empty() || medium.active_voxels == 0 ||
+        !std::isfinite(medium.max_density) || medium.max_density < 0) {
+        return InvalidArgumentError(
+            "{}: brick {}: a piece of the medium of {} bytes, {} voxels and majorant {} (expected "
+            "bytes, voxels and a finite majorant >= 0)",
+            name, id, medium.grid_bytes.size(), medium.active_voxels, medium.max_density);
+    }
+    const SectionInfo section = {w.file.size(), medium.grid_bytes.size(),
+                                 Checksum64(medium.grid_bytes.data(), medium.grid_bytes.size())};
+    NAVE_RETURN_IF_ERROR(w.file.Write(medium.grid_bytes.data(), medium.grid_bytes.size()));
+    info.grid = section;
+    info.active_voxels = medium.active_voxels;
+    info.max_density = medium.max_density;
+    info.decoded_bytes = medium.decoded_bytes;
+    return Status::Ok();
+}
+
 Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const BrickTree& tree,
                            uint64_t source_triangle_count) {
     NAVE_CHECK(!impl_->finished) << "StoreWriter::Finish called twice";
@@ -353,7 +408,8 @@ Status StoreWriter::Finish(const std::vector<MaterialRecord>& materials, const B
     // From here on a failure abandons the file: tables after the payloads, each with its checksum,
     // then the header at offset 0, then fsync and rename.
     w.finished = true;
-    Status written = WriteTablesAndCommit(w.file, h, w.provenance, w.entries, tree, materials);
+    Status written =
+        WriteTablesAndCommit(w.file, h, w.provenance, w.entries, tree, materials, w.medium_grid);
     if (!written.ok()) w.file.Abandon();
     return written;
 }

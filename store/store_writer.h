@@ -4,6 +4,7 @@
 // written under a temporary name; Finish() writes the tables last, then fsyncs and renames: an
 // interrupted writer never leaves a file that opens as a valid store.
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -72,6 +73,20 @@ struct EncodedBrick {
     double simplify_seconds = 0;  ///< time spent making the levels (statistics; not stored)
 };
 
+/// A brick's piece of the store's medium, ready to be appended (format 3.3): BrickMediumInfo's
+/// fields and the section's bytes.
+struct EncodedMedium {
+    std::vector<std::byte> grid_bytes;  ///< OpenVDB's serialization (volumes::GridPiece::bytes)
+    uint64_t active_voxels = 0;         ///< at least 1
+    float max_density = 0;              ///< the majorant: finite, >= 0
+    uint64_t decoded_bytes = 0;         ///< memory once read (volumes::GridPiece::memory_bytes)
+};
+
+/// A brick without triangles for `cell`, one that holds only a piece of the medium: its mesh
+/// section is the 16-byte prefix alone (base 0, no flags, no Draco bitstream), as a brick whose
+/// triangles all collapsed on the grid has, which every reader decodes to an empty mesh.
+EncodedBrick EmptyBrick(const Bounds3f& cell);
+
 /// Checks BrickMesh invariants; errors say which index or count is wrong.
 Status ValidateBrickMesh(const BrickMesh& mesh, size_t material_count);
 
@@ -95,9 +110,18 @@ class StoreWriter {
     /// Appends a brick (its mesh section, then its levels', then its side section) and returns its
     /// id (ids count from 0 in append order). Not thread-safe.
     StatusOr<uint32_t> Append(const EncodedBrick& brick);
+    /// Names the medium's density grid (format 3.3) whose pieces AppendMedium adds: the store then
+    /// has a medium table (StoreHeader::medium_grid), even if no piece is appended. Call it once,
+    /// before AppendMedium; InvalidArgument for an empty name or a second call.
+    Status SetMediumGrid(const std::string& name);
+    /// Appends the piece of the medium of brick `id` (appended before; at most one piece a brick):
+    /// its section goes after the payloads so far. InvalidArgument for an unknown brick, a second
+    /// piece, no SetMediumGrid, no bytes or voxels, or a majorant that is not finite and >= 0. Not
+    /// thread-safe.
+    Status AppendMedium(uint32_t id, const EncodedMedium& medium);
     /// Writes the materials, the brick tree (whose leaves name appended brick ids), the directory,
-    /// the levels table and the header, then commits the file. `source_triangle_count` is the
-    /// input's count before duplication.
+    /// the levels table, the medium table and the header, then commits the file.
+    /// `source_triangle_count` is the input's count before duplication.
     Status Finish(const std::vector<MaterialRecord>& materials, const BrickTree& tree,
                   uint64_t source_triangle_count);
 

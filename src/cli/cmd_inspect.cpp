@@ -1,6 +1,6 @@
 // `nave inspect FILE [--json] [--bricks]`: what a brick store holds, read from its header and
 // tables only (no brick is decoded): bricks, triangles, bytes, bounds, grid and error bound,
-// levels of detail, materials, provenance.
+// levels of detail, the medium's pieces, materials, provenance.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -72,6 +72,26 @@ std::vector<LevelSummary> SummarizeLevels(const store::Store& s, uint64_t* level
     return out;
 }
 
+/// The medium's pieces over all bricks (format 3.3).
+struct MediumSummary {
+    uint64_t voxels = 0, bytes = 0, decoded_bytes = 0, bricks = 0, bricks_without_triangles = 0;
+    float max_density = 0;
+};
+
+MediumSummary SummarizeMedium(const store::Store& s) {
+    MediumSummary m;
+    for (const store::BrickInfo& b : s.bricks()) {
+        if (b.medium.grid.length == 0) continue;
+        m.voxels += b.medium.active_voxels;
+        m.bytes += b.medium.grid.length;
+        m.decoded_bytes += b.medium.decoded_bytes;
+        ++m.bricks;
+        m.bricks_without_triangles += b.triangle_count == 0 ? 1 : 0;
+        m.max_density = std::max(m.max_density, b.medium.max_density);
+    }
+    return m;
+}
+
 /// Percent the levels add to the store's bytes without them.
 double LevelGrowthPercent(const store::Store& s, uint64_t level_bytes) {
     const uint64_t without = s.file_size() - std::min(level_bytes, s.file_size());
@@ -139,6 +159,16 @@ void PrintJson(const store::Store& s, bool list_bricks) {
     out += levels.empty() ? "],\n" : "\n  ],\n";
     out += fmt::format("  \"level_bytes\": {},\n", level_bytes);
     out += fmt::format("  \"level_growth_percent\": {:.4f},\n", LevelGrowthPercent(s, level_bytes));
+    if (h.medium_grid.empty()) {
+        out += "  \"medium\": null,\n";
+    } else {
+        const MediumSummary m = SummarizeMedium(s);
+        out += fmt::format(
+            "  \"medium\": {{\"grid\": {}, \"voxels\": {}, \"bytes\": {}, \"decoded_bytes\": {}, "
+            "\"bricks\": {}, \"bricks_without_triangles\": {}, \"max_density\": {}}},\n",
+            JsonString(h.medium_grid), m.voxels, m.bytes, m.decoded_bytes, m.bricks,
+            m.bricks_without_triangles, m.max_density);
+    }
     out += "  \"materials\": [";
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
@@ -162,11 +192,20 @@ void PrintJson(const store::Store& s, bool list_bricks) {
     if (list_bricks) {
         out += ",\n  \"brick_list\": [";
         for (const store::BrickInfo& b : s.bricks()) {
+            const store::BrickMediumInfo& m = b.medium;
+            const std::string medium =
+                m.grid.length == 0
+                    ? std::string("null")
+                    : fmt::format(
+                          "{{\"voxels\": {}, \"bytes\": {}, \"offset\": {}, \"decoded_bytes\": "
+                          "{}, \"max_density\": {}}}",
+                          m.active_voxels, m.grid.length, m.grid.offset, m.decoded_bytes,
+                          m.max_density);
             out += fmt::format(
                 "{}\n    {{\"id\": {}, \"triangles\": {}, \"vertices\": {}, \"bytes\": {}, "
-                "\"offset\": {}, \"cell\": {{\"min\": {}, \"max\": {}}}}}",
+                "\"offset\": {}, \"cell\": {{\"min\": {}, \"max\": {}}}, \"medium\": {}}}",
                 b.id ? "," : "", b.id, b.triangle_count, b.vertex_count, b.BytesOnDisk(),
-                b.mesh.offset, JsonVec(b.cell.min), JsonVec(b.cell.max));
+                b.mesh.offset, JsonVec(b.cell.min), JsonVec(b.cell.max), medium);
         }
         out += s.bricks().empty() ? "]" : "\n  ]";
     }
@@ -230,6 +269,16 @@ void PrintText(const store::Store& s, bool list_bricks) {
                 Length(l.median_error));
         }
     }
+    if (h.medium_grid.empty()) {
+        out += "  medium       none\n";
+    } else {
+        const MediumSummary m = SummarizeMedium(s);
+        out += fmt::format(
+            "  medium       grid '{}': {} voxels in {} bricks ({} without triangles), {} on disk, "
+            "{} decoded; largest density {:.6g}\n",
+            h.medium_grid, FormatCount(double(m.voxels)), m.bricks, m.bricks_without_triangles,
+            FormatBytes(m.bytes), FormatBytes(m.decoded_bytes), m.max_density);
+    }
     out += fmt::format("  materials    {}\n", s.materials().size());
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
@@ -258,6 +307,13 @@ void PrintText(const store::Store& s, bool list_bricks) {
                                    l.triangle_count, l.vertex_count, l.mesh.length, l.mesh.offset,
                                    Length(l.error));
             }
+            const store::BrickMediumInfo& m = b.medium;
+            if (m.grid.length > 0) {
+                out += fmt::format(
+                    "    medium  {:>10} voxels {:>11}  0x{:<10x} majorant {:.6g}, {} decoded\n",
+                    m.active_voxels, m.grid.length, m.grid.offset, m.max_density,
+                    FormatBytes(m.decoded_bytes));
+            }
         }
     }
     std::fputs(out.c_str(), stdout);
@@ -275,7 +331,8 @@ void RegisterInspectCommand(CLI::App& app, CommandRun& run) {
     cmd->add_option("FILE", *file, "The .nave store")->required();
     cmd->add_flag("--json", *json, "Print JSON on stdout instead of text");
     cmd->add_flag("--bricks", *bricks,
-                  "Also list every brick (id, triangles, vertices, bytes, offset, cell)");
+                  "Also list every brick (id, triangles, vertices, bytes, offset, cell; its "
+                  "levels and its piece of the medium)");
     cmd->callback([&run, file, json, bricks] {
         run = [file, json, bricks]() -> Status {
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> s, store::Store::Open(*file));

@@ -1,4 +1,5 @@
-// `nave preprocess`: model files (or the procedural abbey) -> a brick store, in bounded memory.
+// `nave preprocess`: model files (or the procedural abbey), and a medium's grid, -> a brick store,
+// in bounded memory.
 // The library plans and runs; what touches the whole process is done here: the handlers of SIGINT
 // and SIGTERM (src/cli/interrupt.h) and the open-file limit.
 #include <sys/resource.h>
@@ -28,10 +29,12 @@ void RaiseOpenFileLimit() {
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand(
         "preprocess",
-        "Cut models (OBJ, PLY, STL, glTF, Assimp formats) into a brick store (.nave)");
+        "Cut models (OBJ, PLY, STL, glTF, Assimp formats), and a medium's density (OpenVDB), into "
+        "a brick store (.nave)");
     struct Options {
         std::vector<std::string> inputs;
         std::string generate, output, memory, temp_dir;
+        std::string medium_grid = preprocess::PreprocessOptions{}.medium_grid;
         uint64_t brick_triangles = 0;
         double precision = 0;
         int threads = 0;
@@ -43,7 +46,12 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
         bool levels = false;
     };
     auto opt = std::make_shared<Options>();
-    cmd->add_option("inputs", opt->inputs, "Model files; several are merged into one model");
+    cmd->add_option("inputs", opt->inputs,
+                    "Model files, several merged into one model; and at most one OpenVDB file "
+                    "(.vdb), a medium's density in the model's units, cut along the bricks");
+    cmd->add_option("--medium-grid", opt->medium_grid,
+                    "The float grid of the .vdb file that holds the medium's density")
+        ->capture_default_str();
     cmd->add_option("--generate", opt->generate,
                     "Use a generator instead of files: abbey or abbey:detail=D");
     cmd->add_option("-o,--output", opt->output, "Output store (.nave)")->required();
@@ -88,6 +96,7 @@ void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
             preprocess::PreprocessOptions o;
             for (const auto& in : opt->inputs) o.inputs.emplace_back(in);
             o.generate = opt->generate;
+            o.medium_grid = opt->medium_grid;
             o.output = opt->output;
             if (!opt->memory.empty()) {
                 NAVE_ASSIGN_OR_RETURN(o.memory_bytes, ParseByteSize(opt->memory));

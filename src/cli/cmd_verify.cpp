@@ -1,5 +1,6 @@
 // `nave verify FILE [--json] [--threads N]`: reads every brick of a store, checks its checksums,
-// decodes it and compares it with the directory. Succeeds (exit 0) only if every brick is intact;
+// decodes it (its piece of the medium too, through the OpenVDB plugin) and compares it with the
+// directory and the medium table. Succeeds (exit 0) only if every brick is intact;
 // otherwise lists each damaged brick with its error and fails (exit 1).
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -17,6 +18,7 @@
 #include "src/core/log.h"
 #include "src/core/memory.h"
 #include "src/core/progress.h"
+#include "src/volumes/vdb_plugin.h"
 #include "store/store_reader.h"
 
 namespace nave::cli {
@@ -27,10 +29,30 @@ struct BadBrick {
     Status status;
 };
 
+/// Brick `id`'s piece of the medium decodes to a grid of the voxels the medium table says.
+Status VerifyMedium(const store::Store& s, const volumes::VdbPlugin& plugin, uint32_t id) {
+    const store::BrickMediumInfo& info = s.bricks()[id].medium;
+    NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> bytes, s.ReadBrickMedium(id));
+    const std::string what =
+        fmt::format("{} brick {} medium @0x{:x}", s.path().string(), id, info.grid.offset);
+    NAVE_ASSIGN_OR_RETURN(std::unique_ptr<volumes::ScalarGrid> grid,
+                          plugin.ReadScalarGridBytes(bytes, what));
+    if (grid->active_voxels() != info.active_voxels) {
+        return DataLossError("{}: decoded {} voxels but the medium table says {}", what,
+                             grid->active_voxels(), info.active_voxels);
+    }
+    return Status::Ok();
+}
+
 Status Verify(const std::string& file, bool json, int threads) {
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> s, store::Store::Open(file));
     const std::vector<store::BrickInfo>& bricks = s->bricks();
     const uint32_t brick_count = uint32_t(bricks.size());
+    // The medium's pieces decode through the OpenVDB plugin, loaded only for a store that has one.
+    const volumes::VdbPlugin* plugin = nullptr;
+    if (!s->header().medium_grid.empty()) {
+        NAVE_ASSIGN_OR_RETURN(plugin, volumes::LoadVdbPlugin());
+    }
 
     // Bricks are independent and reads are positional: verify on several threads.
     ProgressBar progress("verify", s->header().triangle_count, "triangles");
@@ -40,6 +62,8 @@ Status Verify(const std::string& file, bool json, int threads) {
     arena.execute([&] {
         tbb::parallel_for(uint32_t(0), brick_count, [&](uint32_t id) {
             Status st = s->VerifyBrick(id);
+            if (st.ok() && plugin != nullptr && bricks[id].medium.grid.length > 0)
+                st = VerifyMedium(*s, *plugin, id);
             if (!st.ok()) {
                 std::lock_guard<std::mutex> lock(bad_mutex);
                 bad.push_back({id, st});
@@ -96,7 +120,8 @@ Status Verify(const std::string& file, bool json, int threads) {
 void RegisterVerifyCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand("verify",
                                        "Read every brick of a store, check its checksums and "
-                                       "decode it; exit 0 only if all are intact");
+                                       "decode it (and its piece of the medium); exit 0 only if "
+                                       "all are intact");
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     auto threads = std::make_shared<int>(int(std::max(1u, std::thread::hardware_concurrency())));

@@ -4,10 +4,14 @@
 // pulls in Boost, Blosc and log4cplus; linked into `nave`, every command would load them, so it
 // lives in a plugin loaded on first use, as OpenImageIO does (src/imaging/oiio_plugin.h).
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
@@ -15,7 +19,7 @@
 namespace nave::volumes {
 
 /// Bumped whenever VdbPlugin's methods or the types they take change.
-inline constexpr int kVdbPluginVersion = 1;
+inline constexpr int kVdbPluginVersion = 2;
 
 /// A grid of voxels, each of constant value over its cell, in world space. Immutable: thread-safe.
 class ScalarGrid {
@@ -23,10 +27,32 @@ class ScalarGrid {
     virtual ~ScalarGrid() = default;
     /// The world box of the active voxels' cells; outside it every value is the background, 0.
     virtual Bounds3f bounds() const = 0;
+    /// Bytes the grid takes in memory (OpenVDB's memUsage), for memory budgets.
+    virtual uint64_t memory_bytes() const = 0;
+    /// Active voxels (those of active tiles included): GridPiece::active_voxels of a piece read.
+    virtual uint64_t active_voxels() const = 0;
     /// Calls `visit(t0, t1, value)` for every voxel the ray o + t d (d unit) crosses with t in
     /// [t_begin, t_end] (world units), front to back, until it returns false.
     virtual void March(const Vec3f& o, const Vec3f& d, float t_begin, float t_end,
                        const std::function<bool(float, float, float)>& visit) const = 0;
+};
+
+/// One piece of a grid cut along a box (VdbPlugin::CutScalarGrid).
+struct GridPiece {
+    /// OpenVDB's own serialization (io::Stream) of a float grid named as the source grid, with
+    /// its transform, holding the source's active voxels whose cells overlap the box.
+    std::vector<std::byte> bytes;
+    uint64_t active_voxels = 0;
+    float max_value = 0;        ///< largest active value: the piece's majorant
+    uint64_t memory_bytes = 0;  ///< ScalarGrid::memory_bytes() of the piece once read
+};
+
+/// What CutScalarGrid saw of the whole grid.
+struct GridCutSummary {
+    uint64_t active_voxels = 0;  ///< in the source grid
+    /// Active voxels whose cells overlap none of the boxes (outside them all: not in any piece).
+    uint64_t voxels_outside = 0;
+    Bounds3f bounds;  ///< world box of the source's active voxels' cells
 };
 
 /// The OpenVDB side. Every method is thread-safe; every failure is a Status naming the file.
@@ -39,6 +65,20 @@ class VdbPlugin {
     /// is InvalidArgument naming the grid.
     virtual StatusOr<std::unique_ptr<ScalarGrid>> ReadScalarGrid(const std::filesystem::path& file,
                                                                  const std::string& grid) const = 0;
+    /// A grid serialized as GridPiece::bytes; `what` names it in errors (e.g. "abbey.nave brick
+    /// 12 medium"). Bytes that do not decode, or hold no float grid, are DataLoss naming `what`.
+    virtual StatusOr<std::unique_ptr<ScalarGrid>> ReadScalarGridBytes(
+        std::span<const std::byte> bytes, const std::string& what) const = 0;
+    /// Cuts the float grid `grid` of `file` along `boxes` (world space), calling `emit(i, piece)`
+    /// for every box i that some active voxel's cell overlaps, in order of i, and stopping at the
+    /// first error `emit` returns. The file is read box by box, only the leaves that overlap it
+    /// (OpenVDB's File::readGrid(name, bbox)), so the whole grid is never in memory at once. The
+    /// grid is checked as ReadScalarGrid checks it (same errors), its values where a box reads
+    /// them: voxels outside every box are counted, not read. With no boxes, it checks the file and
+    /// the grid's type and transform and counts its voxels (reading their masks, not their values).
+    virtual StatusOr<GridCutSummary> CutScalarGrid(
+        const std::filesystem::path& file, const std::string& grid, std::span<const Bounds3f> boxes,
+        const std::function<Status(size_t box, GridPiece piece)>& emit) const = 0;
     /// Writes a float grid named `grid` of `dims` voxels of side `voxel_m`, voxel (0, 0, 0)'s
     /// cell starting at `origin`, with value(i, j, k) (0 is left inactive), to `file`. IoError on
     /// failure.

@@ -20,9 +20,11 @@ struct Layout {
         {};  // provenance, directory, tree, materials; offset and length precede
     size_t brick_count = 0;
     size_t entry_bytes = 0;
-    size_t section_checksum[2] = {};  // mesh, side (within an entry); offset and length precede
-    size_t levels_checksum = 0;       // the levels table's (3.1), in the header
-    size_t level_checksum = 0;        // a level's mesh section's, within its levels-table entry
+    size_t section_checksum[2] = {};   // mesh, side (within an entry); offset and length precede
+    size_t levels_checksum = 0;        // the levels table's (3.1), in the header
+    size_t level_checksum = 0;         // a level's mesh section's, within its levels-table entry
+    size_t medium_table_checksum = 0;  // the medium table's (3.3), in the header
+    size_t medium_checksum = 0;        // a piece's section's, within its medium-table entry
 };
 
 size_t Find(const std::string& bytes, uint64_t marker, size_t size) {
@@ -58,6 +60,14 @@ Layout Learn() {
     // The table's prefix, then the brick's level count, then its entry.
     l.level_checksum = Find(levels, with_level.info.levels[0].mesh.checksum, 8) -
                        store::format::kLevelsPrefixBytes - 4;
+    h.medium.checksum = 0x5eed00000000fffeull;
+    l.medium_table_checksum = Find(store::format::EncodeHeader(h), h.medium.checksum, 8);
+    store::format::RawBrickEntry with_medium;
+    with_medium.info.medium.grid.checksum = 0xc0de000000000004ull;
+    const std::string medium = store::format::EncodeMedium("g", {with_medium});
+    // The table's prefix and the grid's name (a u32 length, then "g"), then the brick's entry.
+    l.medium_checksum = Find(medium, with_medium.info.medium.grid.checksum, 8) -
+                        store::format::kMediumPrefixBytes - 4 - 1;
     return l;
 }
 
@@ -119,8 +129,26 @@ void ResealStore(std::string& bytes) {
             if (count > 0 && at + level_bytes > end) break;
         }
     }
+    // Pieces of the medium: their checksums live in the medium table, sealed next.
+    const uint64_t medium_offset = Load<uint64_t>(bytes, l.medium_table_checksum - 16);
+    const uint64_t medium_length = Load<uint64_t>(bytes, l.medium_table_checksum - 8);
+    if (header_bytes >= l.medium_table_checksum + 8 &&
+        medium_length >= store::format::kMediumPrefixBytes + 4 && medium_offset <= bytes.size() &&
+        medium_length <= bytes.size() - medium_offset) {
+        const uint32_t entry_bytes = Load<uint32_t>(bytes, medium_offset);
+        const uint32_t count = Load<uint32_t>(bytes, medium_offset + 4);
+        const uint32_t name_bytes =
+            Load<uint32_t>(bytes, medium_offset + store::format::kMediumPrefixBytes);
+        const uint64_t end = medium_offset + medium_length;
+        uint64_t at = medium_offset + store::format::kMediumPrefixBytes + 4 + uint64_t(name_bytes);
+        for (uint32_t i = 0;
+             i < count && entry_bytes >= l.medium_checksum + 8 && at + entry_bytes <= end;
+             ++i, at += entry_bytes)
+            Seal(bytes, at + l.medium_checksum);
+    }
     for (size_t t : l.table_checksum) Seal(bytes, t);
     Seal(bytes, l.levels_checksum);
+    if (header_bytes >= l.medium_table_checksum + 8) Seal(bytes, l.medium_table_checksum);
     Store(bytes, header_bytes - 8, Checksum64(bytes.data(), header_bytes - 8));
 }
 

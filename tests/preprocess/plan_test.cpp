@@ -99,12 +99,35 @@ TEST(PreprocessPlan, RefusesNeitherOrBothInputs) {
     ASSERT_FALSE(plan.ok());
     EXPECT_EQ(plan.status().code(), StatusCode::kInvalidArgument);
     EXPECT_EQ(plan.status().message(),
-              "give either input files or --generate abbey[:detail=D], not neither");
+              "give either model files or --generate abbey[:detail=D], not neither");
     PreprocessOptions both = Generate();
     both.inputs = {"model.obj"};
     plan = PlanPreprocess(both, Machine());
     ASSERT_FALSE(plan.ok());
     EXPECT_THAT(plan.status().message(), HasSubstr("not both"));
+    // A .vdb is a medium, not a model: alone it is no input, beside the generator it is welcome.
+    PreprocessOptions medium_only;
+    medium_only.output = "a.nave";
+    medium_only.inputs = {"dust.vdb"};
+    plan = PlanPreprocess(medium_only, Machine());
+    ASSERT_FALSE(plan.ok());
+    EXPECT_THAT(plan.status().message(), HasSubstr("not neither (a .vdb file is a medium"));
+    PreprocessOptions generated_with_medium = Generate();
+    generated_with_medium.inputs = {"dust.VDB"};
+    plan = PlanPreprocess(generated_with_medium, Machine());
+    ASSERT_TRUE(plan.ok()) << plan.status().ToString();
+    EXPECT_EQ(plan->medium, "dust.VDB");
+    EXPECT_TRUE(plan->models.empty());
+}
+
+TEST(PreprocessPlan, RefusesTwoMediaNamingBoth) {
+    PreprocessOptions o;
+    o.output = "a.nave";
+    o.inputs = {"a.vdb", "model.obj", "b.vdb"};
+    auto plan = PlanPreprocess(o, Machine());
+    ASSERT_FALSE(plan.ok());
+    EXPECT_EQ(plan.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_THAT(plan.status().message(), HasSubstr("two media given, a.vdb and b.vdb"));
 }
 
 TEST(PreprocessPlan, RefusesNoOutput) {

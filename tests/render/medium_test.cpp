@@ -78,28 +78,36 @@ TEST(MediumTest, TransmittanceIsBeerLambertOverTheLengthInsideTheBox) {
     const SampledWavelengths lambda = SampledWavelengths::SampleVisible(0.37f);
     const SampledSpectrum sigma_t = m.SigmaT(lambda);
     const Vec3f o(-1, 0.5f, 0.5f), d(1, 0, 0);
-    const SampledSpectrum through = m.Transmittance(o, d, kInf, lambda);
-    const SampledSpectrum half = m.Transmittance(o, d, 1.5f, lambda);
+    const DensityField& box = *m.DensityIn(nullptr);
+    const auto transmittance = [&](const Vec3f& origin, float t_max) {
+        return m.Transmittance(box.Integral(origin, d, 0, t_max), lambda);
+    };
+    const SampledSpectrum through = transmittance(o, kInf);
+    const SampledSpectrum half = transmittance(o, 1.5f);
     for (int i = 0; i < kNumWavelengths; ++i) {
         EXPECT_NEAR(through[i], std::exp(-sigma_t[i] * 1.f), 1e-6f);
         EXPECT_NEAR(half[i], std::exp(-sigma_t[i] * 0.5f), 1e-6f);
         EXPECT_GT(sigma_t[i], 0.25f);
     }
     // A ray beside the box, and one that stops before it, cross none of it.
-    EXPECT_EQ(m.Transmittance(Vec3f(-1, 2, 0.5f), d, kInf, lambda), SampledSpectrum(1.f));
-    EXPECT_EQ(m.Transmittance(o, d, 0.9f, lambda), SampledSpectrum(1.f));
+    EXPECT_EQ(transmittance(Vec3f(-1, 2, 0.5f), kInf), SampledSpectrum(1.f));
+    EXPECT_EQ(transmittance(o, 0.9f), SampledSpectrum(1.f));
     // Diagonally through a corner region: the slab test's length.
-    EXPECT_NEAR(m.density().Integral(Vec3f(-0.5f, -0.5f, 0.5f), Normalize(Vec3f(1, 1, 0)), kInf),
+    EXPECT_NEAR(box.Integral(Vec3f(-0.5f, -0.5f, 0.5f), Normalize(Vec3f(1, 1, 0)), 0, kInf),
                 std::sqrt(2.f), 1e-5f);
+    // From t = 1.25 on, half the box is left.
+    EXPECT_NEAR(box.Integral(o, d, 1.25f, kInf), 0.75f, 1e-6f);
 }
 
 // The free-flight estimator at every wavelength, with an extinction that varies with wavelength:
 // scatterings weighted by ScatterWeight estimate ∫0^L σs e^(-σt s) ds = σs/σt (1 - e^(-σt L)), rays
 // through weighted by NoScatterWeight estimate e^(-σt L), whichever wavelength drew the distance.
+// Each ray flies in two stretches, as across two bricks, carrying its flight's depth between them.
 TEST(MediumFlightTest, WeightsEstimateScatteringAndTransmittanceAtEveryWavelength) {
     const float length = 1.5f;
     const Medium m(std::make_shared<BoxDensity>(Bounds3f({0, -1, -1}, {length, 1, 1})),
                    Spectrum::Constant(0.1f), Rising(), 0.f);
+    const DensityField& box = *m.DensityIn(nullptr);
     RayRecord base;
     base.origin = Vec3f(-0.5f, 0, 0);
     base.dir = Vec3f(1, 0, 0);
@@ -108,28 +116,55 @@ TEST(MediumFlightTest, WeightsEstimateScatteringAndTransmittanceAtEveryWavelengt
     const SampledSpectrum sigma_t = m.SigmaT(base.lambda), sigma_s = m.SigmaS(base.lambda);
     nave::testing::Pcg32 rng(5);
     const int n = 400000;
+    const float split = 1.2f;  // where the first stretch ends
     SampledSpectrum scattered, through;
+    int scatterings = 0;
     for (int k = 0; k < n; ++k) {
         RayRecord r = base;
+        r.flight_depth = 0;
         const float u_choice = rng.NextFloat(), u_distance = rng.NextFloat();
         const float depth = FlightDepth(m, r.lambda, u_choice, u_distance);
-        StartFlight(m, depth, &r);
-        if (r.flags & kMediumScatter) {
-            EXPECT_GE(r.t_max, 0.5f);
-            EXPECT_LE(r.t_max, 0.5f + length);
+        float t = Fly(&box, depth, 0, split, &r);
+        if (std::isinf(t)) {
+            EXPECT_NEAR(r.flight_depth, split - 0.5f, 1e-6f);
+            t = Fly(&box, depth, split, kInf, &r);
+        }
+        if (!std::isinf(t)) {
+            ++scatterings;
+            EXPECT_GE(t, 0.5f);
+            EXPECT_LE(t, 0.5f + length);
             // The depth it aimed at is the density's integral up to where it scatters.
-            EXPECT_NEAR(m.density().Integral(r.origin, r.dir, r.t_max), depth, 1e-5f);
-            scattered += ScatterWeight(m, r, depth);
+            EXPECT_NEAR(box.Integral(r.origin, r.dir, 0, t), depth, 1e-5f);
+            scattered += ScatterWeight(m, r.lambda, depth);
         } else {
-            through += NoScatterWeight(m, r, kInf);
+            EXPECT_NEAR(r.flight_depth, length, 1e-5f);
+            through += NoScatterWeight(m, r.lambda, r.flight_depth);
         }
     }
+    EXPECT_GT(scatterings, n / 10);
     for (int i = 0; i < kNumWavelengths; ++i) {
         const float t = std::exp(-sigma_t[i] * length);
         EXPECT_NEAR(through[i] / n, t, 0.01f) << "wavelength " << base.lambda[i];
         EXPECT_NEAR(scattered[i] / n, sigma_s[i] / sigma_t[i] * (1 - t), 0.01f)
             << "wavelength " << base.lambda[i];
     }
+}
+
+// A field shared out among cells (a grid cut into bricks): the shares' walks along a ray, one cell
+// after the other, add up to the whole's, and reach a target where the whole does.
+TEST(MediumFlightTest, CellSharesOfAFieldAddUpToTheWhole) {
+    auto whole = std::make_shared<BoxDensity>(Bounds3f({0, -1, -1}, {3, 1, 1}));
+    const Bounds3f left({-1, -2, -2}, {1.25f, 2, 2}), right({1.25f, -2, -2}, {4, 2, 2});
+    const CellShare a(whole, left, 2.f), b(whole, right, 2.f);
+    const Vec3f o(-0.5f, 0.1f, 0), d = Normalize(Vec3f(1, 0.1f, 0));
+    const float total = 2 * whole->Integral(o, d, 0, kInf);
+    EXPECT_NEAR(a.Integral(o, d, 0, kInf) + b.Integral(o, d, 0, kInf), total, 1e-5f);
+    EXPECT_NEAR(a.Integral(o, d, 0, kInf), 2 * 1.25f / d.x, 1e-5f);
+    const float target = 0.8f * total;
+    const float t_whole = whole->Reach(o, d, 0, kInf, target / 2);
+    EXPECT_TRUE(std::isinf(a.Reach(o, d, 0, kInf, target)));
+    const float t = b.Reach(o, d, 0, kInf, target - a.Integral(o, d, 0, kInf));
+    EXPECT_NEAR(t, t_whole, 1e-5f);
 }
 
 // An emitter seen through a slab of pure absorber 1 m thick: dimmed by e^(-σa), exactly (the same

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -318,6 +319,45 @@ TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
     const std::vector<float> a = Rgb(*dir_ / "levels1.exr"), b = Rgb(*dir_ / "levels2.exr");
     ASSERT_FALSE(a.empty());
     EXPECT_EQ(a, b);
+}
+
+// Drifting dust cut into the bricks by preprocess (grid = "store"): each brick's piece comes with
+// the brick, on the rank that owns it, and a path's flight carries its depth from brick to brick
+// and rank to rank. Paged under a budget (pieces evicted and read again with their bricks) and as
+// 2 ranks, the image of one process in core, bit for bit.
+TEST_F(MpiRender, AGridStoredInTheBricksGivesTheSingleProcessImage) {
+    const fs::path dust = *dir_ / "dust.vdb", store = *dir_ / "dusty.nave";
+    ASSERT_EQ(test::RunNave("generate dust -o " + dust.string()).exit_code, 0);
+    const test::CommandResult made =
+        test::RunNave("preprocess --generate abbey:detail=1 --brick-triangles 40000 -q " +
+                      dust.string() + " -o " + store.string());
+    ASSERT_EQ(made.exit_code, 0) << made.output;
+    {
+        std::ifstream in(std::string(NAVE_SOURCE_DIR) + "/configs/abbey_dust.toml");
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string config = text.str();
+        const size_t at = config.find("grid = \"dust.vdb\"");
+        ASSERT_NE(at, std::string::npos);
+        config.replace(at, std::string("grid = \"dust.vdb\"").size(), "grid = \"store\"");
+        std::ofstream(*dir_ / "dusty.toml") << config;
+    }
+    auto render = [&](const std::string& out, const std::string& flags = "") {
+        return std::string(NAVE_BINARY) + " render " + store.string() + " -c " +
+               (*dir_ / "dusty.toml").string() + " --resolution 64x48 --spp 2 " + flags + " -o " +
+               (*dir_ / out).string();
+    };
+    const test::CommandResult one = Shell(render("dust1.exr"));
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const test::CommandResult paged = Shell(render("dust_paged.exr", "--memory 300M"));
+    ASSERT_EQ(paged.exit_code, 0) << paged.output;
+    EXPECT_NE(paged.output.find("evictions"), std::string::npos) << paged.output;
+    const test::CommandResult two = Shell(Mpirun(2) + render("dust2.exr", "-q"));
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    const std::vector<float> a = Rgb(*dir_ / "dust1.exr");
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, Rgb(*dir_ / "dust_paged.exr"));
+    EXPECT_EQ(a, Rgb(*dir_ / "dust2.exr"));
 }
 
 // The abbey in haze (a medium over the church): a path's scattering in the air happens on the

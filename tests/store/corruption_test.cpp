@@ -27,11 +27,6 @@ std::string ReadAll(const std::filesystem::path& p) {
     return *s;
 }
 
-void WriteAll(const std::filesystem::path& p, const std::string& bytes) {
-    std::ofstream out(p, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 std::string Hex(uint64_t v) { return fmt::format("0x{:x}", v); }
 
 class StoreCorruption : public ::testing::Test {
@@ -53,8 +48,7 @@ class StoreCorruption : public ::testing::Test {
 
     // Writes `bytes` as a new file and opens it.
     StatusOr<std::unique_ptr<Store>> OpenBytes(const std::string& bytes) {
-        WriteAll(bad_, bytes);
-        return Store::Open(bad_);
+        return test::OpenStoreBytes(bad_, bytes);
     }
     std::string Flipped(uint64_t offset) const {
         std::string b = bytes_;

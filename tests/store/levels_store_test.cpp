@@ -64,10 +64,7 @@ class StoreLevels : public ::testing::Test {
     }
 
     StatusOr<std::unique_ptr<Store>> OpenBytes(const std::string& bytes) {
-        std::ofstream out(bad_, std::ios::binary | std::ios::trunc);
-        out.write(bytes.data(), std::streamsize(bytes.size()));
-        out.close();
-        return Store::Open(bad_);
+        return test::OpenStoreBytes(bad_, bytes);
     }
     // `bytes` with the levels table's checksum and the header's recomputed (a writer's bug behind
     // valid checksums).
@@ -103,7 +100,7 @@ TEST_F(StoreLevels, RoundTripKeepsCountsErrorsAndSections) {
     ASSERT_TRUE(opened.ok()) << opened.status().ToString();
     const Store& store = **opened;
     EXPECT_EQ(store.header().major, 3);
-    EXPECT_EQ(store.header().minor, 2);
+    EXPECT_EQ(store.header().minor, kFormatMinor);
     ASSERT_EQ(store.bricks().size(), 4u);
     for (const BrickInfo& b : store.bricks()) {
         SCOPED_TRACE(::testing::Message() << "brick " << b.id);

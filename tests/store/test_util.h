@@ -8,14 +8,26 @@
 #include <algorithm>
 #include <array>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "store/brick_mesh.h"
 #include "store/grid.h"
+#include "store/store_reader.h"
 
 namespace nave::store::test {
+
+/// Writes `bytes` to `path` (replacing it) and opens it as a store: for tests of damaged stores.
+inline StatusOr<std::unique_ptr<Store>> OpenStoreBytes(const std::filesystem::path& path,
+                                                       const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    out.close();
+    return Store::Open(path);
+}
 
 /// A fresh directory under the system's temporary directory, removed with everything in it.
 class ScratchDir {

@@ -148,6 +148,18 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
                   {LevelOfSlot(id), LevelErrors(BrickOfSlot(id))[LevelOfSlot(id)], coarsest_error_})
             : StatusOr<std::unique_ptr<ResidentBrick>>(mesh.status());
     build.End();
+    if (built.ok() && medium_scale_) {
+        TraceSpan medium(trace_, "read the medium", "pager");
+        const uint32_t brick = BrickOfSlot(id);
+        StatusOr<std::shared_ptr<const DensityField>> piece =
+            LoadMediumPiece(brick, *medium_scale_, &bytes);
+        if (piece.ok()) {
+            // The directory's figure, so that the pager's accounting matches the estimate.
+            (*built)->AttachMedium(std::move(piece).value(), MediumPieceBytes(brick));
+        } else {
+            built = piece.status();
+        }
+    }
     double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!built.ok()) {
@@ -175,6 +187,18 @@ void BrickSource::SetAlphaMasks(AlphaMasks masks) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     NAVE_CHECK_EQ(stats_.resident_bytes, 0u) << "alpha masks set while bricks are resident";
     alpha_masks_ = std::move(masks);
+}
+
+Status BrickSource::UseStoredMedium(float scale) {
+    NAVE_RETURN_IF_ERROR(HasStoredMedium());
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (stats_.resident_bytes != 0)
+        return InvalidArgumentError(
+            "the stored medium cannot be taken up while {} of bricks are "
+            "resident",
+            stats_.resident_bytes);
+    medium_scale_ = scale;
+    return Status::Ok();
 }
 
 Status BrickSource::SetBvhSettings(const BvhSettings& bvh) {

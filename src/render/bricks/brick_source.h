@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "src/core/status.h"
@@ -112,9 +113,15 @@ class BrickSource {
     /// Drops brick `id` from memory if nobody pins it; returns whether it was dropped. The pager's
     /// tool; the default policy never calls it.
     bool Evict(uint32_t id);
-    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes), known without
-    /// loading it.
-    virtual uint64_t EstimatedResidentBytes(uint32_t id) const = 0;
+    /// What brick `id` will take in memory once loaded (ResidentBrick::memory_bytes, with its
+    /// piece of a stored medium once UseStoredMedium), known without loading it.
+    uint64_t EstimatedResidentBytes(uint32_t id) const {
+        return EstimatedMeshBytes(id) + (medium_scale_ ? MediumPieceBytes(BrickOfSlot(id)) : 0);
+    }
+    /// Every brick loaded from now on comes with its piece of the medium grid the source holds
+    /// (ResidentBrick::medium), its values times `scale`; every level of a brick carries the same
+    /// piece. NotFound if the source holds no medium grid; InvalidArgument if bricks are resident.
+    Status UseStoredMedium(float scale);
     BrickSourceStats stats() const;
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
     /// portals).
@@ -149,6 +156,30 @@ class BrickSource {
                 Bounds3f bounds);
     /// Reads and decodes slot `id` (no caching: the base class caches). Adds to `bytes_read`.
     virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
+    /// What slot `id`'s mesh and BVH take once loaded (ResidentBrick::memory_bytes without a
+    /// medium).
+    virtual uint64_t EstimatedMeshBytes(uint32_t id) const = 0;
+    /// Whether the source holds a medium grid cut into its bricks; a message saying why not.
+    virtual Status HasStoredMedium() const {
+        return NotFoundError(
+            "the model holds no medium grid: `nave preprocess` stores one given "
+            "a .vdb file beside the model");
+    }
+    /// Brick `brick`'s piece of it times `scale`, counted inside its cell (null: no voxels there),
+    /// read and decoded; adds to `bytes_read`.
+    virtual StatusOr<std::shared_ptr<const DensityField>> LoadMediumPiece(uint32_t brick,
+                                                                          float scale,
+                                                                          uint64_t* bytes_read) {
+        (void)brick;
+        (void)scale;
+        (void)bytes_read;
+        return std::shared_ptr<const DensityField>();
+    }
+    /// What that piece takes in memory.
+    virtual uint64_t MediumPieceBytes(uint32_t brick) const {
+        (void)brick;
+        return 0;
+    }
     /// Levels brick `brick` has, level 0 included (1: no coarser level).
     virtual uint32_t StoredLevels(uint32_t brick) const {
         (void)brick;
@@ -182,7 +213,8 @@ class BrickSource {
     TraceRecorder* trace_ = nullptr;
     BrickCache* brick_cache_ = nullptr;
     int decode_limit_ = 0;
-    std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
+    std::optional<float> medium_scale_;  // UseStoredMedium's
+    std::mutex decode_mutex_;            // with decode_cv_: counts decodes_ under decode_limit_
     std::condition_variable decode_cv_;
     int decodes_ = 0;
     uint32_t brick_count_ = 0;

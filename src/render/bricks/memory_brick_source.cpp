@@ -47,7 +47,7 @@ float MemoryBrickSource::StoredLevelError(uint32_t brick, uint32_t level) const 
     return level == 0 ? 0.f : levels_[brick][level - 1].error;
 }
 
-uint64_t MemoryBrickSource::EstimatedResidentBytes(uint32_t id) const {
+uint64_t MemoryBrickSource::EstimatedMeshBytes(uint32_t id) const {
     const store::BrickMesh* m = MeshOf(id);
     if (m == nullptr) return 0;
     return ResidentBrick::EstimateMemoryBytes(m->VertexCount(), m->TriangleCount(), m->HasNormals(),
@@ -60,6 +60,17 @@ StatusOr<store::BrickMesh> MemoryBrickSource::LoadMesh(uint32_t id, uint64_t* by
         return NotFoundError("brick {} has no level {}", BrickOfSlot(id), LevelOfSlot(id));
     *bytes_read += m->MemoryBytes();
     return *m;
+}
+
+Status MemoryBrickSource::HasStoredMedium() const {
+    return medium_ ? Status::Ok() : BrickSource::HasStoredMedium();
+}
+
+StatusOr<std::shared_ptr<const DensityField>> MemoryBrickSource::LoadMediumPiece(
+    uint32_t brick, float scale, uint64_t* bytes_read) {
+    (void)bytes_read;
+    return std::shared_ptr<const DensityField>(
+        std::make_shared<CellShare>(medium_, cells()[brick], scale));
 }
 
 }  // namespace nave::render

@@ -24,18 +24,25 @@ class MemoryBrickSource final : public BrickSource {
                       std::vector<store::BrickMesh> meshes,
                       std::vector<store::MaterialRecord> materials,
                       std::vector<std::vector<store::BrickLevel>> levels);
-    uint64_t EstimatedResidentBytes(uint32_t id) const override;
+    /// Holds `whole` as the medium cut into the bricks (UseStoredMedium): each brick's piece is its
+    /// CellShare. Call before UseStoredMedium.
+    void HoldMedium(std::shared_ptr<const DensityField> whole) { medium_ = std::move(whole); }
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+    uint64_t EstimatedMeshBytes(uint32_t id) const override;
     uint32_t StoredLevels(uint32_t brick) const override;
     float StoredLevelError(uint32_t brick, uint32_t level) const override;
+    Status HasStoredMedium() const override;
+    StatusOr<std::shared_ptr<const DensityField>> LoadMediumPiece(uint32_t brick, float scale,
+                                                                  uint64_t* bytes_read) override;
 
   private:
     /// Slot `id`'s mesh, or null for a level its brick lacks.
     const store::BrickMesh* MeshOf(uint32_t id) const;
     std::vector<store::BrickMesh> meshes_;
     std::vector<std::vector<store::BrickLevel>> levels_;  // per brick, coarser levels
+    std::shared_ptr<const DensityField> medium_;          // HoldMedium's
 };
 
 }  // namespace nave::render

@@ -9,6 +9,7 @@
 
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
+#include "src/render/bricks/density_field.h"
 #include "src/render/bricks/embree_device.h"
 #include "src/render/bricks/resident_mesh.h"
 #include "store/brick_mesh.h"
@@ -92,8 +93,18 @@ class ResidentBrick {
     const LevelOfDetail& lod() const { return lod_; }
     const Bounds3f& cell() const { return cell_; }
     const ResidentMesh& mesh() const { return mesh_; }
-    /// Bytes of the mesh plus an estimate of Embree's BVH (for budgets and statistics).
+    /// Bytes of the mesh plus an estimate of Embree's BVH, plus the medium's piece (for budgets
+    /// and statistics).
     uint64_t memory_bytes() const { return memory_bytes_; }
+    /// The brick's piece of a medium stored in the bricks (Medium::DensityIn), counted inside the
+    /// cell only; null when it has none or no such medium is rendered.
+    const DensityField* medium() const { return medium_.get(); }
+    /// Gives the brick its piece of the stored medium, which takes `bytes`. Only its BrickSource
+    /// calls it, before any other thread sees the brick.
+    void AttachMedium(std::shared_ptr<const DensityField> medium, uint64_t bytes) {
+        medium_ = std::move(medium);
+        memory_bytes_ += bytes;
+    }
     /// memory_bytes() of a brick before it is loaded, from its counts (what a store's directory
     /// says). Exact: the pager checks it.
     static uint64_t EstimateMemoryBytes(uint64_t vertex_count, uint64_t triangle_count,
@@ -117,6 +128,7 @@ class ResidentBrick {
     Bounds3f cell_;
     ResidentMesh mesh_;
     void* scene_ = nullptr;  // RTCScene
+    std::shared_ptr<const DensityField> medium_;
     uint64_t memory_bytes_ = 0;
 };
 

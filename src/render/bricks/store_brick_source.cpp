@@ -1,5 +1,6 @@
 #include "src/render/bricks/store_brick_source.h"
 
+#include "src/render/bricks/vdb_density.h"
 #include "store/store_reader.h"
 
 namespace nave::render {
@@ -45,7 +46,7 @@ float StoreBrickSource::StoredLevelError(uint32_t brick, uint32_t level) const {
     return level == 0 ? 0.f : store_->bricks()[brick].levels[level - 1].error;
 }
 
-uint64_t StoreBrickSource::EstimatedResidentBytes(uint32_t id) const {
+uint64_t StoreBrickSource::EstimatedMeshBytes(uint32_t id) const {
     const uint32_t brick = BrickOfSlot(id), level = LevelOfSlot(id);
     if (level >= LevelsOf(brick)) return 0;  // a level this brick lacks: never loaded
     const LevelCounts c = CountsOf(store_->bricks()[brick], level);
@@ -68,6 +69,33 @@ StatusOr<store::BrickMesh> StoreBrickSource::LoadMesh(uint32_t id, uint64_t* byt
     NAVE_ASSIGN_OR_RETURN(store::BrickMesh mesh, store_->ReadBrick(brick, level));
     *bytes_read += CountsOf(store_->bricks()[brick], level).disk_bytes;
     return mesh;
+}
+
+Status StoreBrickSource::HasStoredMedium() const {
+    if (store_->header().medium_grid.empty())
+        return NotFoundError(
+            "{} holds no medium grid: `nave preprocess` stores one given a .vdb file beside the "
+            "model",
+            store_->path().string());
+    return Status::Ok();
+}
+
+StatusOr<std::shared_ptr<const DensityField>> StoreBrickSource::LoadMediumPiece(
+    uint32_t brick, float scale, uint64_t* bytes_read) {
+    const store::BrickInfo& info = store_->bricks()[brick];
+    if (info.medium.grid.length == 0) return std::shared_ptr<const DensityField>();
+    NAVE_ASSIGN_OR_RETURN(const std::vector<std::byte> bytes, store_->ReadBrickMedium(brick));
+    *bytes_read += info.medium.grid.length;
+    NAVE_ASSIGN_OR_RETURN(
+        std::shared_ptr<const VdbDensity> piece,
+        VdbDensity::FromPiece(bytes,
+                              fmt::format("{} brick {} medium", store_->path().string(), brick),
+                              scale, cells()[brick]));
+    return std::shared_ptr<const DensityField>(std::move(piece));
+}
+
+uint64_t StoreBrickSource::MediumPieceBytes(uint32_t brick) const {
+    return store_->bricks()[brick].medium.decoded_bytes;
 }
 
 }  // namespace nave::render

@@ -22,13 +22,17 @@ class StoreBrickSource final : public BrickSource {
                                                             std::shared_ptr<EmbreeDevice> device);
     ~StoreBrickSource() override;
     const store::Store& store() const { return *store_; }
-    uint64_t EstimatedResidentBytes(uint32_t id) const override;
     uint64_t LoadScratchBytes(uint32_t id) const override;
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;
+    uint64_t EstimatedMeshBytes(uint32_t id) const override;
     uint32_t StoredLevels(uint32_t brick) const override;
     float StoredLevelError(uint32_t brick, uint32_t level) const override;
+    Status HasStoredMedium() const override;
+    StatusOr<std::shared_ptr<const DensityField>> LoadMediumPiece(uint32_t brick, float scale,
+                                                                  uint64_t* bytes_read) override;
+    uint64_t MediumPieceBytes(uint32_t brick) const override;
 
   private:
     StoreBrickSource(std::unique_ptr<store::Store> store, std::shared_ptr<EmbreeDevice> device);

@@ -72,9 +72,19 @@ void CameraPaths::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
 
 void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick, RayOutbox& out) {
     if (r.kind == kShadowRay) {
-        const float t1 = SegmentEnd(r, brick);
+        const float t0 = r.t_enter, t1 = SegmentEnd(r, brick);
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
+        if (scene_.medium) {
+            // What the medium lets through from here to the next brick (or the light).
+            const DensityField* field = scene_.medium->DensityIn(&brick);
+            if (field != nullptr) {
+                const float t2 = next == store::kNoBrick ? r.t_max : r.t_enter;
+                r.beta *= scene_.medium->Transmittance(field->Integral(r.origin, r.dir, t0, t2),
+                                                       r.lambda);
+                if (r.beta.IsZero()) return;
+            }
+        }
         if (next == store::kNoBrick) {
             AddShadowContribution(r);  // unoccluded all the way
         } else {
@@ -84,17 +94,17 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
     }
     TraceInBrick(
         r, b, brick, scheduler_, out,
+        [&](RayRecord& path, float t0, float t1) { return FlyTo(path, t0, t1, b, &brick, out); },
         [&](RayRecord& path, const BrickHit& hit) {
             if (scene_.medium) {
-                path.beta *= NoScatterWeight(*scene_.medium, path, hit.t);
-                path.flags &= uint8_t(~kMediumScatter);
+                path.beta *= NoScatterWeight(*scene_.medium, path.lambda, path.flight_depth);
+                path.flight_depth = 0;  // what goes on from the surface is a new flight
             }
             const bool goes_on = ShadePath(path, b, brick, hit, out);
             if (!goes_on && progress_ != nullptr) progress_->Add(1);
-            if (goes_on) StartPathFlight(path);
             return goes_on;
         },
-        [&](const RayRecord& path) { LeaveModel(path, out); });
+        [&](const RayRecord& path) { LeaveModel(path); });
 }
 
 namespace {
@@ -114,34 +124,36 @@ bool SurvivesRoulette(RayRecord& r, const VertexRng& rng) {
 }  // namespace
 
 float CameraPaths::PathFlightDepth(const RayRecord& r) const {
-    // Keyed to the path's vertex, which does not change along the ray's flight: the ray's start
-    // and its scattering draw the same numbers.
+    // Keyed to the path's vertex, which does not change along the ray's flight: every brick the
+    // ray crosses draws the same numbers.
     const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
     return FlightDepth(*scene_.medium, r.lambda, rng.Uniform(kDimFlightChoice),
                        rng.Uniform(kDimFlightDistance));
 }
 
-void CameraPaths::StartPathFlight(RayRecord& r) const {
-    if (!scene_.medium) return;
-    StartFlight(*scene_.medium, PathFlightDepth(r), &r);
+bool CameraPaths::FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
+                        RayOutbox& out) {
+    if (!scene_.medium) return true;
+    const DensityField* field = scene_.medium->DensityIn(brick);
+    if (field == nullptr || !(t1 > t0)) return true;
+    const float t = Fly(field, PathFlightDepth(r), t0, t1, &r);
+    if (!(t < kInfinity)) return true;
+    ScatterInMedium(r, t, b, brick, out);
+    return false;
 }
 
-void CameraPaths::LeaveModel(RayRecord r, RayOutbox& out) {
-    if (scene_.medium) {
-        if (r.flags & kMediumScatter) {
-            ScatterInMedium(r, out);
-            return;
-        }
-        r.beta *= NoScatterWeight(*scene_.medium, r, kInfinity);
-    }
+void CameraPaths::LeaveModel(RayRecord r) {
+    if (scene_.medium) r.beta *= NoScatterWeight(*scene_.medium, r.lambda, r.flight_depth);
     Escape(r);
 }
 
-void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
+void CameraPaths::ScatterInMedium(RayRecord r, float t, uint32_t b, const ResidentBrick* brick,
+                                  RayOutbox& out) {
     const Medium& medium = *scene_.medium;
-    const Vec3f p = r.origin + r.dir * r.t_max;
-    r.beta *= ScatterWeight(medium, r, PathFlightDepth(r));
-    r.flags &= uint8_t(~(kMediumScatter | kSkyShadow));
+    const Vec3f p = r.origin + r.dir * t;
+    r.t_max = t;  // the ray ends at its vertex (the light sampler's cones start there)
+    r.beta *= ScatterWeight(medium, r.lambda, PathFlightDepth(r));
+    r.flags &= uint8_t(~kSkyShadow);
     // As at surfaces (ShadePath): a vertex at max_depth ends the path before it estimates light.
     const auto path_ends = [&] {
         if (progress_ != nullptr) progress_->Add(1);
@@ -153,11 +165,11 @@ void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
     for (size_t i = 0; i < scene_.lights.size(); ++i) {
         if (std::optional<RayRecord> shadow =
                 lights_.SampleLightInMedium(*scene_.lights[i], int(i), p, medium.phase(), r, rng))
-            Spawn(*shadow, store::kNoBrick, nullptr, out);
+            Spawn(*shadow, b, brick, out);
     }
     if (scene_.sky) {
         if (std::optional<RayRecord> shadow = lights_.SampleSkyInMedium(p, medium.phase(), r, rng))
-            Spawn(*shadow, store::kNoBrick, nullptr, out);
+            Spawn(*shadow, b, brick, out);
     }
     // The phase function is sampled exactly: the throughput keeps its value.
     const PhaseSample ps =
@@ -169,7 +181,7 @@ void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
     r.guide_side = kMediumSide;
     r.prev_pdf = ps.pdf;
     // A scattering widens the ray's cone as a diffuse bounce does; it leaves no surface level.
-    r.cone_width = ConeWidthAt(r, r.t_max);
+    r.cone_width = ConeWidthAt(r, t);
     r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
     r.origin_level = 0;
     r.level_reach = 0;
@@ -178,7 +190,7 @@ void CameraPaths::ScatterInMedium(RayRecord r, RayOutbox& out) {
     r.dir = ps.wi;
     r.t_max = kInfinity;
     r.t_enter = r.t_exit = 0;
-    Spawn(r, store::kNoBrick, nullptr, out);
+    Spawn(r, b, brick, out);
 }
 
 void CameraPaths::Escape(const RayRecord& r) {
@@ -252,21 +264,27 @@ bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, f
 
 void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out) {
     ++out.counts.rays;
+    uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
     if (scene_.medium) {
+        // The medium between the ray's origin and its first brick (outside every brick's cell:
+        // only a field that holds everywhere has density there).
+        const float t1 = next == store::kNoBrick ? r.t_max : r.t_enter;
         if (r.kind == kShadowRay) {
-            // What the medium lets through to the light: its density's integral is known at once.
-            r.beta *= scene_.medium->Transmittance(r.origin, r.dir, r.t_max, r.lambda);
-            if (r.beta.IsZero()) return;
+            if (const DensityField* field = scene_.medium->DensityIn(brick)) {
+                r.beta *=
+                    scene_.medium->Transmittance(field->Integral(r.origin, r.dir, 0, t1), r.lambda);
+                if (r.beta.IsZero()) return;
+            }
         } else {
-            StartPathFlight(r);
+            r.flight_depth = 0;
+            if (!FlyTo(r, 0, t1, b, brick, out)) return;
         }
     }
-    uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
     if (next == store::kNoBrick) {
         if (r.kind == kShadowRay) {
             AddShadowContribution(r);
         } else {
-            LeaveModel(r, out);
+            LeaveModel(r);
         }
         return;
     }

@@ -87,19 +87,23 @@ class CameraPaths : public RayProcessor {
     /// A path leaving the model: the sky and the sun it finds, weighted against their next-event
     /// estimation.
     void Escape(const RayRecord& r);
-    /// Path ray `r` at its end without a surface: it scatters in the medium there
-    /// (kMediumScatter) or leaves the model (Escape), weighted for the medium it crossed.
-    void LeaveModel(RayRecord r, RayOutbox& out);
-    /// Samples where path ray `r`, starting now, scatters in the scene's medium (StartFlight);
-    /// nothing without a medium.
-    void StartPathFlight(RayRecord& r) const;
+    /// Path ray `r` at its end without a surface: it leaves the model (Escape), weighted for the
+    /// medium it crossed.
+    void LeaveModel(RayRecord r);
     /// The density's integral at which path ray `r` scatters in the scene's medium (FlightDepth,
-    /// from its vertex's random numbers): what StartPathFlight aimed at, known again without
-    /// walking the medium when the ray gets there.
+    /// from its vertex's random numbers, so known again in every brick the ray crosses).
     float PathFlightDepth(const RayRecord& r) const;
-    /// Path `r` scatters in the medium at its t_max: next-event estimation of the lights and the
-    /// sky through the phase function, then the path goes on in a direction sampled from it.
-    void ScatterInMedium(RayRecord r, RayOutbox& out);
+    /// Flies path ray `r` over [t0, t1] of its ray while it is processed in brick `b` (pinned as
+    /// `brick`; kNoBrick and null outside every brick) through the medium there: true if it gets
+    /// to t1 (its flight_depth grown by what it crossed), false if it scattered on the way and
+    /// went on from there (ScatterInMedium). True at once without a medium.
+    bool FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
+               RayOutbox& out);
+    /// Path `r` scatters in the medium at t = `t` of its ray: next-event estimation of the lights
+    /// and the sky through the phase function, then the path goes on in a direction sampled from
+    /// it. `b` and `brick` as for FlyTo.
+    void ScatterInMedium(RayRecord r, float t, uint32_t b, const ResidentBrick* brick,
+                         RayOutbox& out);
     /// Whether light found by path `r` is a caustic that photon mode's caustic points count
     /// already: a gathering path whose every bounce past its first diffuse vertex was specular
     /// (visible_points.h). Path mode never gathers.

@@ -233,7 +233,7 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                                   std::span<const RayRecord> rays, RayOutbox& out) {
     for (RayRecord r : rays) {
         TraceInBrick(
-            r, brick, resident, scheduler_, out,
+            r, brick, resident, scheduler_, out, FlyThroughNoMedium,
             [&](RayRecord& photon, const BrickHit& hit) {
                 return ShadePhoton(photon, brick, resident, hit);
             },

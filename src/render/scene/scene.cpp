@@ -5,11 +5,11 @@
 
 #include "src/core/log.h"
 #include "src/core/rgb_to_spectrum.h"
+#include "src/render/bricks/vdb_density.h"
 #include "src/render/scene/lights/directional_light.h"
 #include "src/render/scene/lights/point_light.h"
 #include "src/render/scene/lights/spot_light.h"
 #include "src/render/scene/materials/ior.h"
-#include "src/render/scene/media/vdb_density.h"
 #include "src/render/scene/sun/sun.h"
 
 namespace nave::render {
@@ -246,7 +246,12 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
                     config.where, key, spectrum->Evaluate(nm), nm);
     }
     std::shared_ptr<const DensityField> density;
-    if (!config.grid.empty()) {
+    if (config.stored_grid) {
+        // The density comes brick by brick with the bricks (Medium::DensityIn).
+        if (Status s = scene->source->UseStoredMedium(config.density_scale); !s.ok())
+            return Status(s.code(), fmt::format("{}: [medium] grid = \"{}\": {}", config.where,
+                                                kStoredGrid, s.message()));
+    } else if (!config.grid.empty()) {
         StatusOr<std::shared_ptr<const VdbDensity>> grid =
             VdbDensity::Load(config.grid, config.grid_name, config.density_scale);
         if (!grid.ok())

@@ -468,8 +468,17 @@ Status ParseMedium(TableReader& r, MediumConfig* m) {
                 m->where, r.Name(""));
         std::string grid;
         NAVE_RETURN_IF_ERROR(r.String("grid", &grid));
-        m->grid = std::filesystem::path(r.file()).parent_path() / grid;
-        NAVE_RETURN_IF_ERROR(r.String("grid_name", &m->grid_name));
+        if (grid == kStoredGrid) {
+            m->stored_grid = true;
+            if (r.Has("grid_name"))
+                return InvalidArgumentError(
+                    "{}: {}: grid_name names a grid of a .vdb file; grid = \"{}\" is the one "
+                    "grid the store holds",
+                    m->where, r.Name(""), kStoredGrid);
+        } else {
+            m->grid = std::filesystem::path(r.file()).parent_path() / grid;
+            NAVE_RETURN_IF_ERROR(r.String("grid_name", &m->grid_name));
+        }
         NAVE_RETURN_IF_ERROR(r.Float("density_scale", &m->density_scale, 0, 1e9));
     } else if (r.Has("grid_name") || r.Has("density_scale")) {
         return InvalidArgumentError("{}: {}: grid_name and density_scale need a grid", m->where,

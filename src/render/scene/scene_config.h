@@ -122,12 +122,18 @@ struct MaterialConfig {
 };
 
 /// [medium]: a homogeneous participating medium (haze, dust) filling a box, or the model's bounds.
+/// [medium] grid's value that names the grid stored in the bricks rather than a file.
+inline constexpr const char* kStoredGrid = "store";
+
 struct MediumConfig {
     /// box_min, box_max (model units, metres); none: the model's bounds.
     std::optional<Bounds3f> box;
     /// A density grid instead of a box: an OpenVDB file (relative paths from the config's
     /// directory), the float grid's name in it, and a factor on its values.
     std::filesystem::path grid;
+    /// grid = "store" (kStoredGrid): the grid `nave preprocess` cut into the store's bricks, each
+    /// brick's piece loaded and evicted with the brick.
+    bool stored_grid = false;
     std::string grid_name = "density";
     float density_scale = 1.f;
     SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1

@@ -32,9 +32,6 @@ enum RayFlags : uint8_t {
     /// Shadow rays toward the sky (LightSampler::SampleSky) where its windows learn
     /// (LightSampler::sky_windows): the ones that reach it teach them (LearnFromSkyShadow).
     kSkyShadow = 1 << 6,
-    /// Path rays in a medium ([medium]): the ray scatters in it at t_max unless it meets a surface
-    /// first (StartFlight, transport/medium_flight.h).
-    kMediumScatter = 1 << 7,
 };
 
 /// RayRecord::guide_side of a path whose last vertex was a scattering in a medium, which has no
@@ -78,9 +75,14 @@ struct RayRecord {
     uint32_t guide_credit =
         0xffffffffu;  ///< shadow rays of guided paths: PathGuide::CreditKey of the path's
                       ///< previous vertex and direction (PathGuide::kNoCredit: none)
-    float guide_scale =
-        0;  ///< shadow rays of guided paths: the contribution's luminance times this is the
-            ///< credit (1 / (throughput at the vertex * pdf of the direction from the previous))
+    union {
+        /// Shadow rays of guided paths: the contribution's luminance times this is the credit
+        /// (1 / (throughput at the vertex * pdf of the direction from the previous)).
+        float guide_scale = 0;
+        /// Path rays in a medium: the density's integral from the origin to t_enter, the flight
+        /// so far (transport/medium_flight.h), carried from brick to brick.
+        float flight_depth;
+    };
     /// The ray's cone (Amanatides 1984; Akenine-Möller et al. 2019, "Improved shader and texture
     /// level of detail using ray cones"): its footprint is cone_width + cone_spread * t wide at t.
     /// It chooses the level of detail of each brick the ray crosses (level_choice.h).

@@ -248,7 +248,7 @@ RayRecord LightSampler::ShadowFromMedium(const RayRecord& r, const Vec3f& p, con
                                          float t_max) {
     RayRecord s = r;
     s.kind = kShadowRay;
-    s.flags = uint8_t(r.flags & ~(kSkyShadow | kMediumScatter));
+    s.flags = uint8_t(r.flags & ~kSkyShadow);
     s.cone_width = ConeWidthAt(r, r.t_max);
     s.origin_level = 0;
     s.level_reach = 0;

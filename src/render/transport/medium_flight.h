@@ -1,7 +1,7 @@
 #pragma once
-// Paths through a medium (scene/media/medium.h): where a path ray scatters
-// in the medium, sampled when the ray starts, and the weights that make each outcome (a scattering
-// in the medium, a surface reached, the sky reached) an unbiased estimate at every wavelength.
+// Paths through a medium (scene/media/medium.h): where a path ray scatters in the medium, and the
+// weights that make each outcome (a scattering in the medium, a surface reached, the sky reached)
+// an unbiased estimate at every wavelength.
 //
 // The distance to a scattering is drawn from the scattering coefficient σs alone and absorption is
 // carried as a weight, exp(-σa ℓ): survival biasing (Spanier & Gelbard 1969, "Monte Carlo
@@ -15,11 +15,20 @@
 // the ray's origin is D, is ρ mean_j σs_j exp(-σs_j D), and the probability of none before it is
 // mean_j exp(-σs_j D): ρ cancels in every weight, which therefore needs only D (the length inside
 // a homogeneous medium's box; an exact sum over voxels for a grid).
+//
+// A path ray draws, when it starts, the integral D* at which it scatters (FlightDepth), and flies
+// brick by brick: in each, it walks the density that brick holds (Medium::DensityIn, a stored
+// grid's piece or the medium's own field) from where it entered to the next stop (a surface, the
+// next brick, or the end of the model), and scatters where its flight's integral reaches D*. What
+// it carries between bricks is that integral so far (RayRecord::flight_depth), so a grid cut into
+// bricks is never needed whole, and 1 brick or many give the same flights.
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "src/core/spectrum.h"
+#include "src/render/bricks/density_field.h"
 #include "src/render/scene/media/medium.h"
 #include "src/render/stream/ray.h"
 
@@ -27,34 +36,35 @@ namespace nave::render {
 
 /// The density's integral from a path ray's origin to where it scatters, sampled with uniform
 /// numbers `u_choice` (the wavelength of `lambda` whose σs draws it) and `u_distance`: the inverse
-/// of that wavelength's exponential. 0 when that σs is 0 (the ray does not scatter).
+/// of that wavelength's exponential. Infinity when that σs is 0 (the ray does not scatter).
 inline float FlightDepth(const Medium& medium, const SampledWavelengths& lambda, float u_choice,
                          float u_distance) {
     const int j = std::min(int(u_choice * kNumWavelengths), kNumWavelengths - 1);
     const float sigma_s = medium.SigmaS(lambda)[j];
-    if (!(sigma_s > 0)) return 0.f;
+    if (!(sigma_s > 0)) return std::numeric_limits<float>::infinity();
     return -std::log1p(-u_distance) / sigma_s;
 }
 
-/// Samples where path ray `r` (from its origin, up to its t_max) scatters in `medium`: where the
-/// density's integral reaches `depth` (FlightDepth). If before t_max, sets t_max there and
-/// kMediumScatter; else leaves the ray as it is.
-inline void StartFlight(const Medium& medium, float depth, RayRecord* r) {
-    r->flags &= uint8_t(~kMediumScatter);
-    if (!(depth > 0)) return;
-    const float t = medium.density().Reach(r->origin, r->dir, r->t_max, depth);
-    if (!(t < r->t_max)) return;
-    r->t_max = t;
-    r->flags |= kMediumScatter;
+/// Flies path ray `r` over [t0, t1] of its ray through `field` (null: no density there), toward
+/// `target` (its FlightDepth): the t at which its flight's integral reaches `target`, where it
+/// scatters; else infinity, and r->flight_depth grows by what it crossed.
+inline float Fly(const DensityField* field, float target, float t0, float t1, RayRecord* r) {
+    constexpr float kNever = std::numeric_limits<float>::infinity();
+    if (field == nullptr || !(t1 > t0)) return kNever;
+    float walked = 0;
+    const float t = field->Walk(r->origin, r->dir, t0, t1, target - r->flight_depth, &walked);
+    if (t < kNever) return t;
+    r->flight_depth += walked;
+    return kNever;
 }
 
-/// The weight of path ray `r` that reached t = `t_end` (a surface, or infinity: out of the model)
-/// without scattering in `medium`: exp(-σt D) over the probability that no scattering was sampled
-/// before, D the density's integral up to t_end.
-inline SampledSpectrum NoScatterWeight(const Medium& medium, const RayRecord& r, float t_end) {
-    const float depth = medium.density().Integral(r.origin, r.dir, t_end);
+/// The weight of a path ray at `lambda` that crossed `depth` of the density's integral without
+/// scattering (to a surface, or out of the model): exp(-σt D) over the probability that no
+/// scattering was sampled before.
+inline SampledSpectrum NoScatterWeight(const Medium& medium, const SampledWavelengths& lambda,
+                                       float depth) {
     if (depth == 0) return SampledSpectrum(1.f);
-    const SampledSpectrum sigma_t = medium.SigmaT(r.lambda), sigma_s = medium.SigmaS(r.lambda);
+    const SampledSpectrum sigma_t = medium.SigmaT(lambda), sigma_s = medium.SigmaS(lambda);
     SampledSpectrum transmittance;
     float probability = 0;
     for (int i = 0; i < kNumWavelengths; ++i) {
@@ -64,12 +74,12 @@ inline SampledSpectrum NoScatterWeight(const Medium& medium, const RayRecord& r,
     return probability > 0 ? transmittance / probability : SampledSpectrum(0.f);
 }
 
-/// The weight of path ray `r` that scatters in `medium` at its t_max (kMediumScatter), `depth` of
-/// the density's integral from its origin (the FlightDepth that StartFlight reached): σs exp(-σt D)
-/// over the density with which the scattering was sampled there (the medium's density at the point
-/// cancels).
-inline SampledSpectrum ScatterWeight(const Medium& medium, const RayRecord& r, float depth) {
-    const SampledSpectrum sigma_t = medium.SigmaT(r.lambda), sigma_s = medium.SigmaS(r.lambda);
+/// The weight of a path ray at `lambda` that scatters in the medium `depth` of the density's
+/// integral from its origin (its FlightDepth): σs exp(-σt D) over the density with which the
+/// scattering was sampled there (the medium's density at the point cancels).
+inline SampledSpectrum ScatterWeight(const Medium& medium, const SampledWavelengths& lambda,
+                                     float depth) {
+    const SampledSpectrum sigma_t = medium.SigmaT(lambda), sigma_s = medium.SigmaS(lambda);
     SampledSpectrum transmittance;
     float density = 0;
     for (int i = 0; i < kNumWavelengths; ++i) {

@@ -183,35 +183,42 @@ inline float SegmentEnd(const RayRecord& r, const ResidentBrick& brick) {
 /// Traces a path or photon ray `r` inside brick `b` (pinned as `brick`) from its segment there. At
 /// each hit, `shade(r, hit)` scatters the ray in place and returns whether it goes on. A ray that
 /// goes on inside the cell is traced on at once, without queueing; one whose next segment lies in
-/// another brick is sent to `out`; one that leaves the model goes to `escape(r)`.
-template <typename Shade, typename Escape>
+/// another brick is sent to `out`; one that leaves the model goes to `escape(r)`. Every stretch
+/// [t0, t1] of the ray it crosses without meeting a surface (to a hit, to the next brick's
+/// segment, or to the end) is first given to `fly(r, t0, t1)`, which returns false if the ray
+/// ended or went on elsewhere on the way (a scattering in a medium).
+template <typename Fly, typename Shade, typename Escape>
 void TraceInBrick(RayRecord& r, uint32_t b, const ResidentBrick& brick,
-                  const StreamScheduler& scheduler, RayOutbox& out, Shade&& shade,
+                  const StreamScheduler& scheduler, RayOutbox& out, Fly&& fly, Shade&& shade,
                   Escape&& escape) {
+    // Sends `r`, whose next stop Route found (`next`), on from t = `from`.
+    const auto go_on = [&](uint32_t next, float from) {
+        if (!fly(r, from, next == store::kNoBrick ? r.t_max : r.t_enter)) return false;
+        if (next == store::kNoBrick) {
+            escape(r);
+            return false;
+        }
+        if (next == b) return true;  // still in this brick: keep tracing without queueing
+        out.Send(next, b, r);
+        return false;
+    };
     for (;;) {
         const float t1 = SegmentEnd(r, brick);
         ++out.counts.segments_traced;
         BrickHit hit;
         if (!brick.Intersect(r.origin, r.dir, SegmentStart(r, brick), t1, &hit)) {
-            const uint32_t next = scheduler.Route(r, r.t_exit, b);
-            if (next == store::kNoBrick) {
-                escape(r);
-            } else {
-                out.Send(next, b, r);
-            }
+            const float from = r.t_enter;
+            go_on(scheduler.Route(r, r.t_exit, b), from);  // never b again: Route skips it
             return;
         }
+        if (!fly(r, r.t_enter, hit.t)) return;
         if (!shade(r, hit)) return;
         ++out.counts.rays;
-        const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);
-        if (next == store::kNoBrick) {
-            escape(r);
-            return;
-        }
-        if (next == b) continue;  // still in this brick: keep tracing without queueing
-        out.Send(next, b, r);
-        return;
+        if (!go_on(scheduler.Route(r, 0, store::kNoBrick), 0)) return;
     }
 }
+
+/// TraceInBrick's `fly` for rays that cross no medium (photons).
+inline bool FlyThroughNoMedium(RayRecord&, float, float) { return true; }
 
 }  // namespace nave::render

@@ -4,9 +4,7 @@
 
 namespace nave::render {
 
-SampledSpectrum Medium::Transmittance(const Vec3f& o, const Vec3f& d, float t_max,
-                                      const SampledWavelengths& lambda) const {
-    const float depth = density_->Integral(o, d, t_max);
+SampledSpectrum Medium::Transmittance(float depth, const SampledWavelengths& lambda) const {
     if (depth == 0) return SampledSpectrum(1.f);
     const SampledSpectrum sigma_t = SigmaT(lambda);
     SampledSpectrum t;
