@@ -33,7 +33,8 @@ Status CheckMediumGrid(const std::filesystem::path& file, const std::string& gri
     // No boxes: the plugin checks the file, the grid's type and transform, and counts its voxels.
     return AsBadData(
         plugin
-            ->CutScalarGrid(file, grid, {}, [](size_t, volumes::GridPiece) { return Status::Ok(); })
+            ->CutScalarGrid(file, grid, {},
+                            [](size_t, const volumes::GridPiece&) { return Status::Ok(); })
             .status());
 }
 

@@ -19,7 +19,7 @@ if ((${#targets[@]} == 0)); then
   # inputs within seconds; nave isolates that (fuzz_assimp_isolated). docs/fuzzing.md runs it
   # separately, past those crashes.
   targets=(fuzz_obj fuzz_ply fuzz_stl fuzz_gltf fuzz_assimp_isolated fuzz_model_wire fuzz_store
-           fuzz_scene_config)
+           fuzz_vdb fuzz_scene_config)
 fi
 
 bash scripts/setup-debian.sh clang libclang-rt-14-dev  # clang 14, its sanitizer and libFuzzer runtimes (Debian 12)
@@ -96,6 +96,10 @@ seed() {
         { printf '\0'; cat "$f"; } >"$dir/raw_$(basename "$f")"
         { printf '\1'; cat "$f"; } >"$dir/resealed_$(basename "$f")"
       done ;;
+    fuzz_vdb)
+      # Coarse dust (a few KiB each): two voxel sizes, two layouts of leaves.
+      build/asan/src/cli/nave generate dust --voxel 8 -o "$dir/dust8.vdb" >/dev/null 2>&1
+      build/asan/src/cli/nave generate dust --voxel 4 --seed 3 -o "$dir/dust4.vdb" >/dev/null 2>&1 ;;
     fuzz_scene_config) cp configs/*.toml tests/fixtures/scenes/*.toml "$dir/" ;;
     *) echo "fuzz.sh: unknown target $target" >&2; exit 2 ;;
   esac

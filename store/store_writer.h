@@ -113,7 +113,7 @@ class StoreWriter {
     /// Names the medium's density grid (format 3.3) whose pieces AppendMedium adds: the store then
     /// has a medium table (StoreHeader::medium_grid), even if no piece is appended. Call it once,
     /// before AppendMedium; InvalidArgument for an empty name or a second call.
-    Status SetMediumGrid(const std::string& name);
+    Status SetMediumGrid(const std::string& grid);
     /// Appends the piece of the medium of brick `id` (appended before; at most one piece a brick):
     /// its section goes after the payloads so far. InvalidArgument for an unknown brick, a second
     /// piece, no SetMediumGrid, no bytes or voxels, or a majorant that is not finite and >= 0. Not

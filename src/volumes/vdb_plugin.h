@@ -31,8 +31,9 @@ class ScalarGrid {
     virtual uint64_t memory_bytes() const = 0;
     /// Active voxels (those of active tiles included): GridPiece::active_voxels of a piece read.
     virtual uint64_t active_voxels() const = 0;
-    /// Calls `visit(t0, t1, value)` for every voxel the ray o + t d (d unit) crosses with t in
-    /// [t_begin, t_end] (world units), front to back, until it returns false.
+    /// Calls `visit(t0, t1, value)` for the voxels the ray o + t d (d unit) crosses with t in
+    /// [t_begin, t_end] (world units), front to back, until it returns false: every voxel of the
+    /// active leaves and tiles it crosses; voxels elsewhere are 0 and skipped.
     virtual void March(const Vec3f& o, const Vec3f& d, float t_begin, float t_end,
                        const std::function<bool(float, float, float)>& visit) const = 0;
 };

@@ -101,7 +101,10 @@ TEST_F(VdbCut, PiecesHoldTheVoxelsWhoseCellsOverlapTheirBoxAndReadBack) {
     EXPECT_EQ(summary->bounds, Bounds3f(Vec3f(0, 0, 0), Vec3f(5, 3, 2)));
     EXPECT_EQ(pieces_.size(), 3u) << "the box away from the grid gets no piece";
 
-    for (const auto& [b, piece] : pieces_) {
+    for (const auto& entry : pieces_) {
+        // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
+        const size_t b = entry.first;
+        const GridPiece& piece = entry.second;
         SCOPED_TRACE(::testing::Message() << "box " << b);
         EXPECT_EQ(piece.active_voxels, expected[b]);
         EXPECT_EQ(piece.max_value, expected_max[b]);
@@ -152,7 +155,7 @@ TEST_F(VdbCut, EmitErrorStopsTheCut) {
     int calls = 0;
     auto summary = plugin_->CutScalarGrid(
         file_, "density", std::vector<Bounds3f>(3, Bounds3f(Vec3f(0, 0, 0), Vec3f(5, 5, 5))),
-        [&](size_t, GridPiece) {
+        [&](size_t, const GridPiece&) {
             ++calls;
             return IoError("disk full");
         });

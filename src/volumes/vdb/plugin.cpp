@@ -8,6 +8,7 @@
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/RayIntersector.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +23,10 @@ namespace nave::volumes::vdb {
 namespace {
 
 using RayD = openvdb::math::Ray<double>;
+/// Finds the spans of a ray that cross active leaves (8^3 voxels) or tiles: OpenVDB's hierarchical
+/// DDA (Museth 2014, "Hierarchical digital differential analyzer for efficient ray-marching in
+/// OpenVDB", SIGGRAPH Talks) over a boolean copy of the grid's topology.
+using ActiveSpans = openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid, /*NodeLevel=*/0, RayD>;
 
 /// A float grid whose transform is a uniform scale and a translation (checked when read).
 class VdbScalarGrid final : public ScalarGrid {
@@ -36,32 +41,45 @@ class VdbScalarGrid final : public ScalarGrid {
                            Vec3f(float(std::max(lo.x(), hi.x())), float(std::max(lo.y(), hi.y())),
                                  float(std::max(lo.z(), hi.z()))));
         voxel_m_ = grid_->voxelSize().x();
+        // An empty grid has no spans (and the intersector refuses it).
+        if (!grid_->empty()) spans_ = std::make_unique<const ActiveSpans>(*grid_);
     }
 
     Bounds3f bounds() const override { return bounds_; }
-    uint64_t memory_bytes() const override { return uint64_t(grid_->memUsage()); }
+    uint64_t memory_bytes() const override {
+        return uint64_t(grid_->memUsage()) + (spans_ ? uint64_t(spans_->tree().memUsage()) : 0);
+    }
     uint64_t active_voxels() const override { return uint64_t(grid_->activeVoxelCount()); }
 
     void March(const Vec3f& o, const Vec3f& d, float t_begin, float t_end,
                const std::function<bool(float, float, float)>& visit) const override {
-        if (!(t_end > t_begin)) return;
+        if (!(t_end > t_begin) || !spans_) return;
         // In index space, shifted by half a voxel so that the cell a point lies in is the floor
-        // of its coordinates (the DDA's convention). Index time is world time / voxel size.
+        // of its coordinates (the convention of OpenVDB's DDA and of the intersector's node
+        // boxes). Index time is world time / voxel size.
         const openvdb::Vec3d eye =
             grid_->worldToIndex(openvdb::Vec3d(o.x, o.y, o.z)) + openvdb::Vec3d(0.5);
-        const RayD ray(eye, openvdb::Vec3d(d.x, d.y, d.z), t_begin / voxel_m_, t_end / voxel_m_);
-        openvdb::math::DDA<RayD, 0> dda(ray);
+        const openvdb::Vec3d dir(d.x, d.y, d.z);
+        // A shallow copy per call: its accessor is not thread-safe, the topology is shared.
+        ActiveSpans spans(*spans_);
+        if (!spans.setIndexRay(RayD(eye, dir, t_begin / voxel_m_, t_end / voxel_m_))) return;
         auto accessor = grid_->getConstAccessor();
-        do {
-            const double t0 = dda.time(), t1 = dda.next();
-            if (t1 > t0 &&
-                !visit(float(t0 * voxel_m_), float(t1 * voxel_m_), accessor.getValue(dda.voxel())))
-                return;
-        } while (dda.step());
+        double s0 = 0, s1 = 0;
+        // Only the spans across active leaves and tiles hold density: voxel by voxel there.
+        while (spans.march(s0, s1)) {
+            openvdb::math::DDA<RayD, 0> dda(RayD(eye, dir, s0, s1));
+            do {
+                const double t0 = dda.time(), t1 = dda.next();
+                if (t1 > t0 && !visit(float(t0 * voxel_m_), float(t1 * voxel_m_),
+                                      accessor.getValue(dda.voxel())))
+                    return;
+            } while (dda.step());
+        }
     }
 
   private:
     openvdb::FloatGrid::ConstPtr grid_;
+    std::unique_ptr<const ActiveSpans> spans_;
     Bounds3f bounds_;
     double voxel_m_ = 1;
 };
@@ -282,7 +300,7 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
         }
         out.active_voxels = piece->activeVoxelCount();
         if (out.active_voxels == 0) continue;
-        out.memory_bytes = piece->memUsage();
+        out.memory_bytes = VdbScalarGrid(piece).memory_bytes();
         std::ostringstream bytes(std::ios::binary);
         openvdb::io::Stream(bytes).write(openvdb::GridCPtrVec{piece});
         const std::string serialized = std::move(bytes).str();
