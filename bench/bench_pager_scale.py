@@ -18,6 +18,9 @@ on stdout, a Markdown table for the docs. Render numbers (wall, brick loads, byt
     /usr/bin/python3 bench/bench_pager_scale.py --lod --resolution 480x320 --budgets 2G,1G
     /usr/bin/python3 bench/bench_pager_scale.py --detail 1 --resolution 160x107 --spp 1 --budgets 600M,500M \
         --views nave
+    # the dust cut into the bricks, rendered from them:
+    /usr/bin/python3 bench/bench_pager_scale.py --medium configs/dust.vdb --config configs/abbey_dust.toml \
+        --store /tmp/nave-scale/abbey110-dust.nave --resolution 480x320 --budgets 2G
 
 The default case needs about 3 minutes of both cores for the store (docs/preprocess.md) and a few minutes per
 view and budget for the renders; the small one above checks the script in a minute. A budget nave refuses (too
@@ -51,6 +54,9 @@ def main():
     ap.add_argument("--detail", type=int, default=110, help="abbey detail (110: 88 M triangles)")
     ap.add_argument("--store", help="the store to reuse or generate (default: DIR/abbey<detail>.nave)")
     ap.add_argument("--preprocess-memory", default="4G", help="--memory of nave preprocess")
+    ap.add_argument("--medium", default="",
+                    help="a .vdb given to nave preprocess beside the abbey (cut into the bricks); the --config's "
+                         "[medium] grid then becomes \"store\" (configs/abbey_dust.toml)")
     ap.add_argument("--config", default="configs/abbey.toml")
     ap.add_argument("--resolution", default="640x427")
     ap.add_argument("--spp", type=int, default=4)
@@ -86,7 +92,7 @@ def main():
         # nave writes the store under a temporary name and renames it when complete, so an interrupted run
         # leaves nothing here to be mistaken for a store next time.
         cmd = [args.nave, "preprocess", "--generate", f"abbey:detail={args.detail}", "--memory",
-               args.preprocess_memory, "-o", store]
+               args.preprocess_memory, "-o", store] + ([args.medium] if args.medium else [])
         if args.lod:
             cmd += ["--levels"] + (["--level-errors", args.level_errors] if args.level_errors else [])
         p = nave_bench.run_timed(cmd, log)
@@ -95,6 +101,10 @@ def main():
         print(f"preprocess: {p.elapsed_s:.1f} s, peak RSS {gib(p.peak_rss_bytes)}", file=sys.stderr)
 
     base_text = open(args.config).read()
+    if args.medium:
+        base_text, n = re.subn(r'(?m)^grid = ".*"$', 'grid = "store"', base_text)
+        if n != 1:
+            sys.exit(f"--medium: {args.config} has no [medium] grid = \"...\" line to point at the store")
 
     def render_once(view, lod, budget):
         label = f"{view}-{lod}-{budget or 'in-core'}"

@@ -63,7 +63,9 @@ class VdbScalarGrid final : public ScalarGrid {
         // A shallow copy per call: its accessor is not thread-safe, the topology is shared.
         ActiveSpans spans(*spans_);
         if (!spans.setIndexRay(RayD(eye, dir, t_begin / voxel_m_, t_end / voxel_m_))) return;
-        auto accessor = grid_->getConstAccessor();
+        // Unregistered: the grid never changes, and a registered accessor would lock the tree's
+        // table of accessors on every ray (TBB's concurrent_hash_map).
+        auto accessor = grid_->getConstUnsafeAccessor();
         double s0 = 0, s1 = 0;
         // Only the spans across active leaves and tiles hold density: voxel by voxel there.
         while (spans.march(s0, s1)) {
@@ -399,7 +401,8 @@ class Plugin final : public VdbPlugin {
         transform->postTranslate(openvdb::Vec3d(origin.x + 0.5 * voxel_m, origin.y + 0.5 * voxel_m,
                                                 origin.z + 0.5 * voxel_m));
         grid->setTransform(transform);
-        auto accessor = grid->getAccessor();
+        // Unregistered: nothing else touches the grid while it is filled.
+        auto accessor = grid->getUnsafeAccessor();
         for (int k = 0; k < dims.z; ++k)
             for (int j = 0; j < dims.y; ++j)
                 for (int i = 0; i < dims.x; ++i)
