@@ -240,17 +240,21 @@ max_depth = 1
 }
 
 // Inside a closed sphere of albedo 0.5 emitting 0.5 (radiance 1 everywhere, render_test.cpp's
-// furnace) a medium that scatters and does not absorb changes nothing: L stays 1.
+// furnace) a medium that scatters and does not absorb changes nothing: L stays 1. In photon mode
+// too: photons fly and scatter in the medium (their power weighted as paths' throughput is), and
+// camera paths scatter in it and gather the photons where they reach a surface.
 TEST_F(MediumRenderTest, AWhiteFurnaceFilledWithAScatteringMediumStaysAtOne) {
-    const auto t = Render(testing::FurnaceMesh(), {"shell"},
-                          fmt::format(fmt::runtime(testing::kFurnace), "path") + R"(
+    for (const auto& [mode, tolerance] : {std::pair{"path", 0.03}, {"photon", 0.02}}) {
+        const auto t = Render(testing::FurnaceMesh(), {"shell"},
+                              fmt::format(fmt::runtime(testing::kFurnace), mode) + R"(
 [medium]
 sigma_s = 1.5
 g = 0.5
 )",
-                          2);
-    ASSERT_TRUE(t);
-    EXPECT_NEAR(MeanY(*t->film), 1.0, 0.03);
+                              2);
+        ASSERT_TRUE(t);
+        EXPECT_NEAR(MeanY(*t->film), 1.0, tolerance) << mode;
+    }
 }
 
 TEST(MediumConfigTest, BadMediaAreNamed) {
@@ -275,7 +279,7 @@ TEST(MediumConfigTest, BadMediaAreNamed) {
     EXPECT_EQ(error("extinction = 0.02\nalbedo = 0.9"), "");
 }
 
-TEST_F(MediumRenderTest, PhotonModeAndNegativeCoefficientsAreRefused) {
+TEST_F(MediumRenderTest, MediaBeyondTheModelInPhotonModeAndNegativeCoefficientsAreRefused) {
     store::BrickMesh mesh;
     AppendQuad(&mesh, {3, 0, 0}, {0, 0, 2}, {0, 2, 0}, 2, 0);
     auto build_error = [&](const std::string& medium, const std::string& mode) {
@@ -290,7 +294,12 @@ TEST_F(MediumRenderTest, PhotonModeAndNegativeCoefficientsAreRefused) {
             *config);
         return scene.ok() ? std::string() : std::string(scene.status().message());
     };
-    EXPECT_NE(build_error("sigma_s = 0.1", "photon").find("path mode"), std::string::npos);
+    // Photon mode: inside the model's box (its default), not beyond it.
+    EXPECT_EQ(build_error("sigma_s = 0.1", "photon"), "");
+    const std::string beyond =
+        build_error("sigma_s = 0.1\nbox_min = [0, -1, -1]\nbox_max = [5, 1, 1]", "photon");
+    EXPECT_NE(beyond.find("beyond the model's box"), std::string::npos) << beyond;
+    EXPECT_NE(beyond.find("haze.toml"), std::string::npos) << beyond;
     EXPECT_NE(build_error("sigma_s = -0.1", "path").find("medium.sigma_s is -0.1"),
               std::string::npos);
     EXPECT_NE(build_error("extinction = 0.1\nalbedo = 1.2", "path").find("medium.albedo is 1.2"),

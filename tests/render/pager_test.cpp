@@ -64,12 +64,14 @@ std::unique_ptr<BrickSource> BallGridSource() {
 }
 
 /// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
-/// and its guide, or "path_haze": path with a medium over the model).
+/// and its guide, or "path_haze" and "photon_haze": with a medium over the model).
 SceneConfig BallGridConfig(const std::string& mode) {
-    const bool gather = mode == "photon_gather", haze = mode == "path_haze";
-    const std::string text =
-        fmt::format(fmt::runtime(kBallGrid), gather ? "photon" : (haze ? "path" : mode)) +
-        (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
+    const bool gather = mode == "photon_gather",
+               haze = mode == "path_haze" || mode == "photon_haze";
+    const std::string base =
+        gather || mode == "photon_haze" ? "photon" : (mode == "path_haze" ? "path" : mode);
+    const std::string text = fmt::format(fmt::runtime(kBallGrid), base) +
+                             (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
     auto config = ParseSceneConfig(text, "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     if (!config.ok()) return SceneConfig();
@@ -171,6 +173,11 @@ TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path",
 
 // A medium's scatterings happen in whichever brick a ray's free flight ends, resident or not.
 TEST_F(PagerTest, PagedRenderEqualsInCorePathInHaze) { ExpectPagedEqualsInCore("path_haze", 1e-9); }
+
+// Photons too scatter in whichever brick their flight ends.
+TEST_F(PagerTest, PagedRenderEqualsInCorePhotonInHaze) {
+    ExpectPagedEqualsInCore("photon_haze", 1e-9);
+}
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }
 

@@ -175,21 +175,11 @@ void CameraPaths::ScatterInMedium(RayRecord r, float t, uint32_t b, const Reside
     const PhaseSample ps =
         medium.phase().Sample(r.dir, Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)));
     if (!SurvivesRoulette(r, rng)) return path_ends();
-    r.vertex += 1;
-    r.depth += 1;
-    r.flags &= uint8_t(~kSpecularBounce);
     r.guide_side = kMediumSide;
     r.prev_pdf = ps.pdf;
-    // A scattering widens the ray's cone as a diffuse bounce does; it leaves no surface level.
-    r.cone_width = ConeWidthAt(r, t);
-    r.cone_spread = std::max(r.cone_spread, kScatteredConeSpread);
-    r.origin_level = 0;
-    r.level_reach = 0;
-    r.origin = p;
-    r.since_vertex = 0;
-    r.dir = ps.wi;
-    r.t_max = kInfinity;
-    r.t_enter = r.t_exit = 0;
+    // Photon mode's gathering paths: a scattering is no specular bounce (CausticFromPhotons).
+    if (r.flags & kGathering) r.flags = ExtendSpecularChain(r.flags, false);
+    LeaveMediumVertex(&r, t, ps.wi);
     Spawn(r, b, brick, out);
 }
 

@@ -9,6 +9,7 @@
 #include "src/core/log.h"
 #include "src/core/progress.h"
 #include "src/render/scene/surface_hit.h"
+#include "src/render/transport/medium_flight.h"
 #include "src/render/transport/rng.h"
 #include "src/render/transport/transport_common.h"
 
@@ -134,7 +135,13 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
     NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
         *this, photons, wave, StreamScheduler::LastWave::kDrained,
         [&](uint64_t first, uint64_t last) {
-            emitters_->EmitPhotons(first, last, iteration_, visible_->radius(), scheduler_);
+            emitters_->EmitPhotons(first, last, iteration_, visible_->radius(), scheduler_,
+                                   [&](RayRecord& r, RayOutbox& out) {
+                                       // Through empty cells only: a medium there may still
+                                       // scatter it toward a brick.
+                                       r.flags &= uint8_t(~kFlightFromOrigin);
+                                       FlyPhoton(r, 0, r.t_max, store::kNoBrick, nullptr, out);
+                                   });
             return Status::Ok();
         }));
     if (ranks != nullptr) NAVE_RETURN_IF_ERROR(ShareLearning(*ranks));
@@ -232,13 +239,64 @@ std::array<double, 2> SppmIntegrator::HalfLuminances(uint32_t pixel, int iterati
 void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                                   std::span<const RayRecord> rays, RayOutbox& out) {
     for (RayRecord r : rays) {
+        if (r.flags & kFlightFromOrigin) {
+            // The stretch before the first brick lies in empty cells of the model or outside it,
+            // where only a medium that holds everywhere has density (and, in photon mode, only
+            // inside the model's box: MakeMedium).
+            r.flags &= uint8_t(~kFlightFromOrigin);
+            if (!FlyPhoton(r, 0, r.t_enter, brick, &resident, out)) continue;
+        }
         TraceInBrick(
-            r, brick, resident, scheduler_, out, FlyThroughNoMedium,
+            r, brick, resident, scheduler_, out,
+            [&](RayRecord& photon, float t0, float t1) {
+                return FlyPhoton(photon, t0, t1, brick, &resident, out);
+            },
             [&](RayRecord& photon, const BrickHit& hit) {
+                if (scene_.medium) {
+                    photon.beta *=
+                        NoScatterWeight(*scene_.medium, photon.lambda, photon.flight_depth);
+                    photon.flight_depth = 0;  // what goes on from the surface is a new flight
+                }
                 return ShadePhoton(photon, brick, resident, hit);
             },
             [](const RayRecord&) {});  // photons leaving the model carry nothing back
     }
+}
+
+bool SppmIntegrator::FlyPhoton(RayRecord& r, float t0, float t1, uint32_t b,
+                               const ResidentBrick* brick, RayOutbox& out) {
+    if (!scene_.medium) return true;
+    const Medium& medium = *scene_.medium;
+    const DensityField* field = medium.DensityIn(brick);
+    if (field == nullptr || !(t1 > t0)) return true;
+    // The photon stream's flight dimensions, which no surface vertex uses (as a path's).
+    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration_, kStreamPhoton));
+    const float depth = FlightDepth(medium, r.lambda, rng.Uniform(kDimFlightChoice),
+                                    rng.Uniform(kDimFlightDistance));
+    const float t = Fly(field, depth, t0, t1, &r);
+    if (!(t < kInfinity)) return true;
+    // A scattering in the air: the photon's power takes the scattering's weight (absorption on
+    // the way included), Russian roulette on its change as at surfaces, and the phase function
+    // samples where it goes. Photons are stored on surfaces only: the light a camera path's
+    // medium vertex scatters comes from next-event estimation there and from the photons at the
+    // surface its continuation reaches (docs/render.md, "Participating media").
+    if (uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth)) return false;
+    const SampledSpectrum w = ScatterWeight(medium, r.lambda, depth);
+    const float q = std::max(0.f, 1 - w.Average());
+    if (rng.Uniform(kDimRoulette) < q) return false;
+    r.beta *= w / (1 - q);
+    if (r.beta.IsZero()) return false;
+    const PhaseSample ps =
+        medium.phase().Sample(r.dir, Point2f(rng.Uniform(kDimBsdf0), rng.Uniform(kDimBsdf1)));
+    r.flags = ExtendSpecularChain(r.flags, /*specular=*/false);
+    LeaveMediumVertex(&r, t, ps.wi);
+    ++out.counts.rays;
+    const uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
+    // The stretch from the vertex to the next brick is this brick's to fly (it may scatter again).
+    if (!FlyPhoton(r, 0, next == store::kNoBrick ? r.t_max : r.t_enter, b, brick, out))
+        return false;
+    if (next != store::kNoBrick) out.Send(next, b, r);
+    return false;
 }
 
 void SppmIntegrator::LearnWindow(const RayRecord& r, const SurfaceHit& h) {

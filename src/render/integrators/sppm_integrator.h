@@ -53,6 +53,12 @@ class SppmIntegrator final : public Integrator, public RayProcessor {
                    std::unique_ptr<PathGuide> gather_guide);
     /// Shades a photon hit: deposit at visible points, continue by BSDF sampling.
     bool ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& brick, const BrickHit& hit);
+    /// Flies photon `r` over [t0, t1] of its ray in brick `b` (pinned as `brick`; kNoBrick and
+    /// null outside every brick) through the scene's medium, as camera paths fly
+    /// (CameraPaths::FlyTo): true if it gets to t1, false if it scattered on the way and went on
+    /// from there (or ended). True at once without a medium.
+    bool FlyPhoton(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
+                   RayOutbox& out);
     /// A sky photon at its first diffuse hit `h`: teaches the sky's next-event estimation which
     /// window lights that region (SkyWindows).
     void LearnWindow(const RayRecord& r, const SurfaceHit& h);

@@ -1,5 +1,7 @@
 #include "src/render/scene/scene.h"
 
+#include <fmt/ostream.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -215,13 +217,8 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
 namespace {
 
 /// The scene's medium from [medium] (the model's bounds when it gives no box). Errors: negative
-/// coefficients, a medium in photon mode, an empty model without a box.
+/// coefficients, a medium beyond the model's box in photon mode, an empty model without a box.
 Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
-    if (scene->settings.mode == RenderSettings::Mode::kPhoton)
-        return InvalidArgumentError(
-            "{}: [medium] is rendered in path mode (render.mode = \"path\"): photon mode does not "
-            "trace photons through media",
-            config.where);
     Spectrum sigma_a = ToSpectrum(config.sigma_a), sigma_s = ToSpectrum(config.sigma_s);
     if (config.extinction_albedo) {
         const Spectrum sigma_t = ToSpectrum(config.extinction_albedo->first);
@@ -264,6 +261,19 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
             return InvalidArgumentError(
                 "{}: [medium] has no box_min/box_max and the model is empty", config.where);
         density = std::make_shared<BoxDensity>(box);
+    }
+    if (density && scene->settings.mode == RenderSettings::Mode::kPhoton) {
+        // Photons fly only from the first brick they enter (they start far outside the model):
+        // a medium beyond the model's box would dim them by how far away they were started.
+        const Bounds3f model = scene->source->bounds(), b = density->bounds();
+        const float slack = 1e-4f * Length(model.Diagonal());
+        for (int a = 0; a < 3; ++a)
+            if (b.min[a] < model.min[a] - slack || b.max[a] > model.max[a] + slack)
+                return InvalidArgumentError(
+                    "{}: [medium] spans {}, beyond the model's box {}: photon mode needs the "
+                    "medium "
+                    "inside it (give box_min/box_max inside it, or render.mode = \"path\")",
+                    config.where, fmt::streamed(b), fmt::streamed(model));
     }
     scene->medium = std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g);
     return Status::Ok();

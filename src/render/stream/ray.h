@@ -32,6 +32,9 @@ enum RayFlags : uint8_t {
     /// Shadow rays toward the sky (LightSampler::SampleSky) where its windows learn
     /// (LightSampler::sky_windows): the ones that reach it teach them (LearnFromSkyShadow).
     kSkyShadow = 1 << 6,
+    /// Photons in a medium: the stretch from the photon's origin (far outside the model) to the
+    /// first brick it enters is still to be flown, by that brick (SppmIntegrator::ProcessBatch).
+    kFlightFromOrigin = 1 << 7,
 };
 
 /// RayRecord::guide_side of a path whose last vertex was a scattering in a medium, which has no

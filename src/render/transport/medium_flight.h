@@ -30,6 +30,7 @@
 #include "src/core/spectrum.h"
 #include "src/render/bricks/density_field.h"
 #include "src/render/scene/media/medium.h"
+#include "src/render/stream/level_choice.h"
 #include "src/render/stream/ray.h"
 
 namespace nave::render {
@@ -87,6 +88,25 @@ inline SampledSpectrum ScatterWeight(const Medium& medium, const SampledWaveleng
         density += sigma_s[i] * std::exp(-sigma_s[i] * depth) / kNumWavelengths;
     }
     return density > 0 ? sigma_s * transmittance / density : SampledSpectrum(0.f);
+}
+
+/// Moves path or photon `r`, which scatters in the medium at t = `t` of its ray, on toward `wi`
+/// (sampled from the phase function): its next vertex and a new flight. A scattering widens the
+/// ray's cone as a diffuse bounce does, and leaves no surface level behind.
+inline void LeaveMediumVertex(RayRecord* r, float t, const Vec3f& wi) {
+    r->vertex += 1;
+    r->depth += 1;
+    r->flags &= uint8_t(~kSpecularBounce);
+    r->cone_width = ConeWidthAt(*r, t);
+    r->cone_spread = std::max(r->cone_spread, kScatteredConeSpread);
+    r->origin_level = 0;
+    r->level_reach = 0;
+    r->origin = r->origin + r->dir * t;
+    r->since_vertex = 0;
+    r->dir = wi;
+    r->t_max = std::numeric_limits<float>::infinity();
+    r->t_enter = r->t_exit = 0;
+    r->flight_depth = 0;
 }
 
 }  // namespace nave::render

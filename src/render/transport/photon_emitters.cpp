@@ -249,8 +249,9 @@ Status PhotonEmitters::LoadState(ByteReader* in) {
     return in->ExpectEnd();
 }
 
-void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, float footprint,
-                                 StreamScheduler& scheduler) {
+void PhotonEmitters::EmitPhotons(
+    uint64_t first, uint64_t last, uint32_t iteration, float footprint, StreamScheduler& scheduler,
+    const std::function<void(RayRecord&, RayOutbox&)>& meets_no_brick) {
     const float disk_area = kPi * scene_radius_ * scene_radius_;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(first, last, 1024), [&](const auto& range) {
         RayOutbox out;
@@ -334,15 +335,21 @@ void PhotonEmitters::EmitPhotons(uint64_t first, uint64_t last, uint32_t iterati
                 r.beta = s.power;
             }
             r.flags = e.flags;
+            // Through a medium from where it starts (the first brick it enters flies it there).
+            if (scene_.medium) r.flags |= kFlightFromOrigin;
             r.beta /= p_choice;
             if (r.beta.IsZero()) continue;
 
             // In a distributed render the process owning the photon's first brick traces it.
             if (!scheduler.MakesHere(r, i)) continue;
-            // Queued at the first brick along it; a photon that misses the model carries nothing.
+            // Queued at the first brick along it.
             ++out.counts.rays;
             const uint32_t next = scheduler.Route(r, 0, store::kNoBrick);
-            if (next != store::kNoBrick) out.Send(next, store::kNoBrick, r);
+            if (next != store::kNoBrick) {
+                out.Send(next, store::kNoBrick, r);
+            } else if (meets_no_brick) {
+                meets_no_brick(r, out);
+            }
         }
         scheduler.Flush(out);
     });

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "src/core/vecmath.h"
 #include "src/render/scene/lights/triangle_light.h"
 #include "src/render/scene/scene.h"
+#include "src/render/stream/stream_scheduler.h"
 #include "src/render/transport/light_sampling.h"
 #include "src/render/transport/photon_guide.h"
 #include "src/render/transport/photon_portals.h"
@@ -37,9 +39,12 @@ class PhotonEmitters {
 
     /// Queues photons [first, last) of SPPM iteration `iteration` through `scheduler`, on all
     /// threads; each photon carries its own wavelengths. `footprint`: the width of each photon's
-    /// cone (ray.h), the iteration's gather radius: a photon stands for the light within it.
+    /// cone (ray.h), the iteration's gather radius: a photon stands for the light within it. A
+    /// photon that meets no brick goes to `meets_no_brick` if given (in a medium it may still
+    /// scatter toward one), else it carries nothing.
     void EmitPhotons(uint64_t first, uint64_t last, uint32_t iteration, float footprint,
-                     StreamScheduler& scheduler);
+                     StreamScheduler& scheduler,
+                     const std::function<void(RayRecord&, RayOutbox&)>& meets_no_brick = {});
     /// After a photon pass: learns where the sun's photons are worth starting (photon_guide.h) from
     /// deposited[k], the luminance photon k brought to the visible points in fixed point
     /// (`fixed_per_luminance` units to one), for the first learned_photons() photons of the pass.

@@ -34,7 +34,7 @@ enum RngDim : uint32_t {
     kDimLens0,
     kDimLens1,
     kDimLambda,
-    // The path stream, as a ray starts: where it scatters in a medium (StartFlight).
+    // The path stream, as a ray starts: where it scatters in a medium (FlightDepth).
     kDimFlightChoice = 5,
     kDimFlightDistance,
     // Every scattering vertex: BSDF lobe and direction, Russian roulette.
@@ -217,8 +217,5 @@ void TraceInBrick(RayRecord& r, uint32_t b, const ResidentBrick& brick,
         if (!go_on(scheduler.Route(r, 0, store::kNoBrick), 0)) return;
     }
 }
-
-/// TraceInBrick's `fly` for rays that cross no medium (photons).
-inline bool FlyThroughNoMedium(RayRecord&, float, float) { return true; }
 
 }  // namespace nave::render
