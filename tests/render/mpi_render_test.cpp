@@ -360,22 +360,25 @@ TEST_F(MpiRender, AGridStoredInTheBricksGivesTheSingleProcessImage) {
     EXPECT_EQ(a, Rgb(*dir_ / "dust2.exr"));
 }
 
-// The abbey in haze (a medium over the church): a path's scattering in the air happens on the
-// rank whose brick its free flight ends in, and its rays go on as any other. One process's image,
-// bit for bit.
+// The abbey in haze (a medium over the church): a path's or a photon's scattering in the air
+// happens on the rank whose brick its free flight ends in, and its rays go on as any other. One
+// process's image, bit for bit, in both modes.
 TEST_F(MpiRender, AMediumGivesTheSingleProcessImage) {
-    auto render = [&](const std::string& out) {
-        return std::string(NAVE_BINARY) + " render " + Store() + " -c " + NAVE_SOURCE_DIR +
-               "/configs/abbey_haze.toml --resolution 64x48 --spp 2 -q -o " +
-               (*dir_ / out).string();
-    };
-    const test::CommandResult one = Shell(render("haze1.exr"));
-    ASSERT_EQ(one.exit_code, 0) << one.output;
-    const test::CommandResult two = Shell(Mpirun(2) + render("haze2.exr"));
-    ASSERT_EQ(two.exit_code, 0) << two.output;
-    const std::vector<float> a = Rgb(*dir_ / "haze1.exr"), b = Rgb(*dir_ / "haze2.exr");
-    ASSERT_FALSE(a.empty());
-    EXPECT_EQ(a, b);
+    for (const std::string mode : {"path", "photon"}) {
+        auto render = [&](const std::string& out) {
+            return std::string(NAVE_BINARY) + " render " + Store() + " -c " + NAVE_SOURCE_DIR +
+                   "/configs/abbey_haze.toml --mode " + mode +
+                   " --resolution 64x48 --spp 2 --iterations 2 --photons 20000 -q -o " +
+                   (*dir_ / out).string();
+        };
+        const test::CommandResult one = Shell(render("haze1.exr"));
+        ASSERT_EQ(one.exit_code, 0) << one.output;
+        const test::CommandResult two = Shell(Mpirun(2) + render("haze2.exr"));
+        ASSERT_EQ(two.exit_code, 0) << two.output;
+        const std::vector<float> a = Rgb(*dir_ / "haze1.exr"), b = Rgb(*dir_ / "haze2.exr");
+        ASSERT_FALSE(a.empty());
+        EXPECT_EQ(a, b) << mode;
+    }
 }
 
 // Photon mode: each rank makes the visible points of its own bricks and sends each to the ranks
