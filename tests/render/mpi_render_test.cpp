@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <sstream>
 #include <string>
@@ -95,6 +96,21 @@ class MpiRender : public ::testing::Test {
                                                      const std::string& flags,
                                                      const std::string& progress,
                                                      std::vector<std::string>* outputs);
+    /// Runs `render(out)`, a command that writes the image `out`, as one process and as 2 ranks
+    /// (`stem`1.exr, `stem`2.exr), and expects the same RGB, bit for bit. Returns the one
+    /// process's (empty if a run failed: the test has failed then).
+    static std::vector<float> ExpectTwoRanksAsOneProcess(
+        const std::function<std::string(const std::string&)>& render, const std::string& stem) {
+        const test::CommandResult one = Shell(render(stem + "1.exr"));
+        EXPECT_EQ(one.exit_code, 0) << one.output;
+        const test::CommandResult two = Shell(Mpirun(2) + render(stem + "2.exr"));
+        EXPECT_EQ(two.exit_code, 0) << two.output;
+        if (one.exit_code != 0 || two.exit_code != 0) return {};
+        const std::vector<float> a = Rgb(*dir_ / (stem + "1.exr"));
+        EXPECT_FALSE(a.empty()) << stem;
+        EXPECT_EQ(a, Rgb(*dir_ / (stem + "2.exr"))) << stem;
+        return a;
+    }
     static fs::path* dir_;
 };
 fs::path* MpiRender::dir_ = nullptr;
@@ -312,13 +328,7 @@ TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
         return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() +
                " --mode path --lod auto --resolution 64x48 --spp 2 -q -o " + (*dir_ / out).string();
     };
-    const test::CommandResult one = Shell(render("levels1.exr"));
-    ASSERT_EQ(one.exit_code, 0) << one.output;
-    const test::CommandResult two = Shell(Mpirun(2) + render("levels2.exr"));
-    ASSERT_EQ(two.exit_code, 0) << two.output;
-    const std::vector<float> a = Rgb(*dir_ / "levels1.exr"), b = Rgb(*dir_ / "levels2.exr");
-    ASSERT_FALSE(a.empty());
-    EXPECT_EQ(a, b);
+    ExpectTwoRanksAsOneProcess(render, "levels");
 }
 
 // Drifting dust cut into the bricks by preprocess (grid = "store"): each brick's piece comes with
@@ -347,17 +357,13 @@ TEST_F(MpiRender, AGridStoredInTheBricksGivesTheSingleProcessImage) {
                (*dir_ / "dusty.toml").string() + " --resolution 64x48 --spp 2 " + flags + " -o " +
                (*dir_ / out).string();
     };
-    const test::CommandResult one = Shell(render("dust1.exr"));
-    ASSERT_EQ(one.exit_code, 0) << one.output;
+    const std::vector<float> a = ExpectTwoRanksAsOneProcess(
+        [&](const std::string& out) { return render(out, "-q"); }, "dust");
+    ASSERT_FALSE(a.empty());
     const test::CommandResult paged = Shell(render("dust_paged.exr", "--memory 300M"));
     ASSERT_EQ(paged.exit_code, 0) << paged.output;
     EXPECT_NE(paged.output.find("evictions"), std::string::npos) << paged.output;
-    const test::CommandResult two = Shell(Mpirun(2) + render("dust2.exr", "-q"));
-    ASSERT_EQ(two.exit_code, 0) << two.output;
-    const std::vector<float> a = Rgb(*dir_ / "dust1.exr");
-    ASSERT_FALSE(a.empty());
     EXPECT_EQ(a, Rgb(*dir_ / "dust_paged.exr"));
-    EXPECT_EQ(a, Rgb(*dir_ / "dust2.exr"));
 }
 
 // The abbey in haze (a medium over the church): a path's or a photon's scattering in the air
@@ -371,13 +377,7 @@ TEST_F(MpiRender, AMediumGivesTheSingleProcessImage) {
                    " --resolution 64x48 --spp 2 --iterations 2 --photons 20000 -q -o " +
                    (*dir_ / out).string();
         };
-        const test::CommandResult one = Shell(render("haze1.exr"));
-        ASSERT_EQ(one.exit_code, 0) << one.output;
-        const test::CommandResult two = Shell(Mpirun(2) + render("haze2.exr"));
-        ASSERT_EQ(two.exit_code, 0) << two.output;
-        const std::vector<float> a = Rgb(*dir_ / "haze1.exr"), b = Rgb(*dir_ / "haze2.exr");
-        ASSERT_FALSE(a.empty());
-        EXPECT_EQ(a, b) << mode;
+        ExpectTwoRanksAsOneProcess(render, "haze_" + mode);
     }
 }
 

@@ -75,16 +75,10 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
         const float t0 = r.t_enter, t1 = SegmentEnd(r, brick);
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
-        if (scene_.medium) {
-            // What the medium lets through from here to the next brick (or the light).
-            const DensityField* field = scene_.medium->DensityIn(&brick);
-            if (field != nullptr) {
-                const float t2 = next == store::kNoBrick ? r.t_max : r.t_enter;
-                r.beta *= scene_.medium->Transmittance(field->Integral(r.origin, r.dir, t0, t2),
-                                                       r.lambda);
-                if (r.beta.IsZero()) return;
-            }
-        }
+        // What the medium lets through from here to the next brick (or the light).
+        if (!DimShadowRay(scene_.medium.get(), &brick, t0,
+                          next == store::kNoBrick ? r.t_max : r.t_enter, &r))
+            return;
         if (next == store::kNoBrick) {
             AddShadowContribution(r);  // unoccluded all the way
         } else {
@@ -96,10 +90,7 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
         r, b, brick, scheduler_, out,
         [&](RayRecord& path, float t0, float t1) { return FlyTo(path, t0, t1, b, &brick, out); },
         [&](RayRecord& path, const BrickHit& hit) {
-            if (scene_.medium) {
-                path.beta *= NoScatterWeight(*scene_.medium, path.lambda, path.flight_depth);
-                path.flight_depth = 0;  // what goes on from the surface is a new flight
-            }
+            EndFlightAtSurface(scene_.medium.get(), &path);
             const bool goes_on = ShadePath(path, b, brick, hit, out);
             if (!goes_on && progress_ != nullptr) progress_->Add(1);
             return goes_on;
@@ -136,9 +127,10 @@ bool CameraPaths::FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const Resi
     if (!scene_.medium) return true;
     const DensityField* field = scene_.medium->DensityIn(brick);
     if (field == nullptr || !(t1 > t0)) return true;
-    const float t = Fly(field, PathFlightDepth(r), t0, t1, &r);
+    const float depth = PathFlightDepth(r);
+    const float t = Fly(field, depth, t0, t1, &r);
     if (!(t < kInfinity)) return true;
-    ScatterInMedium(r, t, b, brick, out);
+    ScatterInMedium(r, t, depth, b, brick, out);
     return false;
 }
 
@@ -147,12 +139,12 @@ void CameraPaths::LeaveModel(RayRecord r) {
     Escape(r);
 }
 
-void CameraPaths::ScatterInMedium(RayRecord r, float t, uint32_t b, const ResidentBrick* brick,
-                                  RayOutbox& out) {
+void CameraPaths::ScatterInMedium(RayRecord r, float t, float depth, uint32_t b,
+                                  const ResidentBrick* brick, RayOutbox& out) {
     const Medium& medium = *scene_.medium;
     const Vec3f p = r.origin + r.dir * t;
     r.t_max = t;  // the ray ends at its vertex (the light sampler's cones start there)
-    r.beta *= ScatterWeight(medium, r.lambda, PathFlightDepth(r));
+    r.beta *= ScatterWeight(medium, r.lambda, depth);
     r.flags &= uint8_t(~kSkyShadow);
     // As at surfaces (ShadePath): a vertex at max_depth ends the path before it estimates light.
     const auto path_ends = [&] {
@@ -260,11 +252,7 @@ void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, Ray
         // only a field that holds everywhere has density there).
         const float t1 = next == store::kNoBrick ? r.t_max : r.t_enter;
         if (r.kind == kShadowRay) {
-            if (const DensityField* field = scene_.medium->DensityIn(brick)) {
-                r.beta *=
-                    scene_.medium->Transmittance(field->Integral(r.origin, r.dir, 0, t1), r.lambda);
-                if (r.beta.IsZero()) return;
-            }
+            if (!DimShadowRay(scene_.medium.get(), brick, 0, t1, &r)) return;
         } else {
             r.flight_depth = 0;
             if (!FlyTo(r, 0, t1, b, brick, out)) return;

@@ -99,10 +99,11 @@ class CameraPaths : public RayProcessor {
     /// went on from there (ScatterInMedium). True at once without a medium.
     bool FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
                RayOutbox& out);
-    /// Path `r` scatters in the medium at t = `t` of its ray: next-event estimation of the lights
-    /// and the sky through the phase function, then the path goes on in a direction sampled from
-    /// it. `b` and `brick` as for FlyTo.
-    void ScatterInMedium(RayRecord r, float t, uint32_t b, const ResidentBrick* brick,
+    /// Path `r` scatters in the medium at t = `t` of its ray, where its flight reached `depth` (its
+    /// PathFlightDepth): next-event estimation of the lights and the sky through the phase
+    /// function, then the path goes on in a direction sampled from it. `b` and `brick` as for
+    /// FlyTo.
+    void ScatterInMedium(RayRecord r, float t, float depth, uint32_t b, const ResidentBrick* brick,
                          RayOutbox& out);
     /// Whether light found by path `r` is a caustic that photon mode's caustic points count
     /// already: a gathering path whose every bounce past its first diffuse vertex was specular

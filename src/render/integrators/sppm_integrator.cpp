@@ -252,11 +252,7 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                 return FlyPhoton(photon, t0, t1, brick, &resident, out);
             },
             [&](RayRecord& photon, const BrickHit& hit) {
-                if (scene_.medium) {
-                    photon.beta *=
-                        NoScatterWeight(*scene_.medium, photon.lambda, photon.flight_depth);
-                    photon.flight_depth = 0;  // what goes on from the surface is a new flight
-                }
+                EndFlightAtSurface(scene_.medium.get(), &photon);
                 return ShadePhoton(photon, brick, resident, hit);
             },
             [](const RayRecord&) {});  // photons leaving the model carry nothing back

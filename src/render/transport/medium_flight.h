@@ -90,6 +90,26 @@ inline SampledSpectrum ScatterWeight(const Medium& medium, const SampledWaveleng
     return density > 0 ? sigma_s * transmittance / density : SampledSpectrum(0.f);
 }
 
+/// Path or photon `r` reaching a surface without scattering in `medium` (null: none): its weight
+/// for the flight (NoScatterWeight), and what goes on from the surface is a new flight.
+inline void EndFlightAtSurface(const Medium* medium, RayRecord* r) {
+    if (medium == nullptr) return;
+    r->beta *= NoScatterWeight(*medium, r->lambda, r->flight_depth);
+    r->flight_depth = 0;
+}
+
+/// Dims shadow ray `r` by what `medium` (null: none) lets through over [t0, t1] of its ray while it
+/// is processed in `brick` (null: outside every brick; Medium::DensityIn). False if nothing is
+/// left of it.
+inline bool DimShadowRay(const Medium* medium, const ResidentBrick* brick, float t0, float t1,
+                         RayRecord* r) {
+    if (medium == nullptr) return true;
+    const DensityField* field = medium->DensityIn(brick);
+    if (field == nullptr) return true;
+    r->beta *= medium->Transmittance(field->Integral(r->origin, r->dir, t0, t1), r->lambda);
+    return !r->beta.IsZero();
+}
+
 /// Moves path or photon `r`, which scatters in the medium at t = `t` of its ray, on toward `wi`
 /// (sampled from the phase function): its next vertex and a new flight. A scattering widens the
 /// ray's cone as a diffuse bounce does, and leaves no surface level behind.
