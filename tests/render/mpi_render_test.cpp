@@ -106,7 +106,7 @@ class MpiRender : public ::testing::Test {
         const test::CommandResult two = Shell(Mpirun(2) + render(stem + "2.exr"));
         EXPECT_EQ(two.exit_code, 0) << two.output;
         if (one.exit_code != 0 || two.exit_code != 0) return {};
-        const std::vector<float> a = Rgb(*dir_ / (stem + "1.exr"));
+        std::vector<float> a = Rgb(*dir_ / (stem + "1.exr"));
         EXPECT_FALSE(a.empty()) << stem;
         EXPECT_EQ(a, Rgb(*dir_ / (stem + "2.exr"))) << stem;
         return a;
