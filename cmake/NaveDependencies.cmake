@@ -46,6 +46,15 @@ else()
   message(STATUS "nave: MPI not found: nave renders as one process")
 endif()
 
+# Open CASCADE (libocct-data-exchange-dev, libocct-modeling-algorithms-dev): STEP and IGES files, in
+# the plugin preprocess/import/cad. Optional: without it those formats are off and nave says so.
+find_package(OpenCASCADE CONFIG QUIET)
+if(OpenCASCADE_FOUND)
+  message(STATUS "nave: Open CASCADE ${OpenCASCADE_VERSION} found: STEP and IGES import on")
+else()
+  message(STATUS "nave: Open CASCADE not found: STEP and IGES import off (scripts/setup-debian.sh installs it)")
+endif()
+
 if(NAVE_BUILD_TESTS)
   find_package(GTest REQUIRED)
   include(GoogleTest)

@@ -74,6 +74,14 @@ uint64_t MergedSource::progress_done() const {
     return done;
 }
 
+std::string MergedSource::progress_unit() const {
+    std::string unit = sources_.empty() ? "bytes" : sources_[0]->progress_unit();
+    for (const auto& s : sources_) {
+        if (s->progress_unit() != unit) return "units";
+    }
+    return unit;
+}
+
 uint64_t MergedSource::progress_total() const {
     uint64_t total = 0;
     for (const auto& s : sources_) total += s->progress_total();

@@ -21,6 +21,8 @@ class MergedSource final : public TriangleSource {
     std::string units() const override;
     uint64_t progress_done() const override;
     uint64_t progress_total() const override;
+    /// The inputs' unit when they share one, else "units" (their sum is only a rough guide).
+    std::string progress_unit() const override;
     uint64_t memory_bytes() const override;
     const ImportWarnings& warnings() const override { return warnings_; }
 

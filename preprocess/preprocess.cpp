@@ -69,7 +69,7 @@ class TextureFolderGuard {
 StatusOr<std::unique_ptr<TriangleSource>> OpenSource(const PreprocessOptions& options,
                                                      const PreprocessPlan& plan) {
     if (!options.generate.empty()) return OpenGenerator(options.generate, plan.generator_producers);
-    return OpenModels(plan.models);
+    return OpenModels(plan.models, options.precision);
 }
 
 /// Phase 1: streams the source into the partitioner's root bin, then takes its materials (and a
@@ -82,8 +82,7 @@ Status ReadIntoRootBin(std::unique_ptr<TriangleSource> source, const PreprocessO
     stats->units = source->units();
     const auto start = Clock::now();
     {
-        ProgressBar bar("read", source->progress_total(),
-                        source->units() == "m" && !options.generate.empty() ? "parts" : "bytes");
+        ProgressBar bar("read", source->progress_total(), source->progress_unit());
         NAVE_RETURN_IF_ERROR(partitioner.Bin(*source, bar));
         bar.Finish();
     }

@@ -53,6 +53,9 @@ class TriangleSource {
     /// the total (0 if unknown), for progress bars.
     virtual uint64_t progress_done() const = 0;
     virtual uint64_t progress_total() const = 0;
+    /// What progress counts, for the bar: "bytes" (streamed files), "triangles" (models read
+    /// whole, or tessellated), "parts" (the abbey).
+    virtual std::string progress_unit() const { return "bytes"; }
 
     /// Memory the source itself holds (OBJ and PLY vertex arrays grow with the input; glTF and
     /// Assimp hold the whole model), in bytes, for the memory budget and the summary.

@@ -102,6 +102,10 @@ seed() {
       # Coarse dust (a few KiB each): two voxel sizes, two layouts of leaves.
       build/asan/src/cli/nave generate dust --voxel 8 -o "$dir/dust8.vdb" >/dev/null 2>&1
       build/asan/src/cli/nave generate dust --voxel 4 --seed 3 -o "$dir/dust4.vdb" >/dev/null 2>&1 ;;
+    fuzz_cad)
+      # First byte: even STEP, odd IGES (fuzz_cad.cpp); the files the CAD tests write.
+      for f in tests/fixtures/models/cad/*.step; do { printf '\0'; cat "$f"; } >"$dir/$(basename "$f")"; done
+      for f in tests/fixtures/models/cad/*.igs; do { printf '\1'; cat "$f"; } >"$dir/$(basename "$f")"; done ;;
     fuzz_scene_config) cp configs/*.toml tests/fixtures/scenes/*.toml "$dir/" ;;
     *) echo "fuzz.sh: unknown target $target" >&2; exit 2 ;;
   esac

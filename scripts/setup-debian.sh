@@ -21,7 +21,8 @@ packages=(
   libcli11-dev             # CLI11: command-line parsing
   libspdlog-dev libfmt-dev # logging and formatting
   libtinygltf-dev          # glTF 2.0 / GLB import
-  libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS...)
+  libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS, DXF...)
+  libocct-data-exchange-dev libocct-modeling-algorithms-dev  # Open CASCADE: STEP and IGES, tessellated
   libopenmpi-dev openmpi-bin  # Open MPI: the distributed render under mpirun (docs/distributed.md)
 )
 

@@ -84,6 +84,7 @@ class AbbeySource final : public TriangleSource {
     }
     uint64_t progress_done() const override { return parts_done_.load(); }
     uint64_t progress_total() const override { return parts_.size(); }
+    std::string progress_unit() const override { return "parts"; }
     uint64_t memory_bytes() const override {
         // Waiting batches (BufferCap() for the parts ahead, kQueueBatches for the current one), one
         // being filled per producer, and the consumer's two.

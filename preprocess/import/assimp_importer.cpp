@@ -11,22 +11,15 @@
 namespace nave::preprocess {
 namespace {
 
-// The child's exit codes: 0 sends the model; kErrorExitBase + a StatusCode sends Assimp's own error
-// message. Anything else (an abort, a segfault, a library calling exit) is a crash.
-constexpr int kErrorExitBase = 64;
-
-// The child: reads the model with Assimp and writes it, or the error, to `fd`.
+// The child: reads the model with Assimp and writes it, or the error, to `fd`
+// (ReportStatusFromChild: anything but those two ends, an abort or a segfault, is a crash).
 int ReadInChild(const std::filesystem::path& path, int fd) {
     StatusOr<ImportedModel> model = ReadWithAssimpInProcess(path);
-    if (!model.ok()) {
-        const std::string& message = model.status().message();
-        WriteAllToFd(fd, message.data(), message.size());
-        return kErrorExitBase + int(model.status().code());
-    }
+    if (!model.ok()) return ReportStatusFromChild(fd, model.status());
     const std::string bytes = EncodeImportedModel(*model);
     return WriteAllToFd(fd, bytes.data(), bytes.size())
                ? 0
-               : kErrorExitBase + int(StatusCode::kIoError);
+               : ReportStatusFromChild(fd, IoError("{}: cannot send the model", path.string()));
 }
 
 // How long Assimp may take on a file: generous for what its slowest readers do with a valid file
@@ -75,18 +68,13 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenWithAssimp(const std::filesystem::
             kAssimpSecondsPerMiB);
     }
     if (!child.exited || child.exit_code != 0) {
-        const int code = child.exit_code - kErrorExitBase;
-        if (child.exited && code > int(StatusCode::kOk) && code <= int(StatusCode::kInternal)) {
-            return Status(StatusCode(code), child.output);
-        }
-        const std::string how = child.exited
-                                    ? fmt::format("exited with code {}", child.exit_code)
-                                    : fmt::format("crashed ({})", DescribeSignal(child.signal));
+        Status reported;
+        if (ChildReportedStatus(child, &reported)) return reported;
         const std::string said = LastLine(child.stderr_tail);
         return DataLossError(
             "{}: the Assimp importer {} reading this file; the file is damaged or uses something "
             "{} cannot read: repair or re-export it (glTF, OBJ and PLY are read by nave itself){}",
-            path.string(), how, AssimpVersion(),
+            path.string(), DescribeChildEnd(child), AssimpVersion(),
             said.empty() ? "" : " (Assimp said: " + said + ")");
     }
     NAVE_ASSIGN_OR_RETURN(ImportedModel model, DecodeImportedModel(child.output, path.string()));

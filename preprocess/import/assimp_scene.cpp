@@ -1,11 +1,17 @@
 #include "preprocess/import/assimp_scene.h"
 
 #include <assimp/cimport.h>
+#include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/version.h>
 #include <fmt/format.h>
+
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <map>
 
 namespace nave::preprocess {
 
@@ -14,11 +20,77 @@ std::string AssimpVersion() {
                        aiGetVersionPatch());
 }
 
+namespace {
+
+// DXF: one material per layer and colour (Assimp gives each layer as a mesh named after it, and
+// each entity's colour, from its ACI index or the layer's, as vertex colours), named after the
+// layer; a layer of several colours gets "layer #2"... for the second. Meshes are split by colour
+// so that every triangle keeps its own.
+void TakeDxfLayersAsMaterials(const aiScene& scene, ImportedModel& model) {
+    std::vector<IndexedMesh> split;
+    std::vector<store::MaterialRecord> materials;
+    std::map<std::pair<std::string, std::array<int, 3>>, uint32_t> index;
+    std::map<std::string, int> colours_per_layer;
+    size_t kept = 0;
+    for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
+        const aiMesh* src = scene.mMeshes[mi];
+        if ((src->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+        IndexedMesh& mesh = model.meshes[kept++];
+        const std::string layer = src->mName.length > 0 ? src->mName.C_Str() : "0";
+        std::map<uint32_t, IndexedMesh> by_material;
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            std::array<int, 3> rgb{-1, -1, -1};
+            std::array<float, 3> diffuse{0.8f, 0.8f, 0.8f};
+            const uint32_t first = mesh.indices[t];
+            if (src->mColors[0] != nullptr && first < src->mNumVertices) {
+                const aiColor4D& c = src->mColors[0][first];
+                diffuse = {c.r, c.g, c.b};
+                for (int k = 0; k < 3; ++k) rgb[k] = int(std::lround(diffuse[k] * 255.f));
+            }
+            auto [it, added] = index.try_emplace({layer, rgb}, uint32_t(materials.size()));
+            if (added) {
+                store::MaterialRecord m;
+                const int nth = ++colours_per_layer[layer];
+                m.name = nth == 1 ? layer : fmt::format("{} #{}", layer, nth);
+                m.diffuse = diffuse;
+                materials.push_back(std::move(m));
+            }
+            IndexedMesh& part = by_material[it->second];
+            // Positions are copied per triangle: a DXF face owns its corners anyway.
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t v = mesh.indices[t + k];
+                part.indices.push_back(uint32_t(part.positions.size()));
+                part.positions.push_back(v < mesh.positions.size() ? mesh.positions[v] : Vec3f());
+                if (!mesh.normals.empty()) {
+                    part.normals.push_back(v < mesh.normals.size() ? mesh.normals[v] : Vec3f());
+                }
+            }
+        }
+        for (auto& [material, part] : by_material) {
+            part.material = material;
+            part.where = fmt::format("{} layer '{}'", mesh.where, layer);
+            split.push_back(std::move(part));
+        }
+    }
+    model.meshes = std::move(split);
+    model.materials = std::move(materials);
+}
+
+}  // namespace
+
 StatusOr<ImportedModel> ReadWithAssimpInProcess(const std::filesystem::path& path) {
     // Triangulate polygons, bake node transforms into world-space meshes, drop points and lines.
     const unsigned flags =
         aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-    const aiScene* scene = aiImportFile(path.c_str(), flags);
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const bool dxf = ext == ".dxf";
+    // A DXF file's layers are Assimp's meshes (named after them) under one default material:
+    // baking the transforms must not join them, so that each layer can become a material.
+    aiPropertyStore* properties = aiCreatePropertyStore();
+    aiSetImportPropertyInteger(properties, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, dxf ? 1 : 0);
+    const aiScene* scene = aiImportFileExWithProperties(path.c_str(), flags, nullptr, properties);
+    aiReleasePropertyStore(properties);
     if (scene == nullptr) {
         return InvalidArgumentError("{}: Assimp cannot read it: {}", path.string(),
                                     aiGetErrorString());
@@ -86,6 +158,7 @@ StatusOr<ImportedModel> ReadWithAssimpInProcess(const std::filesystem::path& pat
         }
         meshes.push_back(std::move(out));
     }
+    if (dxf) TakeDxfLayersAsMaterials(*scene, model);
     return model;
 }
 

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "preprocess/import/assimp_importer.h"
+#include "preprocess/import/cad_importer.h"
 #include "preprocess/import/gltf_importer.h"
 #include "preprocess/import/obj_importer.h"
 #include "preprocess/import/ply_importer.h"
@@ -31,7 +32,8 @@ std::string Sniff(const std::filesystem::path& path) {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path) {
+StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path,
+                                                    double precision) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
     if (std::filesystem::file_size(path, ec) == 0 && !ec) {
@@ -42,22 +44,33 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path&
     if (ext == ".ply") return OpenPly(path);
     if (ext == ".stl") return OpenStl(path);
     if (ext == ".gltf" || ext == ".glb") return OpenGltf(path);
+    if (IsCadFile(path)) return OpenCad(path, precision);
     std::string head = Sniff(path);
+    // DWG is Autodesk's closed format: no library in Debian reads it. Its files start with the
+    // AutoCAD release ("AC1032" for AutoCAD 2018).
+    if (ext == ".dwg" || (head.rfind("AC10", 0) == 0 && head.size() >= 6 &&
+                          std::isdigit(static_cast<unsigned char>(head[4])) != 0)) {
+        return UnsupportedError(
+            "{}: a DWG drawing, which nave cannot read (no open library reads DWG): export it "
+            "from AutoCAD or its viewer as DXF (3D faces or meshes), or as STEP, IFC or OBJ, and "
+            "give nave that file",
+            path.string());
+    }
     if (head.rfind("ply", 0) == 0) return OpenPly(path);
     if (head.rfind("glTF", 0) == 0) return OpenGltf(path);
     if (!ext.empty() && AssimpSupports(path)) return OpenWithAssimp(path);
     return UnsupportedError(
-        "{}: unknown model format '{}': nave reads .obj, .ply, .stl, .gltf, .glb and what "
-        "Assimp reads (.fbx, .dae, .3ds, ...)",
+        "{}: unknown model format '{}': nave reads .obj, .ply, .stl, .gltf, .glb, .step, .stp, "
+        ".iges, .igs and what Assimp reads (.fbx, .dae, .3ds, .dxf, ...)",
         path.string(), ext.empty() ? "(none)" : ext);
 }
 
 StatusOr<std::unique_ptr<TriangleSource>> OpenModels(
-    const std::vector<std::filesystem::path>& paths) {
+    const std::vector<std::filesystem::path>& paths, double precision) {
     if (paths.empty()) return InvalidArgumentError("no input model given");
     std::vector<std::unique_ptr<TriangleSource>> sources;
     for (const auto& p : paths) {
-        NAVE_ASSIGN_OR_RETURN(auto source, OpenModel(p));
+        NAVE_ASSIGN_OR_RETURN(auto source, OpenModel(p, precision));
         sources.push_back(std::move(source));
     }
     return std::unique_ptr<TriangleSource>(new MergedSource(std::move(sources)));

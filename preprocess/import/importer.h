@@ -10,12 +10,15 @@
 
 namespace nave::preprocess {
 
-/// Opens one model file: .obj, .ply, .stl (streamed), .gltf/.glb (tinygltf), anything Assimp reads.
-/// Errors: NotFound, Unsupported (unknown format, naming the extension and the formats nave reads).
-StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path);
+/// Opens one model file: .obj, .ply, .stl (streamed), .gltf/.glb (tinygltf), .step/.stp/.iges/.igs
+/// (Open CASCADE, tessellated for a store grid step of `precision` metres, 0 for the default:
+/// cad_importer.h), anything Assimp reads. Errors: NotFound, Unsupported (unknown format, naming
+/// the extension and the formats nave reads; a DWG file, naming DXF as the way in).
+StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path& path,
+                                                    double precision = 0);
 
 /// Opens every input and merges them (material names made unique).
 StatusOr<std::unique_ptr<TriangleSource>> OpenModels(
-    const std::vector<std::filesystem::path>& paths);
+    const std::vector<std::filesystem::path>& paths, double precision = 0);
 
 }  // namespace nave::preprocess

@@ -44,7 +44,20 @@ uint64_t IndexedMeshSource::memory_bytes() const {
 
 StatusOr<bool> IndexedMeshSource::Next(std::vector<Triangle>& batch, size_t max_triangles) {
     batch.clear();
-    while (batch.size() < max_triangles && mesh_ < meshes_.size()) {
+    while (batch.size() < max_triangles) {
+        if (mesh_ == meshes_.size()) {
+            if (!feed_) break;
+            IndexedMesh next;
+            NAVE_ASSIGN_OR_RETURN(const bool more, feed_(&next));
+            meshes_.clear();
+            mesh_ = 0;
+            triangle_ = 0;
+            if (!more) {
+                feed_ = nullptr;
+                break;
+            }
+            meshes_.push_back(std::move(next));
+        }
         const IndexedMesh& m = meshes_[mesh_];
         if (triangle_ * 3 >= m.indices.size()) {
             ++mesh_;

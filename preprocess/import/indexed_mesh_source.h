@@ -4,6 +4,7 @@
 // models that fit in memory (memory_bytes() says how much they hold).
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ class IndexedMeshSource final : public TriangleSource {
     std::string units() const override { return units_; }
     uint64_t progress_done() const override { return done_; }
     uint64_t progress_total() const override { return total_; }
+    std::string progress_unit() const override { return "triangles"; }
     uint64_t memory_bytes() const override;
     const ImportWarnings& warnings() const override { return warnings_; }
     /// Writes the embedded images handed to SetEmbeddedImages under their names.
@@ -42,8 +44,18 @@ class IndexedMeshSource final : public TriangleSource {
     void SetEmbeddedImages(std::vector<std::pair<std::string, std::string>> images) {
         embedded_images_ = std::move(images);
     }
+    /// Meshes that arrive one at a time (read from a file in order, cad_importer.cpp): once the
+    /// meshes given to the constructor are used up, `feed(&mesh)` is called for the next one
+    /// until it returns false; each replaces the last, so one mesh is held at a time.
+    /// `total_triangles` is the progress total over all of them.
+    using MeshFeed = std::function<StatusOr<bool>(IndexedMesh* next)>;
+    void SetMeshFeed(MeshFeed feed, uint64_t total_triangles) {
+        feed_ = std::move(feed);
+        total_ = total_triangles;
+    }
 
   private:
+    MeshFeed feed_;
     std::vector<std::pair<std::string, std::string>> embedded_images_;
     std::string name_, units_;
     std::vector<IndexedMesh> meshes_;

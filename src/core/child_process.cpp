@@ -86,6 +86,26 @@ std::string DescribeSignal(int signal) {
     return "signal " + std::to_string(signal) + ": " + (name != nullptr ? name : "unknown");
 }
 
+int ReportStatusFromChild(int fd, const Status& status) {
+    const std::string& message = status.message();
+    WriteAllToFd(fd, message.data(), message.size());
+    return kChildStatusExitBase + int(status.code());
+}
+
+bool ChildReportedStatus(const ChildOutcome& child, Status* reported) {
+    const int code = child.exit_code - kChildStatusExitBase;
+    if (!child.exited || code <= int(StatusCode::kOk) || code > int(StatusCode::kInternal)) {
+        return false;
+    }
+    *reported = Status(StatusCode(code), child.output);
+    return true;
+}
+
+std::string DescribeChildEnd(const ChildOutcome& child) {
+    return child.exited ? "exited with code " + std::to_string(child.exit_code)
+                        : "crashed (" + DescribeSignal(child.signal) + ")";
+}
+
 StatusOr<ChildOutcome> RunInChildProcess(const std::function<int(int output_fd)>& work,
                                          double time_limit_seconds) {
     Pipe out, err;

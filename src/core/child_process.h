@@ -50,6 +50,22 @@ uint64_t ChildAddressSpaceLimitBytes();
 /// Writes all of `size` bytes to `fd`, retrying short writes and EINTR. False on any other error.
 bool WriteAllToFd(int fd, const void* data, size_t size);
 
+/// For work that ends with a Status (the importers' children): a failure is reported by writing its
+/// message to the output and exiting with kChildStatusExitBase + its code; success exits 0. Any
+/// other end (a signal, another exit code) is the work's crash.
+inline constexpr int kChildStatusExitBase = 64;
+
+/// In the child: writes `status`'s message to `fd` and returns the exit code that reports it.
+int ReportStatusFromChild(int fd, const Status& status);
+
+/// In the parent: true, with the Status in `*reported`, when the child reported a failure as
+/// ReportStatusFromChild does; false when it exited 0 or ended any other way.
+bool ChildReportedStatus(const ChildOutcome& child, Status* reported);
+
+/// How a child that did not succeed ended: "exited with code 3", "crashed (signal 11:
+/// Segmentation fault)".
+std::string DescribeChildEnd(const ChildOutcome& child);
+
 /// "signal 6: Aborted": the number and the C library's description of it.
 std::string DescribeSignal(int signal);
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "preprocess/import/triangle_check.h"
@@ -354,6 +355,44 @@ TEST(ImporterRobustness, GarbageAndTruncationsNeverCrash) {
         }
     }
     std::filesystem::remove_all(dir);
+}
+
+// DXF through Assimp: 3DFACE and polyface-mesh entities, each layer (and each colour within it) a
+// material named after the layer.
+TEST(DxfInput, LayersBecomeMaterials) {
+    std::unique_ptr<TriangleSource> source;
+    const std::vector<Triangle> triangles =
+        testing::ReadModel(testing::Fixture("dxf/layers.dxf"), &source);
+    ASSERT_TRUE(source);
+    std::map<std::string, int> per_name;
+    for (const Triangle& t : triangles) ++per_name[source->materials().at(t.material).name];
+    // Walls: two quads of colour 1 (red), one triangle of colour 3; Roof: a quad with a repeated
+    // corner; Vault: a polyface mesh of two triangles.
+    EXPECT_EQ(per_name["Walls"], 4);
+    EXPECT_EQ(per_name["Walls #2"], 1);
+    EXPECT_EQ(per_name["Roof"], 1);
+    EXPECT_EQ(per_name["Vault"], 2);
+    for (const auto& m : source->materials()) {
+        if (m.name == "Walls") {
+            EXPECT_EQ(m.diffuse, (std::array<float, 3>{1.f, 0.f, 0.f}));
+        }
+    }
+}
+
+// DWG is closed: nave refuses it, by extension or by its "AC10xx" signature, naming DXF as the way
+// in, instead of handing it to Assimp or calling it an unknown format.
+TEST(DwgInput, IsRefusedNamingAnExportToDxf) {
+    test::ScratchDir dir("dwg");
+    for (const char* name : {"plan.dwg", "plan.DWG", "plan.bin"}) {
+        SCOPED_TRACE(name);
+        const std::filesystem::path path = dir / name;
+        std::ofstream(path, std::ios::binary) << "AC1032" << std::string(100, '\0');
+        StatusOr<std::unique_ptr<TriangleSource>> source = OpenModel(path);
+        ASSERT_FALSE(source.ok());
+        EXPECT_EQ(source.status().code(), StatusCode::kUnsupported);
+        EXPECT_THAT(source.status().message(), ::testing::HasSubstr(path.string()));
+        EXPECT_THAT(source.status().message(), ::testing::HasSubstr("DXF"));
+    }
 }
 
 }  // namespace
