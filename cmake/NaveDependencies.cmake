@@ -55,6 +55,20 @@ else()
   message(STATUS "nave: Open CASCADE not found: STEP and IGES import off (scripts/setup-debian.sh installs it)")
 endif()
 
+# IFC++ (libifcplusplus-dev: a reader of IFC 2x3 and 4 with Carve's geometry), in the plugin
+# preprocess/import/ifc. Debian ships no CMake or pkg-config file for it. Optional: without it .ifc
+# files go to Assimp, which reads some IFC 2x3.
+find_path(IFCPP_INCLUDE_DIR ifcpp/reader/ReaderSTEP.h)
+find_library(IFCPP_LIBRARY IfcPlusPlus PATH_SUFFIXES ifcplusplus)
+find_library(CARVE_LIBRARY carve PATH_SUFFIXES ifcplusplus)
+if(IFCPP_INCLUDE_DIR AND IFCPP_LIBRARY AND CARVE_LIBRARY)
+  set(NAVE_HAVE_IFCPP ON)
+  message(STATUS "nave: IFC++ found (${IFCPP_LIBRARY}): IFC import on")
+else()
+  set(NAVE_HAVE_IFCPP OFF)
+  message(STATUS "nave: IFC++ not found: IFC files go to Assimp (scripts/setup-debian.sh installs IFC++)")
+endif()
+
 if(NAVE_BUILD_TESTS)
   find_package(GTest REQUIRED)
   include(GoogleTest)

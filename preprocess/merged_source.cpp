@@ -54,6 +54,15 @@ std::string MergedSource::name() const {
     return out;
 }
 
+std::string MergedSource::content() const {
+    std::string content;
+    for (const auto& s : sources_) {
+        const std::string one = s->content();
+        if (!one.empty()) content += (content.empty() ? "" : "|") + one;
+    }
+    return content;
+}
+
 std::string MergedSource::units() const {
     std::string units;
     for (const auto& s : sources_) {

@@ -19,6 +19,8 @@ class MergedSource final : public TriangleSource {
     const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
     std::string name() const override;
     std::string units() const override;
+    /// The inputs' contents that say something, joined by '|'.
+    std::string content() const override;
     uint64_t progress_done() const override;
     uint64_t progress_total() const override;
     /// The inputs' unit when they share one, else "units" (their sum is only a rough guide).

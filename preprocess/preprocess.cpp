@@ -35,15 +35,16 @@ double Since(Clock::time_point t) {
 }
 
 std::string OptionsText(const PreprocessOptions& o, const PreprocessPlan& plan, double step,
-                        const std::string& units) {
+                        const std::string& units, const std::string& content) {
     const std::vector<double>& ratios = o.encode.levels.relative_errors;
     return fmt::format(
         "brick-triangles={} memory={} precision={} threads={} draco-speed={} "
-        "derived-normal-error={} verify-every={} level-errors={} units={}{}",
+        "derived-normal-error={} verify-every={} level-errors={} units={}{}{}",
         plan.brick_triangles, plan.memory_budget, step, plan.threads, o.encode.draco_speed,
         o.encode.derived_normal_error_deg, o.verify_every,
         ratios.empty() ? std::string("none") : fmt::format("{}", fmt::join(ratios, ",")), units,
-        plan.medium.empty() ? std::string() : " medium-grid=" + o.medium_grid);
+        plan.medium.empty() ? std::string() : " medium-grid=" + o.medium_grid,
+        content.empty() ? std::string() : " content=" + content);
 }
 
 /// Removes the texture folder of a run that fails, unless it existed before the run (it may hold
@@ -80,6 +81,7 @@ Status ReadIntoRootBin(std::unique_ptr<TriangleSource> source, const PreprocessO
                        std::vector<store::MaterialRecord>* materials, PreprocessStats* stats) {
     stats->source_name = source->name();
     stats->units = source->units();
+    stats->content = source->content();
     const auto start = Clock::now();
     {
         ProgressBar bar("read", source->progress_total(), source->progress_unit());
@@ -336,7 +338,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     for (const auto& in : options.inputs) provenance.source_files.push_back(in.string());
     if (!options.generate.empty()) provenance.source_files.push_back(options.generate);
     provenance.tool_version = options.tool_version;
-    provenance.options = OptionsText(options, plan, stats.grid_step, stats.units);
+    provenance.options = OptionsText(options, plan, stats.grid_step, stats.units, stats.content);
     NAVE_ASSIGN_OR_RETURN(auto writer,
                           store::StoreWriter::Create(options.output, grid.grid, provenance));
     std::vector<store::BrickTreeNode>& nodes = partitioner.nodes();

@@ -58,6 +58,7 @@ struct PreprocessOptions {
 
 struct PreprocessStats {
     std::string source_name, units;
+    std::string content;                ///< TriangleSource::content()
     uint64_t source_triangles = 0;      ///< triangles read from the input (after skipped bad faces)
     uint64_t stored_triangles = 0;      ///< triangles in bricks (crossing triangles once per brick)
     uint64_t duplicated_triangles = 0;  ///< references beyond the first of triangles crossing cells

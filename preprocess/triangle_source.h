@@ -49,6 +49,12 @@ class TriangleSource {
     /// (OBJ, PLY, STL carry no unit). Positions are never converted.
     virtual std::string units() const { return "unknown"; }
 
+    /// What the file says of itself that the store keeps (in its options text, as `content=`;
+    /// `nave inspect` shows it): the format, its length unit and, for IFC, triangles per entity
+    /// type: "IFC4;unit=0.001m;IfcWall=56,IfcWindow=60". No spaces. Empty when there is nothing
+    /// to say (OBJ, PLY...).
+    virtual std::string content() const { return {}; }
+
     /// Progress in source-specific units (bytes read for files, parts generated for the abbey) and
     /// the total (0 if unknown), for progress bars.
     virtual uint64_t progress_done() const = 0;

@@ -19,9 +19,14 @@ if ((${#targets[@]} == 0)); then
   # inputs within seconds; nave isolates that (fuzz_assimp_isolated). docs/fuzzing.md runs it
   # separately, past those crashes. fuzz_vdb too: OpenVDB 10 allocates whatever size a damaged
   # block's header says, which ASan ends as fatal within seconds (a release build throws bad_alloc,
-  # which nave reports); docs/fuzzing.md runs it separately.
+  # which nave reports); docs/fuzzing.md runs it separately. fuzz_cad too: Open CASCADE 7.6
+  # dereferences null on some damaged STEP entities within a minute (nave runs it in a child
+  # process: fuzz_cad_isolated, in the list when the build has Open CASCADE or IFC++).
   targets=(fuzz_obj fuzz_ply fuzz_stl fuzz_gltf fuzz_assimp_isolated fuzz_model_wire fuzz_store
            fuzz_scene_config)
+  if dpkg-query -W -f='${Status}' libocct-data-exchange-dev libifcplusplus-dev 2>/dev/null | grep -q "install ok installed"; then
+    targets+=(fuzz_cad_isolated)
+  fi
 fi
 
 bash scripts/setup-debian.sh clang libclang-rt-14-dev  # clang 14, its sanitizer and libFuzzer runtimes (Debian 12)
@@ -102,10 +107,11 @@ seed() {
       # Coarse dust (a few KiB each): two voxel sizes, two layouts of leaves.
       build/asan/src/cli/nave generate dust --voxel 8 -o "$dir/dust8.vdb" >/dev/null 2>&1
       build/asan/src/cli/nave generate dust --voxel 4 --seed 3 -o "$dir/dust4.vdb" >/dev/null 2>&1 ;;
-    fuzz_cad)
-      # First byte: even STEP, odd IGES (fuzz_cad.cpp); the files the CAD tests write.
+    fuzz_cad | fuzz_cad_isolated)
+      # First byte modulo 3: STEP, IGES, IFC (fuzz_cad.cpp); the files the CAD and IFC tests read.
       for f in tests/fixtures/models/cad/*.step; do { printf '\0'; cat "$f"; } >"$dir/$(basename "$f")"; done
-      for f in tests/fixtures/models/cad/*.igs; do { printf '\1'; cat "$f"; } >"$dir/$(basename "$f")"; done ;;
+      for f in tests/fixtures/models/cad/*.igs; do { printf '\1'; cat "$f"; } >"$dir/$(basename "$f")"; done
+      for f in tests/fixtures/models/ifc/*.ifc; do { printf '\2'; cat "$f"; } >"$dir/$(basename "$f")"; done ;;
     fuzz_scene_config) cp configs/*.toml tests/fixtures/scenes/*.toml "$dir/" ;;
     *) echo "fuzz.sh: unknown target $target" >&2; exit 2 ;;
   esac
@@ -129,7 +135,7 @@ for t in "${targets[@]}"; do
   asan=
   # The isolated Assimp target's children crash by design: SIGSEGV and SIGBUS must reach their default
   # handler (the child resets it) rather than ASan's, as in the `nave` executable.
-  if [[ $t == fuzz_assimp_isolated ]]; then asan=allow_user_segv_handler=1; fi
+  if [[ $t == fuzz_assimp_isolated || $t == fuzz_cad_isolated ]]; then asan=allow_user_segv_handler=1; fi
   ASAN_OPTIONS=${ASAN_OPTIONS:-$asan} "$bin/$t" "${limits[@]}" -artifact_prefix="$artifacts/" "$corpus" \
     >"$log" 2>&1 || status=$?
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)

@@ -23,6 +23,7 @@ packages=(
   libtinygltf-dev          # glTF 2.0 / GLB import
   libassimp-dev            # the long tail of CAD formats (FBX, DAE, 3DS, DXF...)
   libocct-data-exchange-dev libocct-modeling-algorithms-dev  # Open CASCADE: STEP and IGES, tessellated
+  libifcplusplus-dev       # IFC++ with Carve: IFC 2x3 and IFC 4 building models
   libopenmpi-dev openmpi-bin  # Open MPI: the distributed render under mpirun (docs/distributed.md)
 )
 

@@ -12,6 +12,9 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <optional>
+
+#include "preprocess/import/material_table.h"
 
 namespace nave::preprocess {
 
@@ -29,8 +32,7 @@ namespace {
 void TakeDxfLayersAsMaterials(const aiScene& scene, ImportedModel& model) {
     std::vector<IndexedMesh> split;
     std::vector<store::MaterialRecord> materials;
-    std::map<std::pair<std::string, std::array<int, 3>>, uint32_t> index;
-    std::map<std::string, int> colours_per_layer;
+    MaterialTable table(materials);
     size_t kept = 0;
     for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
         const aiMesh* src = scene.mMeshes[mi];
@@ -39,23 +41,14 @@ void TakeDxfLayersAsMaterials(const aiScene& scene, ImportedModel& model) {
         const std::string layer = src->mName.length > 0 ? src->mName.C_Str() : "0";
         std::map<uint32_t, IndexedMesh> by_material;
         for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-            std::array<int, 3> rgb{-1, -1, -1};
-            std::array<float, 3> diffuse{0.8f, 0.8f, 0.8f};
+            std::optional<std::array<float, 4>> rgb;
             const uint32_t first = mesh.indices[t];
             if (src->mColors[0] != nullptr && first < src->mNumVertices) {
                 const aiColor4D& c = src->mColors[0][first];
-                diffuse = {c.r, c.g, c.b};
-                for (int k = 0; k < 3; ++k) rgb[k] = int(std::lround(diffuse[k] * 255.f));
+                rgb = {c.r, c.g, c.b, 1.f};
             }
-            auto [it, added] = index.try_emplace({layer, rgb}, uint32_t(materials.size()));
-            if (added) {
-                store::MaterialRecord m;
-                const int nth = ++colours_per_layer[layer];
-                m.name = nth == 1 ? layer : fmt::format("{} #{}", layer, nth);
-                m.diffuse = diffuse;
-                materials.push_back(std::move(m));
-            }
-            IndexedMesh& part = by_material[it->second];
+            const uint32_t material = table.Find(layer, rgb);
+            IndexedMesh& part = by_material[material];
             // Positions are copied per triangle: a DXF face owns its corners anyway.
             for (int k = 0; k < 3; ++k) {
                 const uint32_t v = mesh.indices[t + k];

@@ -41,7 +41,7 @@ inline constexpr double kAngularDeflection = 0.35;
 
 /// What the plugin saw of a file.
 struct CadReadSummary {
-    std::string format;     ///< "STEP" or "IGES"
+    std::string format;     ///< "STEP", "IGES", "IFC4", "IFC2X3"
     std::string file_unit;  ///< the file's own length unit as it names it ("MM", "INCH", ...)
     double linear_deflection = 0;     ///< metres, as used
     double angular_deflection = 0;    ///< radians, as used
@@ -49,6 +49,9 @@ struct CadReadSummary {
     uint64_t instances = 0;           ///< placements of them (leaves of the assembly tree)
     uint64_t triangles = 0;           ///< emitted, over all instances
     uint64_t faces_without_mesh = 0;  ///< faces the tessellator could not mesh (skipped)
+    /// IFC: triangles per entity type ("IfcWall"), and products left out (spaces, openings).
+    std::vector<std::pair<std::string, uint64_t>> by_kind;
+    uint64_t skipped_products = 0;
 };
 
 /// The Open CASCADE side.

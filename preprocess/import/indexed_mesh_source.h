@@ -31,6 +31,8 @@ class IndexedMeshSource final : public TriangleSource {
     const std::vector<store::MaterialRecord>& materials() const override { return materials_; }
     std::string name() const override { return name_; }
     std::string units() const override { return units_; }
+    std::string content() const override { return content_; }
+    void SetContent(std::string content) { content_ = std::move(content); }
     uint64_t progress_done() const override { return done_; }
     uint64_t progress_total() const override { return total_; }
     std::string progress_unit() const override { return "triangles"; }
@@ -57,7 +59,7 @@ class IndexedMeshSource final : public TriangleSource {
   private:
     MeshFeed feed_;
     std::vector<std::pair<std::string, std::string>> embedded_images_;
-    std::string name_, units_;
+    std::string name_, units_, content_;
     std::vector<IndexedMesh> meshes_;
     std::vector<store::MaterialRecord> materials_;
     ImportWarnings warnings_;

@@ -234,6 +234,9 @@ TEST_F(CadImport, DamagedFilesAreErrorsNamingThem) {
         {"garbage.step", "this is not a STEP file\n"},
         {"header_only.stp", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\nENDSEC;\nEND-ISO-10303-21;\n"},
         {"cut.step", text.substr(0, text.size() / 2)},
+        // Cut at the end of an entity, where a reader could stop content with part of a model.
+        {"cut_at_entity.step", text.substr(0, text.find("\n#100 =") + 1)},
+        {"cut_after_data.step", text.substr(0, text.find("ENDSEC;", text.find("DATA;")) + 8)},
         {"garbage.iges", std::string(400, 'x')},
     };
     for (const Case& c : cases) {
@@ -247,6 +250,33 @@ TEST_F(CadImport, DamagedFilesAreErrorsNamingThem) {
         EXPECT_NE(status.message().find(path.string()), std::string::npos) << status.message();
         EXPECT_EQ(status.code(), StatusCode::kDataLoss) << status.message();
     }
+}
+
+// Open CASCADE 7.6 dereferences null on a vertex that names an entity of the wrong type (found by
+// fuzz_cad): the crash ends the child that reads the file, and nave reports it naming the file and
+// the signal, without a store.
+TEST_F(CadImport, ACrashInOpenCascadeIsAnErrorNamingTheSignal) {
+    std::string text;
+    {
+        std::ifstream in(std::filesystem::path(NAVE_TEST_FIXTURES) / "models/cad/chapel.step");
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string vertex = "#83 = VERTEX_POINT('',#84);";
+    const size_t at = text.find(vertex);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, vertex.size(), "#83 = VERTEX_POINT('',#27StepRepr_PropertyDefinition84);");
+    const auto path = dir_ / "crash.step";
+    std::ofstream(path, std::ios::binary) << text;
+    StatusOr<std::unique_ptr<TriangleSource>> source = OpenModel(path);
+    ASSERT_FALSE(source.ok());
+    EXPECT_EQ(source.status().code(), StatusCode::kDataLoss);
+    EXPECT_NE(source.status().message().find(path.string() + ": Open CASCADE crashed (signal 11"),
+              std::string::npos)
+        << source.status().message();
+    const std::string out = (dir_ / "crash.nave").string();
+    test::CommandResult run = test::RunNave("preprocess " + path.string() + " -o " + out);
+    EXPECT_EQ(run.exit_code, 1) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 // The fuzz seeds (tests/fixtures/models/cad) are the chapel as the tests write it.

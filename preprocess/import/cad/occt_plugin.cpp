@@ -42,6 +42,7 @@
 #include <unordered_map>
 
 #include "preprocess/import/cad_plugin.h"
+#include "preprocess/import/material_table.h"
 
 namespace nave::preprocess::cad {
 namespace {
@@ -68,51 +69,21 @@ std::string NameOf(const TDF_Label& label) {
     return Utf8(name->Get());
 }
 
-// The first layer a label is on, or empty.
+// The first layer a label is on, or empty. A layer named by a bare number (a CAD system's default
+// numbered level, such as the "256" of some translators) says less than the part's own name, so
+// it is passed over.
 std::string LayerOf(const Handle(XCAFDoc_LayerTool) & layers, const TDF_Label& label) {
     Handle(TColStd_HSequenceOfExtendedString) names;
     if (label.IsNull() || layers.IsNull() || !layers->GetLayers(label, names) || names.IsNull() ||
         names->IsEmpty()) {
         return {};
     }
-    return Utf8(names->Value(1));
+    const std::string layer = Utf8(names->Value(1));
+    const bool numbered = std::all_of(layer.begin(), layer.end(), [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c)) != 0;
+    });
+    return numbered ? std::string() : layer;
 }
-
-// One material per name and colour. The first colour met under a name keeps the name, so a part
-// whose faces share one colour is named as the file names it; further colours get "name #2"...
-class MaterialTable {
-  public:
-    explicit MaterialTable(std::vector<store::MaterialRecord>& records) : records_(records) {}
-
-    uint32_t Find(const std::string& name, const Quantity_ColorRGBA* colour) {
-        std::array<int, 4> key{-1, -1, -1, -1};
-        if (colour != nullptr) {
-            const Quantity_Color& rgb = colour->GetRGB();
-            key = {Quantize(rgb.Red()), Quantize(rgb.Green()), Quantize(rgb.Blue()),
-                   Quantize(colour->Alpha())};
-        }
-        auto [it, added] = index_.try_emplace({name, key}, uint32_t(records_.size()));
-        if (!added) return it->second;
-        const int nth = ++colours_per_name_[name];
-        store::MaterialRecord m;
-        m.name = nth == 1 ? name : fmt::format("{} #{}", name, nth);
-        if (colour != nullptr) {
-            // Quantity_Color holds linear RGB (Open CASCADE 7.5 and later), as MaterialRecord.
-            const Quantity_Color& rgb = colour->GetRGB();
-            m.diffuse = {float(rgb.Red()), float(rgb.Green()), float(rgb.Blue())};
-            m.opacity = colour->Alpha();
-        }
-        records_.push_back(std::move(m));
-        return it->second;
-    }
-
-  private:
-    static int Quantize(double v) { return int(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); }
-
-    std::vector<store::MaterialRecord>& records_;
-    std::map<std::pair<std::string, std::array<int, 4>>, uint32_t> index_;
-    std::map<std::string, int> colours_per_name_;
-};
 
 // Keeps what Open CASCADE reports as it reads (instead of printing it on nave's standard output),
 // so that a refusal can say what the library found: the first failure or alarm ("Syntax error at
@@ -301,8 +272,15 @@ class Plugin final : public CadPlugin {
         for (RWMesh_FaceIterator face(node.RefLabel, node.Location, true, node.Style); face.More();
              face.Next()) {
             if (face.IsEmptyMesh()) continue;
-            const uint32_t material =
-                table.Find(name, face.HasFaceColor() ? &face.FaceColor() : nullptr);
+            std::optional<std::array<float, 4>> rgba;
+            if (face.HasFaceColor()) {
+                // Quantity_Color holds linear RGB (Open CASCADE 7.5 and later), as
+                // MaterialRecord does.
+                const Quantity_Color& rgb = face.FaceColor().GetRGB();
+                rgba = {float(rgb.Red()), float(rgb.Green()), float(rgb.Blue()),
+                        face.FaceColor().Alpha()};
+            }
+            const uint32_t material = table.Find(name, rgba);
             IndexedMesh& mesh = by_material[material];
             mesh.material = material;
             const uint32_t base = uint32_t(mesh.positions.size());

@@ -1,6 +1,7 @@
 #include "src/render/scene/scene.h"
 
 #include <fmt/ostream.h>
+#include <fnmatch.h>
 
 #include <cmath>
 #include <numbers>
@@ -169,11 +170,22 @@ StatusOr<SunState> ResolveSun(const SunConfig& sun, const std::string& file) {
 
 namespace {
 
-/// The config mapping of a model material: its own, else "default", else null.
+/// True for a [materials] key that is a glob pattern ("*glazing*", "IfcWall:*"), not a name.
+bool IsPattern(const std::string& key) { return key.find_first_of("*?[") != std::string::npos; }
+
+/// The config mapping of a model material: its own table, else the longest pattern that matches
+/// it (the most specific; ties go to the first in key order), else "default", else null.
 const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config,
                                                                 const std::string& name) {
     auto it = config.materials.find(name);
-    if (it == config.materials.end()) it = config.materials.find("default");
+    if (it != config.materials.end()) return &*it;
+    const std::pair<const std::string, MaterialConfig>* best = nullptr;
+    for (const auto& entry : config.materials) {
+        if (!IsPattern(entry.first) || fnmatch(entry.first.c_str(), name.c_str(), 0) != 0) continue;
+        if (best == nullptr || entry.first.size() > best->first.size()) best = &entry;
+    }
+    if (best != nullptr) return best;
+    it = config.materials.find("default");
     return it == config.materials.end() ? nullptr : &*it;
 }
 
@@ -307,6 +319,14 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         SurfaceMaterial m;
         m.name = rec.name;
         NAVE_ASSIGN_OR_RETURN(m.material, ToMaterial(mc, it->first));
+        if (mc.builtin.empty() && mc.reflectance_from_model) {
+            // The model's own colour, linear sRGB, lifted to a reflectance spectrum
+            // (core/rgb_to_spectrum.h: Jakob & Hanika 2019).
+            const SigmoidPolynomial albedo =
+                UpliftReflectance(Vec3f(rec.diffuse[0], rec.diffuse[1], rec.diffuse[2]));
+            m.material = DiffuseMaterial{
+                Spectrum::FromFunction([&](double nm) { return albedo.Evaluate(float(nm)); })};
+        }
         m.black = mc.builtin.empty() && mc.kind == MaterialConfig::Kind::kBlack;
         m.portal = mc.portal;
         if (mc.emission) {
@@ -327,8 +347,10 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
         const std::string& name = entry.first;
         if (name == "default") continue;
-        bool used = std::any_of(records.begin(), records.end(),
-                                [&](const auto& r) { return r.name == name; });
+        const bool pattern = IsPattern(name);
+        bool used = std::any_of(records.begin(), records.end(), [&](const auto& r) {
+            return pattern ? fnmatch(name.c_str(), r.name.c_str(), 0) == 0 : r.name == name;
+        });
         if (!used)
             log::Warning("{}: [materials.{}] maps no material of the model", entry.second.where,
                          name);

@@ -538,7 +538,16 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     }
     if (type == "diffuse") {
         m->kind = MaterialConfig::Kind::kDiffuse;
-        NAVE_RETURN_IF_ERROR(r.Spectrum("reflectance", &m->reflectance));
+        const toml::node* reflectance = r.Has("reflectance") ? r.Take("reflectance") : nullptr;
+        if (reflectance != nullptr && reflectance->is_string()) {
+            if (*reflectance->value<std::string>() != "model") {
+                return r.TypeError("reflectance", *reflectance,
+                                   "a number, a table, or the string \"model\"");
+            }
+            m->reflectance_from_model = true;
+        } else {
+            NAVE_RETURN_IF_ERROR(r.Spectrum("reflectance", &m->reflectance));
+        }
     } else if (type == "conductor") {
         m->kind = MaterialConfig::Kind::kConductor;
         m->eta = SpectrumSpec::Constant(0.2f);

@@ -95,8 +95,11 @@ struct MaterialConfig {
     enum class Kind { kDiffuse, kConductor, kDielectric, kThinDielectric, kBlack };
     Kind kind = Kind::kDiffuse;
     SpectrumSpec reflectance = SpectrumSpec::Constant(0.5f);  ///< diffuse albedo
-    SpectrumSpec eta = SpectrumSpec::Constant(1.5f);          ///< dielectric index, conductor eta
-    SpectrumSpec k = SpectrumSpec::Constant(0.f);             ///< conductor absorption
+    /// `reflectance = "model"`: the albedo is the model material's own colour (MTL Kd, glTF
+    /// baseColorFactor, a STEP or IFC colour), lifted from linear sRGB to a spectrum.
+    bool reflectance_from_model = false;
+    SpectrumSpec eta = SpectrumSpec::Constant(1.5f);  ///< dielectric index, conductor eta
+    SpectrumSpec k = SpectrumSpec::Constant(0.f);     ///< conductor absorption
     SpectrumSpec transmittance =
         SpectrumSpec::Constant(1.f);  ///< internal transmittance of thin glass per pass
     std::optional<SpectrumSpec> total_transmittance;  ///< measured total transmittance of a pane
@@ -238,8 +241,8 @@ struct SceneConfig {
     SkyConfig sky;
     std::vector<LightConfig> lights;
     std::optional<MediumConfig> medium;
-    std::map<std::string, MaterialConfig>
-        materials;  ///< by model material name; "default" for the rest
+    std::map<std::string, MaterialConfig> materials;  ///< by model material name or glob pattern
+                                                      ///< ("*glazing*"); "default" for the rest
     RenderSettings render;
     OutputConfig output;
     TextureConfig textures;
