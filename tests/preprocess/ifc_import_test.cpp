@@ -3,6 +3,7 @@
 // the wall, the window's pane as glazing, the room not rendered; damaged files are errors naming
 // them.
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -161,6 +162,56 @@ TEST_F(IfcImport, DamagedFilesAreErrorsNamingThem) {
         test::RunNave("preprocess " + (dir_ / "garbage.ifc").string() + " -o " + out);
     EXPECT_EQ(run.exit_code, 1) << run.output;
     EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// The mean of an image's RGB over all its pixels.
+double MeanRgb(const std::filesystem::path& exr) {
+    auto in = OIIO::ImageInput::open(exr.string());
+    EXPECT_TRUE(in) << exr;
+    if (!in) return -1;
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+    EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+    double sum = 0;
+    for (size_t i = 0; i < pixels.size(); i += size_t(spec.nchannels)) {
+        sum += pixels[i] + pixels[i + 1] + pixels[i + 2];
+    }
+    return sum / double(3 * spec.width * spec.height);
+}
+
+// configs/ifc_chapel.toml renders the IFC building lit through its windows, its names mapped by
+// pattern: the panes pass the sun and sky in; with the same panes black, the closed nave is dark.
+TEST_F(IfcImport, TheChapelIsLitThroughItsWindowsByTheExampleConfig) {
+    const std::string store = (dir_ / "chapel.nave").string();
+    test::CommandResult run =
+        test::RunNave("preprocess -q " + IfcFixture("chapel_ifc4.ifc").string() + " -o " + store);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const std::filesystem::path config =
+        std::filesystem::path(NAVE_TEST_FIXTURES).parent_path().parent_path() / "configs" /
+        "ifc_chapel.toml";
+    std::string text;
+    {
+        std::ifstream in(config);
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string glass = "builtin = \"window_glass\"";
+    ASSERT_NE(text.find(glass), std::string::npos);
+    std::string blind = text;
+    blind.replace(blind.find(glass), glass.size(), "type = \"black\"");
+    const auto blind_config = dir_ / "blind.toml";
+    std::ofstream(blind_config) << blind;
+
+    const std::string options = " --resolution 48x32 --spp 4 -q";
+    run = test::RunNave("render " + store + " --config " + config.string() + " -o " +
+                        (dir_ / "lit.exr").string() + options);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    run = test::RunNave("render " + store + " --config " + blind_config.string() + " -o " +
+                        (dir_ / "blind.exr").string() + options);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const double lit = MeanRgb(dir_ / "lit.exr"), dark = MeanRgb(dir_ / "blind.exr");
+    EXPECT_GT(lit, 0);
+    // Black panes leave nothing but what the nave's surfaces emit: none.
+    EXPECT_EQ(dark, 0) << "lit " << lit;
 }
 
 }  // namespace
