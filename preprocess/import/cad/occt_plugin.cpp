@@ -235,10 +235,10 @@ class Plugin final : public CadPlugin {
              it.More(); it.Next()) {
             const XCAFPrs_DocumentNode& node = it.Current();
             const TopoDS_Shape part = XCAFDoc_ShapeTool::GetShape(node.RefLabel);
-            // Meshes only faces without a fine enough triangulation: a part placed again is
-            // already meshed.
-            BRepMesh_IncrementalMesh(part, summary.linear_deflection, false,
-                                     summary.angular_deflection, false);
+            // Meshes (in its constructor) only faces without a fine enough triangulation: a part
+            // placed again is already meshed.
+            const BRepMesh_IncrementalMesh mesher(part, summary.linear_deflection, false,
+                                                  summary.angular_deflection, false);
             std::string name = LayerOf(layers, node.Label);
             if (name.empty()) name = LayerOf(layers, node.RefLabel);
             if (name.empty()) name = NameOf(node.RefLabel);
