@@ -14,6 +14,7 @@
 #include <map>
 #include <optional>
 
+#include "preprocess/import/dxf_mesh.h"
 #include "preprocess/import/material_table.h"
 
 namespace nave::preprocess {
@@ -29,13 +30,14 @@ namespace {
 // each entity's colour, from its ACI index or the layer's, as vertex colours), named after the
 // layer; a layer of several colours gets "layer #2"... for the second. Meshes are split by colour
 // so that every triangle keeps its own.
-void TakeDxfLayersAsMaterials(const aiScene& scene, ImportedModel& model) {
+void TakeDxfLayersAsMaterials(const aiScene* scene, std::vector<DxfMesh> mesh_entities,
+                              ImportedModel& model) {
     std::vector<IndexedMesh> split;
     std::vector<store::MaterialRecord> materials;
     MaterialTable table(materials);
     size_t kept = 0;
-    for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
-        const aiMesh* src = scene.mMeshes[mi];
+    for (unsigned mi = 0; scene != nullptr && mi < scene->mNumMeshes; ++mi) {
+        const aiMesh* src = scene->mMeshes[mi];
         if ((src->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
         IndexedMesh& mesh = model.meshes[kept++];
         const std::string layer = src->mName.length > 0 ? src->mName.C_Str() : "0";
@@ -65,6 +67,12 @@ void TakeDxfLayersAsMaterials(const aiScene& scene, ImportedModel& model) {
             split.push_back(std::move(part));
         }
     }
+    // The MESH entities nave read itself (dxf_mesh.h): their layer, no colour.
+    for (DxfMesh& entity : mesh_entities) {
+        entity.mesh.material = table.Find(entity.layer, std::nullopt);
+        entity.mesh.where += fmt::format(" layer '{}'", entity.layer);
+        split.push_back(std::move(entity.mesh));
+    }
     model.meshes = std::move(split);
     model.materials = std::move(materials);
 }
@@ -78,12 +86,22 @@ StatusOr<ImportedModel> ReadWithAssimpInProcess(const std::filesystem::path& pat
     std::string ext = path.extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     const bool dxf = ext == ".dxf";
+    std::vector<DxfMesh> mesh_entities;
+    if (dxf) {
+        NAVE_ASSIGN_OR_RETURN(mesh_entities, ReadDxfMeshEntities(path));
+    }
     // A DXF file's layers are Assimp's meshes (named after them) under one default material:
     // baking the transforms must not join them, so that each layer can become a material.
     aiPropertyStore* properties = aiCreatePropertyStore();
     aiSetImportPropertyInteger(properties, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, dxf ? 1 : 0);
     const aiScene* scene = aiImportFileExWithProperties(path.c_str(), flags, nullptr, properties);
     aiReleasePropertyStore(properties);
+    // A drawing of MESH entities alone is "no 3d data" to Assimp: nave's own reader has it.
+    if (dxf && scene == nullptr && !mesh_entities.empty()) {
+        ImportedModel model;
+        TakeDxfLayersAsMaterials(nullptr, std::move(mesh_entities), model);
+        return model;
+    }
     if (scene == nullptr) {
         return InvalidArgumentError("{}: Assimp cannot read it: {}", path.string(),
                                     aiGetErrorString());
@@ -151,7 +169,7 @@ StatusOr<ImportedModel> ReadWithAssimpInProcess(const std::filesystem::path& pat
         }
         meshes.push_back(std::move(out));
     }
-    if (dxf) TakeDxfLayersAsMaterials(*scene, model);
+    if (dxf) TakeDxfLayersAsMaterials(scene, std::move(mesh_entities), model);
     return model;
 }
 

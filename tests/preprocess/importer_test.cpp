@@ -379,6 +379,38 @@ TEST(DxfInput, LayersBecomeMaterials) {
     }
 }
 
+// MESH entities, which Assimp does not read, are read by nave: a drawing of them alone, each layer
+// a material, a concave face cut by ear clipping (area 3, not the fan's).
+TEST(DxfInput, MeshEntitiesAreReadByNave) {
+    std::unique_ptr<TriangleSource> source;
+    const std::vector<Triangle> triangles =
+        testing::ReadModel(testing::Fixture("dxf/mesh.dxf"), &source);
+    ASSERT_TRUE(source);
+    std::map<std::string, double> area;
+    std::map<std::string, int> count;
+    for (const Triangle& t : triangles) {
+        const std::string& name = source->materials().at(t.material).name;
+        area[name] += testing::Area(t);
+        ++count[name];
+    }
+    EXPECT_EQ(count["Apse"], 2);
+    EXPECT_NEAR(area["Apse"], 1.0, 1e-6);
+    EXPECT_EQ(count["Vault"], 4);
+    EXPECT_NEAR(area["Vault"], 3.0, 1e-6);
+}
+
+// A MESH entity whose face names a vertex it does not have is an error naming the file and line.
+TEST(DxfInput, ADamagedMeshEntityIsAnErrorNamingItsLine) {
+    test::ScratchDir dir("dxf");
+    const std::filesystem::path path = dir / "bad.dxf";
+    std::ofstream(path) << "0\nSECTION\n2\nENTITIES\n0\nMESH\n8\nApse\n92\n3\n10\n0\n20\n0\n30\n0\n"
+                           "10\n1\n20\n0\n30\n0\n10\n0\n20\n1\n30\n0\n93\n4\n90\n3\n90\n0\n90\n1\n"
+                           "90\n9\n0\nENDSEC\n0\nEOF\n";
+    const std::string error = testing::ReadError(path);
+    EXPECT_THAT(
+        error, ::testing::HasSubstr(path.string() + ":5: MESH entity: a face names vertex 9 of 3"));
+}
+
 // DWG is closed: nave refuses it, by extension or by its "AC10xx" signature, naming DXF as the way
 // in, instead of handing it to Assimp or calling it an unknown format.
 TEST(DwgInput, IsRefusedNamingAnExportToDxf) {
