@@ -6,6 +6,8 @@
 
 #include <cstdio>
 
+#include "preprocess/import/cad_plugin.h"
+#include "preprocess/import/ifc_plugin.h"
 #include "preprocess/preprocess.h"
 #include "src/cli/commands.h"
 #include "src/cli/interrupt.h"
@@ -29,8 +31,15 @@ void RaiseOpenFileLimit() {
 void RegisterPreprocessCommand(CLI::App& app, CommandRun& run) {
     CLI::App* cmd = app.add_subcommand(
         "preprocess",
-        "Cut models (OBJ, PLY, STL, glTF, Assimp formats), and a medium's density (OpenVDB), into "
-        "a brick store (.nave)");
+        "Cut models (OBJ, PLY, STL, glTF, STEP, IGES, IFC, DXF, Assimp formats), and a medium's "
+        "density (OpenVDB), into a brick store (.nave)");
+    // Which readers this build has: STEP/IGES and IFC are optional at build time.
+    cmd->footer(fmt::format(
+        "Formats: .obj .ply .stl .gltf .glb (nave); .step .stp .iges .igs (Open CASCADE: {}); .ifc "
+        "(IFC++: {}); .dxf .fbx .dae .3ds .off ... (Assimp); .dwg is refused (export DXF). "
+        "docs/preprocess.md, \"Formats\".",
+        preprocess::CadPluginBuilt() ? "on" : "off in this build",
+        preprocess::IfcPluginBuilt() ? "on" : "off in this build, .ifc goes to Assimp"));
     struct Options {
         std::vector<std::string> inputs;
         std::string generate, output, memory, temp_dir;
