@@ -291,8 +291,18 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
     std::string err, warn;
     std::string ext = path.extension().string();
     for (char& c : ext) c = char(std::tolower(c));
-    bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
-                            : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
+    bool ok = false;
+    try {
+        ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
+                           : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
+    } catch (const std::exception& e) {
+        // tinygltf indexes some arrays with at(), which throws on a damaged index
+        // (FuzzRegression.GltfIndexOutOfRangeIsAnError).
+        return InvalidArgumentError(
+            "{}: not a valid glTF 2.0 file: the glTF reader failed on it "
+            "({})",
+            path.string(), e.what());
+    }
     if (!ok) return InvalidArgumentError("{}: not a valid glTF 2.0 file: {}", path.string(), err);
     std::string file = path.filename().string();
     ImportWarnings warnings;

@@ -26,6 +26,14 @@ TEST(FuzzRegression, GltfUnknownComponentTypeIsAnError) {
                                  "componentType 5127"));
 }
 
+// A GLB whose JSON, damaged by fuzz_gltf, makes tinygltf index an empty array with at(): the
+// std::out_of_range it throws went through nave to std::terminate.
+TEST(FuzzRegression, GltfIndexOutOfRangeIsAnError) {
+    const std::string error = testing::ReadError(Fixture("fuzz/gltf_out_of_range.glb"));
+    EXPECT_THAT(error, HasSubstr("gltf_out_of_range.glb: not a valid glTF 2.0 file: the glTF "
+                                 "reader failed on it (vector::_M_range_check"));
+}
+
 // A binary PLY whose header, damaged, declares an element of 8375319363688624582 records and no
 // properties: the importer skipped the records one by one, zero bytes each, and never ended (a
 // libFuzzer timeout). Such records are now skipped at once, and the file ends in an error.
