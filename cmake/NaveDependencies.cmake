@@ -51,6 +51,14 @@ endif()
 find_package(OpenCASCADE CONFIG QUIET)
 if(OpenCASCADE_FOUND)
   message(STATUS "nave: Open CASCADE ${OpenCASCADE_VERSION} found: STEP and IGES import on")
+  # The toolkits nave calls, by their files rather than Open CASCADE's imported targets: those carry
+  # the link interface of its visualization (fontconfig, GL, X11, FreeImage) into every link, which
+  # would need those libraries' -dev packages; at run time each toolkit finds its own dependencies.
+  set(NAVE_OCCT_TOOLKITS)
+  foreach(toolkit TKXDESTEP TKXDEIGES TKSTEP TKIGES TKXSBase TKXCAF TKLCAF TKCAF TKRWMesh TKMesh
+                  TKPrim TKTopAlgo TKBRep TKGeomBase TKG3d TKG2d TKMath TKernel)
+    list(APPEND NAVE_OCCT_TOOLKITS ${OpenCASCADE_LIBRARY_DIR}/lib${toolkit}.so)
+  endforeach()
 else()
   message(STATUS "nave: Open CASCADE not found: STEP and IGES import off (scripts/setup-debian.sh installs it)")
 endif()
