@@ -445,12 +445,19 @@ BackgroundJob StartJob(const std::string& command) {
         ::_exit(127);
     }
     if (job.mpirun < 0) return job;
-    // `timeout` runs mpirun, which runs the ranks: wait for both ranks to be rendering.
-    for (int i = 0; i < 200 && job.ranks.size() < 2; ++i) {
+    // `timeout` runs mpirun, which runs the ranks: wait for both ranks to be rendering. Up to a
+    // minute: on a machine that has just installed Open MPI and runs other tests beside this one,
+    // its first start took over 10 s (a fresh Debian 12).
+    for (int i = 0; i < 1200 && job.ranks.size() < 2; ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
         job.ranks.clear();
         for (pid_t launcher : Children(job.mpirun))
             for (pid_t rank : Children(launcher)) job.ranks.push_back(rank);
+    }
+    if (job.ranks.size() < 2) {
+        // The test fails on it; the job must not outlive it.
+        ::kill(job.mpirun, SIGKILL);
+        ::waitpid(job.mpirun, nullptr, 0);
     }
     return job;
 }
