@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "preprocess/import/file_extension.h"
 #include "src/core/log.h"
 #include "src/core/progress.h"
 #include "src/volumes/vdb_plugin.h"
@@ -21,12 +22,7 @@ Status AsBadData(Status status) {
 
 }  // namespace
 
-bool IsMediumFile(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".vdb";
-}
+bool IsMediumFile(const std::filesystem::path& path) { return LowerExtension(path) == ".vdb"; }
 
 Status CheckMediumGrid(const std::filesystem::path& file, const std::string& grid) {
     NAVE_ASSIGN_OR_RETURN(const volumes::VdbPlugin* plugin, volumes::LoadVdbPlugin());

@@ -15,6 +15,7 @@
 #include <optional>
 
 #include "preprocess/import/dxf_mesh.h"
+#include "preprocess/import/file_extension.h"
 #include "preprocess/import/material_table.h"
 
 namespace nave::preprocess {
@@ -83,9 +84,7 @@ StatusOr<ImportedModel> ReadWithAssimpInProcess(const std::filesystem::path& pat
     // Triangulate polygons, bake node transforms into world-space meshes, drop points and lines.
     const unsigned flags =
         aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    const bool dxf = ext == ".dxf";
+    const bool dxf = LowerExtension(path) == ".dxf";
     std::vector<DxfMesh> mesh_entities;
     if (dxf) {
         NAVE_ASSIGN_OR_RETURN(mesh_entities, ReadDxfMeshEntities(path));

@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "preprocess/import/cad_plugin.h"
+#include "preprocess/import/file_extension.h"
 #include "preprocess/import/ifc_plugin.h"
 #include "preprocess/import/indexed_mesh_source.h"
 #include "preprocess/import/model_wire.h"
@@ -58,13 +59,19 @@ class Spool {
     std::string dir_;
 };
 
-// The summary travels as one line of tab-separated fields before the material table; IFC's
-// triangles per entity type as "IfcWall=12,IfcWindow=4".
-std::string EncodeSummary(const CadReadSummary& s) {
+// IFC's triangles per entity type as text: "IfcWall=12,IfcWindow=4" (with "=" and ","), for the
+// summary line, the store's content and the log.
+std::string KindsText(const CadReadSummary& s, const char* pair, const char* between) {
     std::string kinds;
     for (const auto& [kind, triangles] : s.by_kind) {
-        kinds += fmt::format("{}{}={}", kinds.empty() ? "" : ",", kind, triangles);
+        kinds += fmt::format("{}{}{}{}", kinds.empty() ? "" : between, kind, pair, triangles);
     }
+    return kinds;
+}
+
+// The summary travels as one line of tab-separated fields before the material table.
+std::string EncodeSummary(const CadReadSummary& s) {
+    const std::string kinds = KindsText(s, "=", ",");
     return fmt::format("{}\t{}\t{:.17g}\t{:.17g}\t{}\t{}\t{}\t{}\t{}\t{}\n", s.format, s.file_unit,
                        s.linear_deflection, s.angular_deflection, s.parts, s.instances, s.triangles,
                        s.faces_without_mesh, s.skipped_products, kinds);
@@ -198,8 +205,7 @@ class SpoolReader {
 }  // namespace
 
 bool IsCadFile(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = LowerExtension(path);
     return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs" ||
            (ext == ".ifc" && IfcPluginBuilt());
 }
@@ -213,10 +219,7 @@ std::string Content(const CadReadSummary& s) {
         if (c != ' ' && c != ';' && c != '|') unit += c;
     }
     std::string content = s.format + ";unit=" + (unit.empty() ? "unnamed" : unit);
-    std::string kinds;
-    for (const auto& [kind, triangles] : s.by_kind) {
-        kinds += fmt::format("{}{}={}", kinds.empty() ? "" : ",", kind, triangles);
-    }
+    const std::string kinds = KindsText(s, "=", ",");
     return kinds.empty() ? content : content + ";" + kinds;
 }
 
@@ -258,15 +261,11 @@ Status CheckNotCutShort(const std::filesystem::path& path, const std::string& ex
 // What the log says of a file read.
 std::string Describe(const std::filesystem::path& path, const CadReadSummary& s) {
     if (s.format.rfind("IFC", 0) == 0) {
-        std::string kinds;
-        for (const auto& [kind, triangles] : s.by_kind) {
-            kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", kind, triangles);
-        }
         return fmt::format(
             "{}: {} with a length unit of {}, converted to metres; {} products with surfaces ({} "
             "spaces, openings and annotations not rendered), {} triangles: {}",
             path.filename().string(), s.format, s.file_unit, s.instances, s.skipped_products,
-            s.triangles, kinds);
+            s.triangles, KindsText(s, " ", ", "));
     }
     return fmt::format(
         "{}: {} in {}, converted to metres; {} parts in {} placements, {} triangles (linear "
@@ -282,8 +281,7 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenCad(const std::filesystem::path& p
                                                   double precision) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return NotFoundError("{}: no such file", path.string());
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = LowerExtension(path);
     // Plugins are loaded here, before the fork: the child then only calls into them (dlopen after
     // a fork of a process with threads could wait forever on a lock another thread held).
     PluginRead read;

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "preprocess/import/text_parse.h"
 #include "preprocess/import/triangulate.h"
 
 namespace nave::preprocess {
@@ -34,12 +35,6 @@ class PairReader {
     std::ifstream& in_;
     uint64_t line_ = 0;
 };
-
-std::string Trim(const std::string& s) {
-    const size_t b = s.find_first_not_of(" \t");
-    if (b == std::string::npos) return {};
-    return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
 
 }  // namespace
 
@@ -119,7 +114,7 @@ StatusOr<std::vector<DxfMesh>> ReadDxfMeshEntities(const std::filesystem::path& 
         if (!in_mesh) continue;
         switch (p.code) {
             case 8:
-                current.layer = Trim(p.value);
+                current.layer = std::string(Trim(p.value));
                 break;
             case 92:
                 if (have_vertex_count) break;

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 
+#include "preprocess/import/file_extension.h"
 #include "preprocess/import/indexed_mesh_source.h"
 
 namespace nave::preprocess {
@@ -289,8 +290,7 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenGltf(const std::filesystem::path& 
     EmbeddedImages embedded;
     loader.SetImageLoader(KeepEmbeddedImageBytes, &embedded);
     std::string err, warn;
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(c));
+    const std::string ext = LowerExtension(path);
     bool ok = false;
     try {
         ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())

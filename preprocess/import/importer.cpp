@@ -6,6 +6,7 @@
 
 #include "preprocess/import/assimp_importer.h"
 #include "preprocess/import/cad_importer.h"
+#include "preprocess/import/file_extension.h"
 #include "preprocess/import/gltf_importer.h"
 #include "preprocess/import/obj_importer.h"
 #include "preprocess/import/ply_importer.h"
@@ -14,11 +15,6 @@
 
 namespace nave::preprocess {
 namespace {
-
-std::string Lower(std::string s) {
-    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // The first bytes, to recognise files by content when the extension says nothing.
 std::string Sniff(const std::filesystem::path& path) {
@@ -39,7 +35,7 @@ StatusOr<std::unique_ptr<TriangleSource>> OpenModel(const std::filesystem::path&
     if (std::filesystem::file_size(path, ec) == 0 && !ec) {
         return InvalidArgumentError("{}: empty file: expected a model", path.string());
     }
-    std::string ext = Lower(path.extension().string());
+    const std::string ext = LowerExtension(path);
     if (ext == ".obj") return OpenObj(path);
     if (ext == ".ply") return OpenPly(path);
     if (ext == ".stl") return OpenStl(path);

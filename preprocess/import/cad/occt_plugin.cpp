@@ -42,15 +42,11 @@
 #include <unordered_map>
 
 #include "preprocess/import/cad_plugin.h"
+#include "preprocess/import/file_extension.h"
 #include "preprocess/import/material_table.h"
 
 namespace nave::preprocess::cad {
 namespace {
-
-std::string Lower(std::string s) {
-    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 std::string Utf8(const TCollection_ExtendedString& s) {
     return TCollection_AsciiString(s, '?').ToCString();
@@ -131,7 +127,7 @@ StatusOr<ReadDocument> ReadIntoDocument(const std::filesystem::path& file,
     app->NewDocument("MDTV-XCAF", out.doc);
     // The readers convert every length into the document's unit: metres, as the store keeps.
     XCAFDoc_DocumentTool::SetLengthUnit(out.doc, 1.0);
-    const std::string ext = Lower(file.extension().string());
+    const std::string ext = LowerExtension(file);
     const bool step = ext == ".step" || ext == ".stp";
     out.format = step ? "STEP" : "IGES";
     IFSelect_ReturnStatus read_status = IFSelect_RetVoid;

@@ -22,14 +22,13 @@
 
 #include <algorithm>
 #include <carve/triangulator.hpp>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <new>
 #include <optional>
 
 #include "preprocess/import/ifc_plugin.h"
 #include "preprocess/import/material_table.h"
+#include "src/core/file.h"
 
 namespace nave::preprocess::ifc {
 namespace {
@@ -114,9 +113,7 @@ class Plugin final : public IfcPlugin {
                                          std::vector<store::MaterialRecord>& materials) {
         // Read by nave and handed over as text: IFC++'s own file reader converts the path through
         // a locale that a minimal system lacks, and then reads nothing without a word.
-        std::ifstream in(file, std::ios::binary);
-        if (!in) return IoError("{}: cannot open it", file.string());
-        std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        NAVE_ASSIGN_OR_RETURN(std::string content, ReadFileToString(file));
         auto model = std::make_shared<BuildingModel>();
         auto converter = std::make_shared<GeometryConverter>(model);
         auto reader = std::make_shared<ReaderSTEP>();

@@ -173,6 +173,11 @@ namespace {
 /// True for a [materials] key that is a glob pattern ("*glazing*", "IfcWall:*"), not a name.
 bool IsPattern(const std::string& key) { return key.find_first_of("*?[") != std::string::npos; }
 
+/// True when the [materials] key `key` (a name or a pattern) maps the model material `name`.
+bool KeyMaps(const std::string& key, const std::string& name) {
+    return IsPattern(key) ? fnmatch(key.c_str(), name.c_str(), 0) == 0 : key == name;
+}
+
 /// The config mapping of a model material: its own table, else the longest pattern that matches
 /// it (the most specific; ties go to the first in key order), else "default", else null.
 const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfig& config,
@@ -181,7 +186,7 @@ const std::pair<const std::string, MaterialConfig>* FindMapping(const SceneConfi
     if (it != config.materials.end()) return &*it;
     const std::pair<const std::string, MaterialConfig>* best = nullptr;
     for (const auto& entry : config.materials) {
-        if (!IsPattern(entry.first) || fnmatch(entry.first.c_str(), name.c_str(), 0) != 0) continue;
+        if (!IsPattern(entry.first) || !KeyMaps(entry.first, name)) continue;
         if (best == nullptr || entry.first.size() > best->first.size()) best = &entry;
     }
     if (best != nullptr) return best;
@@ -347,10 +352,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
         // Not a structured binding: clang before 16 (the fuzz preset's) cannot capture one.
         const std::string& name = entry.first;
         if (name == "default") continue;
-        const bool pattern = IsPattern(name);
-        bool used = std::any_of(records.begin(), records.end(), [&](const auto& r) {
-            return pattern ? fnmatch(name.c_str(), r.name.c_str(), 0) == 0 : r.name == name;
-        });
+        bool used = std::any_of(records.begin(), records.end(),
+                                [&](const auto& r) { return KeyMaps(name, r.name); });
         if (!used)
             log::Warning("{}: [materials.{}] maps no material of the model", entry.second.where,
                          name);
