@@ -64,18 +64,25 @@ std::unique_ptr<BrickSource> BallGridSource() {
 }
 
 /// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
-/// and its guide, or "path_haze" and "photon_haze": with a medium over the model).
+/// and its guide, "path_guided": path guiding over 16 passes, or "path_haze" and "photon_haze":
+/// with a medium over the model).
 SceneConfig BallGridConfig(const std::string& mode) {
     const bool gather = mode == "photon_gather",
-               haze = mode == "path_haze" || mode == "photon_haze";
-    const std::string base =
-        gather || mode == "photon_haze" ? "photon" : (mode == "path_haze" ? "path" : mode);
+               haze = mode == "path_haze" || mode == "photon_haze", guided = mode == "path_guided";
+    const std::string base = gather || mode == "photon_haze"
+                                 ? "photon"
+                                 : (mode == "path_haze" || guided ? "path" : mode);
     const std::string text = fmt::format(fmt::runtime(kBallGrid), base) +
                              (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
     auto config = ParseSceneConfig(text, "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     if (!config.ok()) return SceneConfig();
     config->render.final_gather = gather;
+    if (guided) {
+        // Rounds 0 | 1 | 2-3 | ... | 32-63: passes 2-63 sample what rounds 0-4 taught.
+        config->render.path_guiding = true;
+        config->render.spp = 64;
+    }
     return *config;
 }
 
@@ -108,6 +115,8 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     ASSERT_TRUE(in_core->status.ok()) << in_core->status.ToString();
     const BrickBudgetMinimum m = MinimumBrickBudget(*in_core->source, true);
     EXPECT_GE(in_core->source->brick_count(), 30u);
+    EXPECT_EQ(in_core->stats.rounds_overlapped, 0) << "in-core, every wave is drained";
+    int rounds_overlapped = 0;
     // Prefetching on and off; then small waves (the in-core render has one), which under paging
     // overlap; then without the brick cache (every reload decodes the brick again); then with
     // queues spilled to disk beyond 64 KiB.
@@ -136,6 +145,7 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
         EXPECT_EQ(paged->stats.residency.prefetch_loads > 0, prefetch);
         EXPECT_EQ(paged->stats.residency.brick_budget_bytes, options.brick_budget_bytes);
         EXPECT_EQ(paged->stats.spilled_rays > 0, variant == 4) << variant;
+        rounds_overlapped += paged->stats.rounds_overlapped;
         // With the cache, every brick is decoded once and every reload read back from it.
         if (options.brick_cache) {
             EXPECT_EQ(paged->stats.brick_cache_reads, paged->stats.residency.reloads) << variant;
@@ -146,6 +156,12 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
             EXPECT_EQ(paged->stats.brick_cache_reads, 0u);
             EXPECT_EQ(paged->stats.brick_cache_written, 0u);
         }
+    }
+    // A guided render's rounds begin while the round before is still in flight under a budget:
+    // the same image says that what each pass sampled did not depend on it.
+    if (mode == "path_guided") {
+        EXPECT_GT(in_core->stats.guide_cells_guiding, 0u);
+        EXPECT_GT(rounds_overlapped, 0);
     }
 }
 
@@ -170,6 +186,9 @@ TEST_F(PagerTest, AWaveLargerThanTheQueueMemorySpillsAsItIsGenerated) {
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePath) { ExpectPagedEqualsInCore("path", 1e-9); }
+TEST_F(PagerTest, PagedRenderEqualsInCoreGuidedPath) {
+    ExpectPagedEqualsInCore("path_guided", 1e-9);
+}
 
 // A medium's scatterings happen in whichever brick a ray's free flight ends, resident or not.
 TEST_F(PagerTest, PagedRenderEqualsInCorePathInHaze) { ExpectPagedEqualsInCore("path_haze", 1e-9); }

@@ -22,6 +22,7 @@
 #include "render_test_util.h"
 #include "src/core/sampling.h"
 #include "src/render/scene/materials/bxdf.h"
+#include "src/render/stream/ray.h"
 
 namespace nave::render {
 namespace {
@@ -249,6 +250,71 @@ TEST(PathGuide, ProcessesResumedFromASharedCheckpointShareOnlyNewCredits) {
     EXPECT_TRUE(one.Guides(p, kSide));
 }
 
+// Path mode's rounds (GuideRounds::kDoublingPasses): a render under a memory budget begins round
+// r while round r - 1's last paths are still crediting, and Updates the guide between two of their
+// credits. The guide must end where a render that drained every round first ends, bit for bit, and
+// each pass must sample what the round two before it closed.
+TEST(PathGuide, RoundsEndTheSameWhetherTheirLastCreditsComeBeforeOrAfterAnUpdate) {
+    std::mt19937 rng(17);
+    const Vec3f points[2] = {Vec3f(0.5f, 0.5f, 0.5f), Vec3f(3.2f, 1.5f, 2.5f)};
+    struct Credit {
+        uint32_t pass;
+        Vec3f p, w;
+        double value;
+    };
+    // Rounds 0 | 1 | 2-3 | 4-7, 600 credits a pass.
+    std::vector<Credit> rounds[4];
+    for (uint32_t pass = 0; pass < 8; ++pass) {
+        for (int i = 0; i < 600; ++i) {
+            const Vec3f w = UniformDirection(rng);
+            const double v = std::exp(std::uniform_real_distribution<double>(-4, 2)(rng));
+            rounds[RoundOfPass(pass)].push_back({pass, points[i % 2], w, v});
+        }
+    }
+    auto credit = [](PathGuide& g, const std::vector<Credit>& c, size_t from, size_t to) {
+        for (size_t i = from; i < to; ++i)
+            g.Credit(g.CreditKey(c[i].p, kSide, c[i].w), c[i].value, c[i].pass);
+    };
+    auto make = [] { return PathGuide(kBox, 4, 2048, 1.0, GuideRounds::kDoublingPasses); };
+    // Drained: every round ends before the next begins; round r + 2 begins with the Update of r.
+    PathGuide drained = make();
+    credit(drained, rounds[0], 0, rounds[0].size());
+    credit(drained, rounds[1], 0, rounds[1].size());
+    EXPECT_FALSE(drained.Guides(points[0], kSide, 1)) << "round 1 samples nothing";
+    drained.Update();  // closes round 0: round 2 samples it
+    EXPECT_TRUE(drained.Guides(points[0], kSide, 2)) << "the coarse cells learned from round 0";
+    EXPECT_FALSE(drained.Guides(points[0], kSide, 1));
+    const Vec3f w = Normalize(Vec3f(0.3f, -0.2f, 0.9f));
+    const float round_0_pdf = drained.Pdf(points[0], kSide, w, 2);
+    credit(drained, rounds[2], 0, rounds[2].size());
+    drained.Update();  // closes round 1: round 3 samples it
+    credit(drained, rounds[3], 0, rounds[3].size());
+    drained.Update();  // closes round 2
+    // Overlapped: each Update comes while the round after the closed one is half done.
+    PathGuide overlapped = make();
+    credit(overlapped, rounds[0], 0, rounds[0].size());
+    credit(overlapped, rounds[1], 0, 100);
+    overlapped.Update();
+    EXPECT_EQ(overlapped.Pdf(points[0], kSide, w, 2), round_0_pdf)
+        << "round 1's credits before the Update are not round 0's";
+    credit(overlapped, rounds[1], 100, rounds[1].size());
+    credit(overlapped, rounds[2], 0, 700);
+    overlapped.Update();
+    credit(overlapped, rounds[2], 700, rounds[2].size());
+    credit(overlapped, rounds[3], 0, 1000);
+    overlapped.Update();
+    credit(overlapped, rounds[3], 1000, rounds[3].size());
+    EXPECT_EQ(overlapped.rounds_closed(), 3u);
+    ByteWriter a, b;
+    drained.SaveState(&a);
+    overlapped.SaveState(&b);
+    EXPECT_EQ(a.Take(), b.Take());
+    for (uint32_t pass : {2u, 4u, 8u}) {
+        EXPECT_EQ(overlapped.Pdf(points[1], kSide, w, pass), drained.Pdf(points[1], kSide, w, pass))
+            << "pass " << pass;
+    }
+}
+
 TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {
     PathGuide guide(kBox, 4, 1, 1.0);  // one cell with a histogram at most
     const Vec3f first(0.5f, 0.5f, 0.5f), second(3.5f, 3.5f, 3.5f), outside(5, 5, 5);
@@ -348,7 +414,7 @@ reflectance = 0.6
 type = "thin_dielectric"
 eta = 1.5
 [render]
-spp = 128
+spp = 512
 max_depth = 3
 )";
 

@@ -196,7 +196,7 @@ void CameraPaths::Escape(const RayRecord& r) {
             r.guide_side != kMediumSide) {
             guide_->Credit(
                 guide_->CreditKey(r.origin - r.dir * r.since_vertex, r.guide_side, r.dir),
-                double(sky.Average()) / double(r.prev_pdf));
+                double(sky.Average()) / double(r.prev_pdf), r.sample);
         }
     }
     if (scene_.sun >= 0) {
@@ -219,7 +219,7 @@ void CameraPaths::AddShadowContribution(const RayRecord& r) {
     film_->AddSample(r.pixel, r.beta, r.lambda, Half(r));
     if (r.flags & kSkyShadow) lights_.LearnFromSkyShadow(r);
     if (guide_ != nullptr && r.guide_credit != PathGuide::kNoCredit)
-        guide_->Credit(r.guide_credit, double(r.beta.Average()) * double(r.guide_scale));
+        guide_->Credit(r.guide_credit, double(r.beta.Average()) * double(r.guide_scale), r.sample);
 }
 
 bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, float t1,

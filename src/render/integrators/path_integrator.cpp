@@ -19,7 +19,8 @@ StatusOr<std::unique_ptr<PathIntegrator>> PathIntegrator::Create(const RenderSce
     std::unique_ptr<PathGuide> guide;
     if (scene.settings.path_guiding && !scene.source->bounds().Empty()) {
         guide = std::make_unique<PathGuide>(scene.source->bounds(), kGuideCoarseCellsLongAxis,
-                                            kGuideMaxCells, GuideRadianceScale(scene));
+                                            kGuideMaxCells, GuideRadianceScale(scene),
+                                            GuideRounds::kDoublingPasses);
     }
     return std::unique_ptr<PathIntegrator>(
         new PathIntegrator(scene, film, scheduler, std::move(lights), std::move(guide)));
@@ -90,14 +91,33 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     const int group =
         checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
     int s_end = std::min(spp, s + group);
-    // The guide learns from every pass and updates its distributions after passes 1, 2, 4,
-    // 8...: each update follows a complete drain, so that what it learned from does not depend
-    // on the waves, the memory budget or the threads. The processes of a distributed render
-    // re-balance their bricks at the same points (StreamScheduler::Rebalance).
+    // The guide learns in rounds of passes that double (0 | 1 | 2-3 | 4-7 ...), and a round
+    // samples what the guide learned up to two rounds before (GuideRounds::kDoublingPasses): before
+    // round r begins, round r - 2 must have ended, and its Update is made, at the same point of
+    // every render, so that what each pass samples does not depend on the waves, the memory
+    // budget or the threads; round r - 1's last rays may still be in flight, and under a budget
+    // they are traced beside round r's instead of draining to the last ray first. The processes
+    // of a distributed render re-balance their bricks at the same points
+    // (StreamScheduler::Rebalance), after a complete drain.
     const bool learns = owned_guide_ || scheduler_.ranks() != nullptr;
-    const int next_update = learns ? int(std::bit_floor(unsigned(s))) * 2 + (s == 0) : 0;
-    const bool update = learns && s_end >= next_update;
-    if (update) s_end = next_update;
+    const uint32_t round = RoundOfPass(uint32_t(s));
+    if (learns) s_end = std::min(s_end, int(FirstPassOfRound(round + 1)));
+    if (learns && uint32_t(s) == FirstPassOfRound(round) && round >= 2) {
+        NAVE_RETURN_IF_ERROR(scheduler_.DrainRoundsBefore(*this, round - 1));
+        if (scheduler_.ranks() != nullptr) {
+            // Each process credited the paths it traced: all of them learn from all.
+            NAVE_RETURN_IF_ERROR(ShareState(*scheduler_.ranks()));
+            NAVE_RETURN_IF_ERROR(scheduler_.Rebalance());
+        }
+        if (owned_guide_) {
+            NAVE_CHECK_EQ(owned_guide_->rounds_closed(), round - 2);
+            owned_guide_->Update();
+            log::Debug(
+                "path guide after round {} (passes before {}): {} cells learning, {} guiding",
+                round - 2, FirstPassOfRound(round - 1), owned_guide_->cells_used(),
+                owned_guide_->cells_guiding());
+        }
+    }
     NAVE_RETURN_IF_ERROR(scheduler_.DrainInWaves(
         *this, pixels, wave, StreamScheduler::LastWave::kTailInFlight,
         [&](uint64_t first, uint64_t last) {
@@ -109,17 +129,7 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     // collective sums, which no process may enter while rays are still on their way to it (its
     // senders would wait for it): the round ends with a complete drain there.
     const bool collective_check = checks && scheduler_.ranks() != nullptr;
-    if (update || boundaries || collective_check) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
-    if (update && scheduler_.ranks() != nullptr) {
-        // Each process credited the paths it traced: all of them learn from all.
-        NAVE_RETURN_IF_ERROR(ShareState(*scheduler_.ranks()));
-        NAVE_RETURN_IF_ERROR(scheduler_.Rebalance());
-    }
-    if (update && owned_guide_) {
-        owned_guide_->Update();
-        log::Debug("path guide after {} passes: {} cells learning, {} guiding", s_end,
-                   owned_guide_->cells_used(), owned_guide_->cells_guiding());
-    }
+    if (boundaries || collective_check) NAVE_RETURN_IF_ERROR(scheduler_.Drain(*this));
     // The last wave's tail may still be in flight: the noise estimate then misses a little of the
     // last pass, which the final estimate, after the last drain, does not.
     return s_end;
@@ -158,7 +168,7 @@ bool PathIntegrator::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& br
     // The side the path sees of the surface, which keeps the guide's histograms of a floor and
     // of the wall above it apart.
     const int side = PathGuide::SideSeenFrom(h.ns, wo);
-    const GuidedBsdf continuation(bsdf, owned_guide_.get(), h.p, side);
+    const GuidedBsdf continuation(bsdf, owned_guide_.get(), h.p, side, r.sample);
     if (flags & (kBxdfDiffuse | kBxdfGlossy)) {
         // What next-event estimation finds here, reflected once more, is light arriving at the
         // path's previous vertex from this one: its shadow rays credit the guide there.

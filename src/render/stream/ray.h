@@ -3,6 +3,7 @@
 // brick it lands in travels with it: geometry, the segment in the current brick, the path's
 // identity (for the counter-based random numbers), its throughput and wavelengths.
 
+#include <bit>
 #include <cstdint>
 
 #include "src/core/spectrum.h"
@@ -46,6 +47,13 @@ inline uint8_t ExtendSpecularChain(uint8_t flags, bool specular) {
     if (!specular) return uint8_t((flags & ~kSpecularChain) | kChainBroken);
     return (flags & kChainBroken) ? flags : uint8_t(flags | kSpecularChain);
 }
+
+/// The round of pass `pass` (a camera ray's sample index) in a render that learns in rounds of
+/// doubling length, passes 0 | 1 | 2-3 | 4-7 | ... (path guiding, GuideRounds::kDoublingPasses):
+/// the scheduler counts the rays in flight per round (StreamScheduler::DrainRoundsBefore).
+inline uint32_t RoundOfPass(uint32_t pass) { return uint32_t(std::bit_width(pass)); }
+/// The first pass of round `round`.
+inline uint32_t FirstPassOfRound(uint32_t round) { return round == 0 ? 0 : 1u << (round - 1); }
 
 struct RayRecord {
     Vec3f origin;

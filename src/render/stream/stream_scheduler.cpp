@@ -189,6 +189,22 @@ std::string SentPerBrick::Text() const {
     return text;
 }
 
+void StreamScheduler::CountRounds(std::span<const RayRecord> rays, int64_t sign) {
+    if (ranks_ != nullptr) return;
+    std::array<int64_t, kRounds> n{};
+    for (const RayRecord& r : rays) ++n[RoundOfPass(r.sample)];
+    for (size_t k = 0; k < kRounds; ++k) {
+        if (n[k] != 0) waiting_by_round_[k].fetch_add(sign * n[k], std::memory_order_relaxed);
+    }
+}
+
+uint64_t StreamScheduler::WaitingBeforeRound(uint32_t round) const {
+    int64_t n = 0;
+    for (size_t k = 0; k < std::min<size_t>(round, kRounds); ++k)
+        n += waiting_by_round_[k].load(std::memory_order_relaxed);
+    return uint64_t(std::max<int64_t>(n, 0));
+}
+
 void StreamScheduler::Flush(RayOutbox& out) {
     std::vector<std::pair<uint32_t, RayRecord>>& rays = out.rays;
     std::sort(rays.begin(), rays.end(),
@@ -198,6 +214,7 @@ void StreamScheduler::Flush(RayOutbox& out) {
         size_t j = i;
         group.clear();
         while (j < rays.size() && rays[j].first == rays[i].first) group.push_back(rays[j++].second);
+        CountRounds(group, +1);
         exchange_->Send(rays[i].first, group);
         i = j;
     }
@@ -211,9 +228,29 @@ void StreamScheduler::Flush(RayOutbox& out) {
 }
 
 Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
+    return DrainUntil(processor, stop_below, 0);
+}
+
+Status StreamScheduler::DrainRoundsBefore(RayProcessor& processor, uint32_t round) {
+    if (ranks_ != nullptr) return Drain(processor);
+    NAVE_RETURN_IF_ERROR(DrainUntil(processor, 0, round));
+    for (uint32_t i = 0; i < queues_.brick_count(); ++i) {
+        if (queues_.Waiting(i) > 0) {
+            ++rounds_overlapped_;
+            break;
+        }
+    }
+    return Status::Ok();
+}
+
+Status StreamScheduler::DrainUntil(RayProcessor& processor, size_t stop_below,
+                                   uint32_t rounds_before) {
     std::vector<RayRecord> batch;
     std::vector<size_t> waiting(queues_.brick_count());
     for (;;) {
+        // Between two batches every ray of this process is in a queue: none of a round before
+        // rounds_before there means that none is left.
+        if (rounds_before > 0 && WaitingBeforeRound(rounds_before) == 0) break;
         size_t total = 0;
         for (uint32_t i = 0; i < queues_.brick_count(); ++i)
             total += waiting[i] = queues_.Waiting(i);
@@ -240,6 +277,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
         if (!source_.IsResident(b)) pager_->Prefetch(waiting, b, 0);
         NAVE_ASSIGN_OR_RETURN(BrickHandle handle, Acquire(b));
         NAVE_RETURN_IF_ERROR(queues_.Take(b, max_batch_, &batch, queue_spill_.get()).status());
+        CountRounds(batch, -1);
         batches_.fetch_add(1, std::memory_order_relaxed);
         waiting[b] -= batch.size();
         pager_->Prefetch(waiting, b,
@@ -396,6 +434,7 @@ void StreamScheduler::FillStats(const BrickSourceStats& before, StreamStats* sta
     stats->brick_moves = brick_moves_.load();
     stats->rays = rays_.load();
     stats->batches = batches_.load();
+    stats->rounds_overlapped = rounds_overlapped_;
     stats->peak_queue_bytes =
         std::max<uint64_t>(stats->peak_queue_bytes, queues_.PeakMemoryBytes());
     stats->bytes_read = after.bytes_read - before.bytes_read;

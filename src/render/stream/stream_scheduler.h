@@ -7,6 +7,7 @@
 // happens to a ray inside a brick (shading, lights, the film) is the processor's, so paging is
 // tuned here without touching the physics.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -145,6 +146,13 @@ class StreamScheduler {
     /// Runs the scheduler until at most `stop_below` rays wait (0: every queue is empty), tracing
     /// every batch with `processor`. Errors: a brick that cannot be pinned.
     Status Drain(RayProcessor& processor, size_t stop_below = 0);
+    /// Runs the scheduler, as Drain does, until no ray of a round before `round` is left, the
+    /// round of a ray being RoundOfPass of its sample index: the rays of later rounds are traced
+    /// meanwhile (the fullest brick first, as always) and may stay in flight. A render that learns
+    /// in rounds then waits for the round it learns from without draining the one after it, whose
+    /// tail, a few rays over many bricks, rides on the next round's loads instead of costing loads
+    /// of its own. A distributed render drains completely instead (its processes count no rounds).
+    Status DrainRoundsBefore(RayProcessor& processor, uint32_t round);
     /// How the last wave of DrainInWaves ends: with its tail still in flight (the next pass's first
     /// wave joins it), or drained to the last ray.
     enum class LastWave { kTailInFlight, kDrained };
@@ -199,6 +207,13 @@ class StreamScheduler {
     Status SpillIfOverCap(const std::vector<size_t>& waiting);
     /// Spills queues of bricks that are not resident until their memory is below half the cap.
     Status SpillQueues(const std::vector<size_t>& waiting);
+    /// Drain, which also stops once no ray of a round before `rounds_before` is left (0: no
+    /// such stop).
+    Status DrainUntil(RayProcessor& processor, size_t stop_below, uint32_t rounds_before);
+    /// Rays waiting in this process's queues of rounds before `round`.
+    uint64_t WaitingBeforeRound(uint32_t round) const;
+    /// Counts `count` rays of `rays` queued (+1) or taken (-1) in waiting_by_round_.
+    void CountRounds(std::span<const RayRecord> rays, int64_t sign);
 
     BrickSource& source_;
     const store::BrickTree& tree_;
@@ -225,8 +240,13 @@ class StreamScheduler {
     // tracing) since the last Rebalance: the work that re-balancing shares out.
     std::vector<uint64_t> work_us_;
     int rebalances_ = 0;
+    int rounds_overlapped_ = 0;
     std::atomic<uint64_t> segments_traced_{0}, shadow_segments_{0}, brick_moves_{0}, batches_{0},
         rays_{0};
+    // One process: the rays waiting in the queues per round (RoundOfPass of their sample index,
+    // 0..32), for DrainRoundsBefore.
+    static constexpr size_t kRounds = 33;
+    std::array<std::atomic<int64_t>, kRounds> waiting_by_round_{};
 };
 
 }  // namespace nave::render

@@ -38,6 +38,9 @@ struct StreamStats {
     int ranks = 1;
     ExchangeCounts exchange;
     int rebalances = 0;  ///< times the bricks went to new owners (StreamScheduler::Rebalance)
+    /// Rounds of a render that learns in rounds which began while rays of the round before were
+    /// still in flight (StreamScheduler::DrainRoundsBefore).
+    int rounds_overlapped = 0;
 };
 
 }  // namespace nave::render

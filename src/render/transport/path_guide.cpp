@@ -4,10 +4,12 @@
 #include <atomic>
 #include <cmath>
 #include <tuple>
+#include <utility>
 
 #include "src/core/byte_stream.h"
 #include "src/core/check.h"
 #include "src/core/sampling.h"
+#include "src/render/stream/ray.h"
 
 namespace nave::render {
 namespace {
@@ -23,18 +25,29 @@ float BinPdf(const float* cdf, int bin) {
     return (cdf[bin] - (bin > 0 ? cdf[bin - 1] : 0.f)) * float(PathGuide::kBins) / (4 * kPi);
 }
 
+/// PathGuide::Cell::since_round of the cells the constructor gives histograms: every round credits
+/// them.
+constexpr int32_t kBeforeRounds = -2;
+
 }  // namespace
 
 struct PathGuide::Cell {
-    uint64_t sum[kBins] = {};  // fixed-point credits per bin
-    float cdf[kBins] = {};     // after Update: the cumulative distribution over the bins
+    uint64_t sum[kBins] = {};      // fixed-point credits per bin, of the oldest open round too
+    uint64_t pending[kBins] = {};  // those of the round after the oldest open one
+    /// The cumulative distributions over the bins of the last two Updates, by the parity of the
+    /// round each closed (kEveryUpdate uses [0] only): a round samples the one its lag names.
+    float cdf[2][kBins] = {};
     uint32_t credits = 0;
-    bool guiding = false;  // Update gave it a distribution
+    uint32_t pending_credits = 0;
+    /// The Update (its round) that gave the cell its histogram (kBeforeRounds: the guide's
+    /// constructor): the rounds that began before it count their credits in the level's counts.
+    int32_t since_round = 0;
+    bool guiding[2] = {false, false};  // the Update of that parity gave it a distribution
 };
 
 PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_t max_cells,
-                     double radiance_scale)
-    : bounds_(bounds), max_cells_(max_cells) {
+                     double radiance_scale, GuideRounds rounds)
+    : bounds_(bounds), max_cells_(max_cells), rounds_(rounds) {
     NAVE_CHECK(!bounds.Empty());
     NAVE_CHECK(coarse_cells_long_axis > 0 && coarse_cells_long_axis <= 64);
     const Vec3f d = bounds.Diagonal();
@@ -52,7 +65,8 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
         level.size *= kSides;
         level.slot = std::make_unique<uint32_t[]>(level.size);
         std::fill_n(level.slot.get(), level.size, kNoCell);
-        level.count = std::make_unique<uint32_t[]>(level.size);  // zeroed
+        level.count = std::make_unique<uint32_t[]>(level.size);          // zeroed
+        level.pending_count = std::make_unique<uint32_t[]>(level.size);  // zeroed
     }
     // CreditKey packs the finest slot index in 24 bits.
     NAVE_CHECK(levels_[kLevels - 1].size <= (1u << 24));
@@ -62,6 +76,18 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
     // from 2^64, and a credit a millionth of the scale still has 4000 units.
     to_fixed_ = 0x1p32 / std::max(radiance_scale, 1e-30);
     cells_.reserve(max_cells_);
+    // With rounds that begin before the one two rounds back has ended, a cell given its
+    // histogram by an Update learns from the second round after it and guides from the fourth
+    // (passes 8-15): the coarse cells, when they take at most half the cap, have theirs from the
+    // start, so that the first round's paths teach them and the third round's (passes 2-3) are
+    // guided by them.
+    if (rounds_ == GuideRounds::kDoublingPasses && levels_[0].size <= max_cells_ / 2) {
+        for (uint32_t i = 0; i < levels_[0].size; ++i) {
+            levels_[0].slot[i] = uint32_t(cells_.size());
+            cells_.push_back(std::make_unique<Cell>());
+            cells_.back()->since_round = kBeforeRounds;
+        }
+    }
 }
 
 PathGuide::~PathGuide() = default;
@@ -72,7 +98,7 @@ uint64_t PathGuide::MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells) 
     uint64_t grid = 0;
     for (int l = 0; l < kLevels; ++l) {
         const uint64_t res = uint64_t(coarse_cells_long_axis) << l;
-        grid += res * res * res * kSides * 2 * sizeof(uint32_t);
+        grid += res * res * res * kSides * 3 * sizeof(uint32_t);
     }
     return grid + uint64_t(max_cells) * (sizeof(Cell) + sizeof(std::unique_ptr<Cell>));
 }
@@ -117,8 +143,20 @@ uint32_t PathGuide::CreditKey(const Vec3f& p, int side, const Vec3f& w) const {
     return IndexAt(kLevels - 1, xyz, side) << 8 | uint32_t(BinOf(w));
 }
 
-void PathGuide::Credit(uint32_t key, double value) {
+uint32_t PathGuide::RoundOf(uint32_t pass) const {
+    return rounds_ == GuideRounds::kDoublingPasses ? RoundOfPass(pass) : rounds_closed_;
+}
+
+void PathGuide::Credit(uint32_t key, double value, uint32_t pass) {
     if (key == kNoCredit || !(value > 0)) return;
+    const uint32_t round = RoundOf(pass);
+    // A round credits the cells that had histograms when it began (the Update Lag() rounds
+    // before it), whenever its credits arrive: the sums then do not depend on when the Update
+    // in between happened.
+    NAVE_CHECK(round >= rounds_closed_ && round <= rounds_closed_ + 1)
+        << "a credit of round " << round << " while round " << rounds_closed_
+        << " is the oldest open";
+    const bool oldest = Oldest(round);
     const Level& fine = levels_[kLevels - 1];
     const int side = int((key >> 8) % kSides);
     const uint32_t g = (key >> 8) / kSides;
@@ -131,32 +169,37 @@ void PathGuide::Credit(uint32_t key, double value) {
     for (int l = 0; l < kLevels; ++l) {
         const uint32_t index = IndexAt(l, xyz, side);
         const uint32_t slot = levels_[l].slot[index];
-        if (slot == kNoCell) {
-            std::atomic_ref<uint32_t>(levels_[l].count[index])
-                .fetch_add(1, std::memory_order_relaxed);
+        if (slot == kNoCell || int64_t(cells_[slot]->since_round) > int64_t(round) - Lag()) {
+            uint32_t* count = oldest ? levels_[l].count.get() : levels_[l].pending_count.get();
+            std::atomic_ref<uint32_t>(count[index]).fetch_add(1, std::memory_order_relaxed);
             continue;
         }
         Cell& cell = *cells_[slot];
-        std::atomic_ref<uint64_t>(cell.sum[key & 0xff]).fetch_add(units, std::memory_order_relaxed);
-        std::atomic_ref<uint32_t>(cell.credits).fetch_add(1, std::memory_order_relaxed);
+        std::atomic_ref<uint64_t>((oldest ? cell.sum : cell.pending)[key & 0xff])
+            .fetch_add(units, std::memory_order_relaxed);
+        std::atomic_ref<uint32_t>(oldest ? cell.credits : cell.pending_credits)
+            .fetch_add(1, std::memory_order_relaxed);
     }
 }
 
 void PathGuide::Update(uint32_t min_credits) {
+    const uint32_t closing = rounds_closed_;
+    const int parity = int(closing % uint32_t(Lag()));
     cells_guiding_ = 0;
     for (const std::unique_ptr<Cell>& c : cells_) {
         Cell& cell = *c;
         double total = 0;
         for (uint64_t s : cell.sum) total += double(s);
-        cell.guiding = cell.credits >= min_credits && total > 0;
-        if (!cell.guiding) continue;
+        cell.guiding[parity] = cell.credits >= min_credits && total > 0;
+        if (!cell.guiding[parity]) continue;
         ++cells_guiding_;
+        float* cdf = cell.cdf[parity];
         double running = 0;
         for (int b = 0; b < kBins; ++b) {
             running += (1 - kUniformShare) * double(cell.sum[b]) / total + kUniformShare / kBins;
-            cell.cdf[b] = float(running);
+            cdf[b] = float(running);
         }
-        cell.cdf[kBins - 1] = 1.f;
+        cdf[kBins - 1] = 1.f;
     }
     // New histograms for the cells most credited so far, in an order that depends on the counts
     // alone (ties: coarser level, then lower index).
@@ -166,7 +209,11 @@ void PathGuide::Update(uint32_t min_credits) {
         uint32_t index;
     };
     std::vector<Candidate> candidates;
-    const uint32_t min_count = std::max(1u, min_credits / 4);
+    // A cell made now learns from the next round (kEveryUpdate) or only from the second round
+    // after this one (kDoublingPasses: the next is under way already), and guides one Update
+    // later still: there, a cell is made as soon as anything credited it.
+    const uint32_t min_count =
+        rounds_ == GuideRounds::kDoublingPasses ? 1u : std::max(1u, min_credits / 4);
     for (int l = 0; l < kLevels; ++l) {
         for (uint32_t i = 0; i < levels_[l].size; ++i) {
             if (levels_[l].slot[i] == kNoCell && levels_[l].count[i] >= min_count)
@@ -180,23 +227,43 @@ void PathGuide::Update(uint32_t min_credits) {
         if (cells_.size() >= max_cells_) break;
         levels_[c.level].slot[c.index] = uint32_t(cells_.size());
         cells_.push_back(std::make_unique<Cell>());
+        cells_.back()->since_round = int32_t(closing);
     }
+    // The round after the closed one is the oldest open one now: what it credited so far joins
+    // the sums, and its later credits go there directly.
+    for (Level& level : levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) {
+            level.count[i] += level.pending_count[i];
+            level.pending_count[i] = 0;
+        }
+    }
+    for (const std::unique_ptr<Cell>& c : cells_) {
+        for (int b = 0; b < kBins; ++b) c->sum[b] += std::exchange(c->pending[b], 0);
+        c->credits += std::exchange(c->pending_credits, 0);
+    }
+    ++rounds_closed_;
+    // Every process holds the same credits after the sums that precede an Update in a
+    // distributed render, and makes the same Update: what is shared is what it holds now.
+    if (!shared_.empty()) shared_ = FlatCredits();
 }
 
 std::vector<uint64_t> PathGuide::FlatCredits() const {
     // The levels' counts, then each cell's bins and credit count. Cells only ever join at the end
     // (Update), so earlier entries keep their place.
     size_t size = 0;
-    for (const Level& level : levels_) size += level.size;
-    size += cells_.size() * (kBins + 1);
+    for (const Level& level : levels_) size += 2 * size_t(level.size);
+    size += cells_.size() * 2 * (kBins + 1);
     std::vector<uint64_t> values(size);
     size_t at = 0;
     for (const Level& level : levels_) {
         for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.count[i];
+        for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.pending_count[i];
     }
     for (const std::unique_ptr<Cell>& cell : cells_) {
         for (int b = 0; b < kBins; ++b) values[at++] = cell->sum[b];
         values[at++] = cell->credits;
+        for (int b = 0; b < kBins; ++b) values[at++] = cell->pending[b];
+        values[at++] = cell->pending_credits;
     }
     return values;
 }
@@ -211,33 +278,44 @@ Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>&
     size_t at = 0;
     for (Level& level : levels_) {
         for (uint32_t i = 0; i < level.size; ++i) level.count[i] = uint32_t(shared_[at++]);
+        for (uint32_t i = 0; i < level.size; ++i) level.pending_count[i] = uint32_t(shared_[at++]);
     }
     for (const std::unique_ptr<Cell>& cell : cells_) {
         for (int b = 0; b < kBins; ++b) cell->sum[b] = shared_[at++];
         cell->credits = uint32_t(shared_[at++]);
+        for (int b = 0; b < kBins; ++b) cell->pending[b] = shared_[at++];
+        cell->pending_credits = uint32_t(shared_[at++]);
     }
     return Status::Ok();
 }
 
 void PathGuide::SaveState(ByteWriter* out) const {
+    out->Put(rounds_closed_);
     for (const Level& level : levels_) {
         out->PutArray(level.slot.get(), level.size);
         out->PutArray(level.count.get(), level.size);
+        out->PutArray(level.pending_count.get(), level.size);
     }
     out->Put(uint32_t(cells_.size()));
     for (const std::unique_ptr<Cell>& cell : cells_) {
         out->Put(cell->sum);
+        out->Put(cell->pending);
         out->Put(cell->cdf);
         out->Put(cell->credits);
-        out->Put(uint8_t(cell->guiding));
+        out->Put(cell->pending_credits);
+        out->Put(cell->since_round);
+        out->Put(uint8_t(cell->guiding[0] | cell->guiding[1] << 1));
     }
     out->Put(cells_guiding_);
 }
 
 Status PathGuide::LoadState(ByteReader* in) {
+    NAVE_RETURN_IF_ERROR(in->Get(&rounds_closed_, "guide rounds closed"));
     for (Level& level : levels_) {
         NAVE_RETURN_IF_ERROR(in->GetArray(level.slot.get(), level.size, "guide cell slots"));
         NAVE_RETURN_IF_ERROR(in->GetArray(level.count.get(), level.size, "guide cell counts"));
+        NAVE_RETURN_IF_ERROR(
+            in->GetArray(level.pending_count.get(), level.size, "guide cell pending counts"));
     }
     uint32_t cells = 0;
     NAVE_RETURN_IF_ERROR(in->Get(&cells, "guide cell count"));
@@ -258,10 +336,14 @@ Status PathGuide::LoadState(ByteReader* in) {
         auto cell = std::make_unique<Cell>();
         uint8_t guiding = 0;
         NAVE_RETURN_IF_ERROR(in->Get(&cell->sum, "guide cell sums"));
-        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distribution"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->pending, "guide cell pending sums"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distributions"));
         NAVE_RETURN_IF_ERROR(in->Get(&cell->credits, "guide cell credits"));
-        NAVE_RETURN_IF_ERROR(in->Get(&guiding, "guide cell flag"));
-        cell->guiding = guiding != 0;
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->pending_credits, "guide cell pending credits"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->since_round, "guide cell round"));
+        NAVE_RETURN_IF_ERROR(in->Get(&guiding, "guide cell flags"));
+        cell->guiding[0] = (guiding & 1) != 0;
+        cell->guiding[1] = (guiding & 2) != 0;
         cells_.push_back(std::move(cell));
     }
     NAVE_RETURN_IF_ERROR(in->Get(&cells_guiding_, "guiding cell count"));
@@ -272,19 +354,27 @@ Status PathGuide::LoadState(ByteReader* in) {
     return Status::Ok();
 }
 
-const float* PathGuide::Distribution(const Vec3f& p, int side) const {
+const float* PathGuide::Distribution(const Vec3f& p, int side, uint32_t pass) const {
+    // The Update whose distributions pass `pass` samples: the one closing round (its round -
+    // Lag()). kEveryUpdate: the last one.
+    const int64_t made_by = int64_t(RoundOf(pass)) - Lag();
+    if (made_by < 0) return nullptr;
+    const int parity = int(made_by % Lag());
     int xyz[3];
     if (!FineCoords(p, xyz)) return nullptr;
     for (int l = kLevels - 1; l >= 0; --l) {
         const uint32_t slot = levels_[l].slot[IndexAt(l, xyz, side)];
-        if (slot != kNoCell && cells_[slot]->guiding) return cells_[slot]->cdf;
+        // A cell given its histogram by a later Update than made_by has not guided at made_by:
+        // its flag of that parity was cleared when it was made and is set again only by an
+        // Update after every round sampling made_by's has begun.
+        if (slot != kNoCell && cells_[slot]->guiding[parity]) return cells_[slot]->cdf[parity];
     }
     return nullptr;
 }
 
 std::optional<GuideSample> PathGuide::Sample(const Vec3f& p, int side, float u_bin, float u0,
-                                             float u1) const {
-    const float* cdf = Distribution(p, side);
+                                             float u1, uint32_t pass) const {
+    const float* cdf = Distribution(p, side, pass);
     if (cdf == nullptr) return std::nullopt;
     const int bin = int(std::upper_bound(cdf, cdf + kBins - 1, u_bin) - cdf);
     // Uniform within the bin: cos θ and φ are uniform in it (equal-area cylindrical mapping,
@@ -299,8 +389,8 @@ std::optional<GuideSample> PathGuide::Sample(const Vec3f& p, int side, float u_b
     return GuideSample{wi, BinPdf(cdf, BinOf(wi))};
 }
 
-float PathGuide::Pdf(const Vec3f& p, int side, const Vec3f& w) const {
-    const float* cdf = Distribution(p, side);
+float PathGuide::Pdf(const Vec3f& p, int side, const Vec3f& w, uint32_t pass) const {
+    const float* cdf = Distribution(p, side, pass);
     if (cdf == nullptr) return 0;
     return BinPdf(cdf, BinOf(w));
 }
@@ -308,7 +398,7 @@ float PathGuide::Pdf(const Vec3f& p, int side, const Vec3f& w) const {
 float GuidedBsdf::Pdf(const Vec3f& wo, const Vec3f& wi, const SampledWavelengths& lambda) const {
     const float bsdf_pdf = bsdf_.Pdf(wo, wi, lambda);
     if (guide_ == nullptr) return bsdf_pdf;
-    return kGuideShare * guide_->Pdf(p_, side_, wi) + (1 - kGuideShare) * bsdf_pdf;
+    return kGuideShare * guide_->Pdf(p_, side_, wi, pass_) + (1 - kGuideShare) * bsdf_pdf;
 }
 
 std::optional<BsdfSample> GuidedBsdf::Sample(const Vec3f& wo, float u_choice, float uc, Point2f u,
@@ -316,7 +406,7 @@ std::optional<BsdfSample> GuidedBsdf::Sample(const Vec3f& wo, float u_choice, fl
                                              const SampledWavelengths& lambda) const {
     if (guide_ == nullptr) return bsdf_.Sample(wo, uc, u, lambda);
     if (u_choice < kGuideShare) {
-        std::optional<GuideSample> g = guide_->Sample(p_, side_, ug[0], ug[1], ug[2]);
+        std::optional<GuideSample> g = guide_->Sample(p_, side_, ug[0], ug[1], ug[2], pass_);
         if (!g) return std::nullopt;
         BsdfSample s;
         s.wi = g->wi;
@@ -333,7 +423,7 @@ std::optional<BsdfSample> GuidedBsdf::Sample(const Vec3f& wo, float u_choice, fl
     }
     std::optional<BsdfSample> s = bsdf_.Sample(wo, uc, u, lambda);
     if (!s) return std::nullopt;
-    s->pdf = kGuideShare * guide_->Pdf(p_, side_, s->wi) + (1 - kGuideShare) * s->pdf;
+    s->pdf = kGuideShare * guide_->Pdf(p_, side_, s->wi, pass_) + (1 - kGuideShare) * s->pdf;
     return s;
 }
 

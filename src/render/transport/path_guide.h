@@ -43,11 +43,28 @@ struct GuideSample {
     float pdf = 0;
 };
 
+/// How a guide's learning is split into rounds, each closed by an Update, and which distributions
+/// a path samples.
+enum class GuideRounds {
+    /// Every Update closes the round in progress, and what is sampled next is what it made:
+    /// credits and samples need no pass (photon mode's gather guide: an Update per iteration,
+    /// after a complete drain).
+    kEveryUpdate,
+    /// Rounds of passes that double (passes 0 | 1 | 2-3 | 4-7 ..., RoundOfPass), and a pass of
+    /// round r samples what the Update closing round r - 2 made (none before round 2). Round r
+    /// may then start while round r - 1's last rays are still in flight, and only round r - 2
+    /// must have ended: a render under a memory budget overlaps the tail of one round, scattered
+    /// over many bricks, with the next round's rays instead of draining it to the last ray
+    /// (docs/render.md, "Path guiding").
+    kDoublingPasses,
+};
+
 /// Incident-radiance histograms over three nested grids of cells (each cell of a level split in
 /// 2 x 2 x 2 at the next), the finest guiding where enough paths credit it. Credit is thread-safe
 /// and may run while paths are sampled; Update is not concurrent with anything (call it between
-/// two drains, always at the same points of the render: which cells get histograms depends only
-/// on the credits before it, so the image does not depend on threads or the memory budget).
+/// two batches, always at the same points of the render: which cells get histograms and what
+/// each round samples depend only on the credits of the rounds before, never on when a credit
+/// arrived, so the image does not depend on threads or the memory budget).
 class PathGuide {
   public:
     /// Bins per cell: kZBins in cos θ (θ from +z) times kPhiBins in φ; every bin covers the same
@@ -62,9 +79,10 @@ class PathGuide {
     /// A guide over `bounds` with coarse cells of about the longest axis /
     /// `coarse_cells_long_axis`, at most `max_cells` of them (over the levels) holding histograms.
     /// `radiance_scale`: a radiance of the scene's order (a sunlit white wall's, or the sky's),
-    /// which sets the fixed-point resolution of the credits.
+    /// which sets the fixed-point resolution of the credits. `rounds`: how Update splits the
+    /// learning (GuideRounds).
     PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_t max_cells,
-              double radiance_scale);
+              double radiance_scale, GuideRounds rounds = GuideRounds::kEveryUpdate);
     ~PathGuide();
     PathGuide(const PathGuide&) = delete;
     PathGuide& operator=(const PathGuide&) = delete;
@@ -88,25 +106,32 @@ class PathGuide {
     /// The key that credits direction `w` (unit) at point `p` on a surface of side `side`, or
     /// kNoCredit outside the grid.
     uint32_t CreditKey(const Vec3f& p, int side, const Vec3f& w) const;
-    /// Adds `value` (incident radiance over the pdf it was sampled with, >= 0) to the bin of `key`
-    /// in each level's cell that has a histogram, and counts the credit for those that have not.
-    /// Thread-safe; the order of credits does not change the sums.
-    void Credit(uint32_t key, double value);
+    /// Adds `value` (incident radiance over the pdf it was sampled with, >= 0), learned by a path
+    /// of pass `pass` (kDoublingPasses: of a round not yet closed; kEveryUpdate: ignored), to the
+    /// bin of `key` in each level's cell that had a histogram when that round began, and counts
+    /// the credit for the others. Thread-safe; the order of credits does not change the sums.
+    void Credit(uint32_t key, double value, uint32_t pass = 0);
 
-    /// Makes the credits so far the distributions Sample and Pdf use (a cell guides once it holds
-    /// `min_credits` credits), and gives histograms to the cells most credited without one (at
-    /// least `min_credits` / 4 credits, most first, up to the cap). Not concurrent with Credit,
+    /// Closes the oldest round still open (kDoublingPasses: every pass of it must have ended;
+    /// its successor may still be in flight): the credits of every closed round become the
+    /// distributions that the rounds sampling this one's use (a cell guides once it holds
+    /// `min_credits` credits), and the cells most credited without a histogram get one (at least
+    /// `min_credits` / 4 credits, most first, up to the cap). Not concurrent with Credit,
     /// Sample or Pdf.
     void Update(uint32_t min_credits = 64);
+    /// Rounds closed so far (kDoublingPasses: round rounds_closed() is the oldest open one).
+    uint32_t rounds_closed() const { return rounds_closed_; }
 
-    /// Whether a cell at `p` has a distribution (Sample and Pdf are then meaningful).
-    bool Guides(const Vec3f& p, int side) const { return Distribution(p, side) != nullptr; }
-    /// A direction at `p` on a surface of side `side` from its finest guiding cell and three
-    /// uniform numbers; nothing if no cell there guides.
-    std::optional<GuideSample> Sample(const Vec3f& p, int side, float u_bin, float u0,
-                                      float u1) const;
+    /// Whether a cell at `p` guides a path of pass `pass` (Sample and Pdf are then meaningful).
+    bool Guides(const Vec3f& p, int side, uint32_t pass = 0) const {
+        return Distribution(p, side, pass) != nullptr;
+    }
+    /// A direction at `p` on a surface of side `side` from its finest cell guiding pass `pass`,
+    /// and three uniform numbers; nothing if no cell there guides.
+    std::optional<GuideSample> Sample(const Vec3f& p, int side, float u_bin, float u0, float u1,
+                                      uint32_t pass = 0) const;
     /// The solid-angle pdf of Sample at `p`, `side` for direction `w` (0 if no cell there guides).
-    float Pdf(const Vec3f& p, int side, const Vec3f& w) const;
+    float Pdf(const Vec3f& p, int side, const Vec3f& w, uint32_t pass = 0) const;
 
     /// In a distributed render (docs/distributed.md), before each Update and before a checkpoint
     /// is written: gives every process's
@@ -138,7 +163,8 @@ class PathGuide {
         std::unique_ptr<uint32_t[]>
             slot;  // per grid cell and side: its index in cells_, or kNoCell
         std::unique_ptr<uint32_t[]> count;  // per grid cell and side without a histogram: credits
-        uint32_t size = 0;                  // grid cells times kSides
+        std::unique_ptr<uint32_t[]> pending_count;  // the same, of the round after the oldest
+        uint32_t size = 0;                          // grid cells times kSides
     };
     static constexpr uint32_t kNoCell = 0xffffffffu;
     /// The finest level's cell coordinates of `p`; false outside the bounds.
@@ -146,13 +172,23 @@ class PathGuide {
     /// The index at `level` of the histogram slot of the finest level's cell coordinates `xyz`
     /// and `side`.
     uint32_t IndexAt(int level, const int xyz[3], int side) const;
-    /// The distribution (CDF over the bins) of the finest guiding cell at `p`, `side`, or null.
-    const float* Distribution(const Vec3f& p, int side) const;
+    /// The distribution (CDF over the bins) of the finest cell at `p`, `side` guiding pass
+    /// `pass`, or null.
+    const float* Distribution(const Vec3f& p, int side, uint32_t pass) const;
+    /// The round a credit of pass `pass` belongs to.
+    uint32_t RoundOf(uint32_t pass) const;
+    /// Rounds between a round and the one whose Update made what it samples.
+    int Lag() const { return rounds_ == GuideRounds::kDoublingPasses ? 2 : 1; }
+    /// Whether round `round`'s credits are those of the oldest open round (the others, of the
+    /// round after it, wait in the cells' pending sums until Update closes the oldest).
+    bool Oldest(uint32_t round) const { return round <= rounds_closed_; }
 
     Bounds3f bounds_;
     Vec3f inv_fine_cell_;
     uint32_t max_cells_;
-    double to_fixed_;        // fixed-point units per unit of credit
+    double to_fixed_;  // fixed-point units per unit of credit
+    GuideRounds rounds_;
+    uint32_t rounds_closed_ = 0;
     Level levels_[kLevels];  // coarse to fine
     std::vector<std::unique_ptr<Cell>> cells_;
     uint32_t cells_guiding_ = 0;
@@ -173,14 +209,16 @@ class GuidedBsdf {
     static constexpr float kGuideShare = 0.5f;
 
     /// The continuation at `p` of `bsdf` (both must outlive this) on a surface of side `side`
-    /// (PathGuide::SideOf); `guide` null: the BSDF alone.
-    GuidedBsdf(const Bsdf& bsdf, const PathGuide* guide, const Vec3f& p, int side)
+    /// (PathGuide::SideOf), of a path of pass `pass`; `guide` null: the BSDF alone.
+    GuidedBsdf(const Bsdf& bsdf, const PathGuide* guide, const Vec3f& p, int side,
+               uint32_t pass = 0)
         : bsdf_(bsdf),
-          guide_(guide != nullptr && !(bsdf.Flags() & kBxdfSpecular) && guide->Guides(p, side)
+          guide_(guide != nullptr && !(bsdf.Flags() & kBxdfSpecular) && guide->Guides(p, side, pass)
                      ? guide
                      : nullptr),
           p_(p),
-          side_(side) {}
+          side_(side),
+          pass_(pass) {}
 
     bool guided() const { return guide_ != nullptr; }
     /// The solid-angle pdf with which Sample draws `wi`.
@@ -196,6 +234,7 @@ class GuidedBsdf {
     const PathGuide* guide_;
     Vec3f p_;
     int side_;
+    uint32_t pass_;
 };
 
 }  // namespace nave::render
