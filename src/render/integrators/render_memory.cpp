@@ -25,7 +25,8 @@ RenderStateBytes RenderStateMemory(const RenderSettings& settings, int width, in
             state.transport +=
                 PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGatherGuideMaxCells);
     } else if (settings.path_guiding) {
-        state.transport = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
+        state.transport = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells,
+                                                 GuideRounds::kDoublingPasses);
     }
     // Writing a checkpoint holds the film's and the guide's state beside them.
     state.checkpoint = checkpoints ? CheckpointMemoryBytes(settings, width, height, aov) : 0;

@@ -13,7 +13,8 @@ uint64_t CheckpointMemoryBytes(const RenderSettings& settings, int width, int he
     uint64_t state = 0;
     if (settings.mode == RenderSettings::Mode::kPath) {
         if (settings.path_guiding)
-            state = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells);
+            state = PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells,
+                                           GuideRounds::kDoublingPasses);
     } else {
         // Four doubles per pixel, and a few photon guides of 128 x 128 doubles; the gather guide
         // and the sky windows' sums (key, sum, count) when they learn.

@@ -32,11 +32,10 @@ constexpr int32_t kBeforeRounds = -2;
 }  // namespace
 
 struct PathGuide::Cell {
-    uint64_t sum[kBins] = {};      // fixed-point credits per bin, of the oldest open round too
-    uint64_t pending[kBins] = {};  // those of the round after the oldest open one
-    /// The cumulative distributions over the bins of the last two Updates, by the parity of the
-    /// round each closed (kEveryUpdate uses [0] only): a round samples the one its lag names.
-    float cdf[2][kBins] = {};
+    uint64_t sum[kBins] = {};  // fixed-point credits per bin, of the oldest open round too
+    /// The cumulative distribution over the bins that the last Update of an even round made
+    /// (kEveryUpdate: of every round); Overlap::cdf holds the odd rounds'.
+    float cdf[kBins] = {};
     uint32_t credits = 0;
     uint32_t pending_credits = 0;
     /// The Update (its round) that gave the cell its histogram (kBeforeRounds: the guide's
@@ -44,6 +43,23 @@ struct PathGuide::Cell {
     int32_t since_round = 0;
     bool guiding[2] = {false, false};  // the Update of that parity gave it a distribution
 };
+
+/// What a cell needs beside Cell when rounds overlap (kDoublingPasses), kept apart so that photon
+/// mode's gather guide, whose rounds never overlap, does not hold it.
+struct PathGuide::Overlap {
+    uint64_t pending[kBins] = {};  // credits of the round after the oldest open one
+    float cdf[kBins] = {};         // the distribution that the last Update of an odd round made
+};
+
+float* PathGuide::CdfOf(uint32_t slot, int parity) const {
+    return parity == 0 ? cells_[slot]->cdf : overlap_[slot]->cdf;
+}
+
+void PathGuide::AddCell(int32_t since_round) {
+    cells_.push_back(std::make_unique<Cell>());
+    cells_.back()->since_round = since_round;
+    if (rounds_ == GuideRounds::kDoublingPasses) overlap_.push_back(std::make_unique<Overlap>());
+}
 
 PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_t max_cells,
                      double radiance_scale, GuideRounds rounds)
@@ -65,8 +81,9 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
         level.size *= kSides;
         level.slot = std::make_unique<uint32_t[]>(level.size);
         std::fill_n(level.slot.get(), level.size, kNoCell);
-        level.count = std::make_unique<uint32_t[]>(level.size);          // zeroed
-        level.pending_count = std::make_unique<uint32_t[]>(level.size);  // zeroed
+        level.count = std::make_unique<uint32_t[]>(level.size);  // zeroed
+        if (rounds == GuideRounds::kDoublingPasses)
+            level.pending_count = std::make_unique<uint32_t[]>(level.size);  // zeroed
     }
     // CreditKey packs the finest slot index in 24 bits.
     NAVE_CHECK(levels_[kLevels - 1].size <= (1u << 24));
@@ -76,6 +93,7 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
     // from 2^64, and a credit a millionth of the scale still has 4000 units.
     to_fixed_ = 0x1p32 / std::max(radiance_scale, 1e-30);
     cells_.reserve(max_cells_);
+    if (rounds_ == GuideRounds::kDoublingPasses) overlap_.reserve(max_cells_);
     // With rounds that begin before the one two rounds back has ended, a cell given its
     // histogram by an Update learns from the second round after it and guides from the fourth
     // (passes 8-15): the coarse cells, when they take at most half the cap, have theirs from the
@@ -84,23 +102,28 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
     if (rounds_ == GuideRounds::kDoublingPasses && levels_[0].size <= max_cells_ / 2) {
         for (uint32_t i = 0; i < levels_[0].size; ++i) {
             levels_[0].slot[i] = uint32_t(cells_.size());
-            cells_.push_back(std::make_unique<Cell>());
-            cells_.back()->since_round = kBeforeRounds;
+            AddCell(kBeforeRounds);
         }
     }
 }
 
 PathGuide::~PathGuide() = default;
 
-uint64_t PathGuide::MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells) {
+uint64_t PathGuide::MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells,
+                                GuideRounds rounds) {
     // At most the grid's index and count per cell of each level (the bounds' other axes as long as
     // the longest at worst), and the histograms.
     uint64_t grid = 0;
     for (int l = 0; l < kLevels; ++l) {
         const uint64_t res = uint64_t(coarse_cells_long_axis) << l;
-        grid += res * res * res * kSides * 3 * sizeof(uint32_t);
+        // Its slots and counts, and the pending counts of overlapping rounds.
+        const uint64_t arrays = rounds == GuideRounds::kDoublingPasses ? 3 : 2;
+        grid += res * res * res * kSides * arrays * sizeof(uint32_t);
     }
-    return grid + uint64_t(max_cells) * (sizeof(Cell) + sizeof(std::unique_ptr<Cell>));
+    uint64_t per_cell = sizeof(Cell) + sizeof(std::unique_ptr<Cell>);
+    if (rounds == GuideRounds::kDoublingPasses)
+        per_cell += sizeof(Overlap) + sizeof(std::unique_ptr<Overlap>);
+    return grid + uint64_t(max_cells) * per_cell;
 }
 
 bool PathGuide::FineCoords(const Vec3f& p, int xyz[3]) const {
@@ -175,7 +198,7 @@ void PathGuide::Credit(uint32_t key, double value, uint32_t pass) {
             continue;
         }
         Cell& cell = *cells_[slot];
-        std::atomic_ref<uint64_t>((oldest ? cell.sum : cell.pending)[key & 0xff])
+        std::atomic_ref<uint64_t>((oldest ? cell.sum : overlap_[slot]->pending)[key & 0xff])
             .fetch_add(units, std::memory_order_relaxed);
         std::atomic_ref<uint32_t>(oldest ? cell.credits : cell.pending_credits)
             .fetch_add(1, std::memory_order_relaxed);
@@ -186,14 +209,14 @@ void PathGuide::Update(uint32_t min_credits) {
     const uint32_t closing = rounds_closed_;
     const int parity = int(closing % uint32_t(Lag()));
     cells_guiding_ = 0;
-    for (const std::unique_ptr<Cell>& c : cells_) {
-        Cell& cell = *c;
+    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
+        Cell& cell = *cells_[slot];
         double total = 0;
         for (uint64_t s : cell.sum) total += double(s);
         cell.guiding[parity] = cell.credits >= min_credits && total > 0;
         if (!cell.guiding[parity]) continue;
         ++cells_guiding_;
-        float* cdf = cell.cdf[parity];
+        float* cdf = CdfOf(slot, parity);
         double running = 0;
         for (int b = 0; b < kBins; ++b) {
             running += (1 - kUniformShare) * double(cell.sum[b]) / total + kUniformShare / kBins;
@@ -226,20 +249,21 @@ void PathGuide::Update(uint32_t min_credits) {
     for (const Candidate& c : candidates) {
         if (cells_.size() >= max_cells_) break;
         levels_[c.level].slot[c.index] = uint32_t(cells_.size());
-        cells_.push_back(std::make_unique<Cell>());
-        cells_.back()->since_round = int32_t(closing);
+        AddCell(int32_t(closing));
     }
     // The round after the closed one is the oldest open one now: what it credited so far joins
     // the sums, and its later credits go there directly.
     for (Level& level : levels_) {
+        if (!level.pending_count) continue;
         for (uint32_t i = 0; i < level.size; ++i) {
             level.count[i] += level.pending_count[i];
             level.pending_count[i] = 0;
         }
     }
-    for (const std::unique_ptr<Cell>& c : cells_) {
-        for (int b = 0; b < kBins; ++b) c->sum[b] += std::exchange(c->pending[b], 0);
-        c->credits += std::exchange(c->pending_credits, 0);
+    for (uint32_t slot = 0; slot < overlap_.size(); ++slot) {
+        Cell& c = *cells_[slot];
+        for (int b = 0; b < kBins; ++b) c.sum[b] += std::exchange(overlap_[slot]->pending[b], 0);
+        c.credits += std::exchange(c.pending_credits, 0);
     }
     ++rounds_closed_;
     // Every process holds the same credits after the sums that precede an Update in a
@@ -251,19 +275,23 @@ std::vector<uint64_t> PathGuide::FlatCredits() const {
     // The levels' counts, then each cell's bins and credit count. Cells only ever join at the end
     // (Update), so earlier entries keep their place.
     size_t size = 0;
-    for (const Level& level : levels_) size += 2 * size_t(level.size);
-    size += cells_.size() * 2 * (kBins + 1);
+    for (const Level& level : levels_) size += size_t(level.size) * (level.pending_count ? 2 : 1);
+    size += cells_.size() * (kBins + 1) + overlap_.size() * (kBins + 1);
     std::vector<uint64_t> values(size);
     size_t at = 0;
     for (const Level& level : levels_) {
         for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.count[i];
+        if (!level.pending_count) continue;
         for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.pending_count[i];
     }
-    for (const std::unique_ptr<Cell>& cell : cells_) {
-        for (int b = 0; b < kBins; ++b) values[at++] = cell->sum[b];
-        values[at++] = cell->credits;
-        for (int b = 0; b < kBins; ++b) values[at++] = cell->pending[b];
-        values[at++] = cell->pending_credits;
+    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
+        const Cell& cell = *cells_[slot];
+        for (int b = 0; b < kBins; ++b) values[at++] = cell.sum[b];
+        values[at++] = cell.credits;
+        if (slot < overlap_.size()) {
+            for (int b = 0; b < kBins; ++b) values[at++] = overlap_[slot]->pending[b];
+            values[at++] = cell.pending_credits;
+        }
     }
     return values;
 }
@@ -278,13 +306,17 @@ Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>&
     size_t at = 0;
     for (Level& level : levels_) {
         for (uint32_t i = 0; i < level.size; ++i) level.count[i] = uint32_t(shared_[at++]);
+        if (!level.pending_count) continue;
         for (uint32_t i = 0; i < level.size; ++i) level.pending_count[i] = uint32_t(shared_[at++]);
     }
-    for (const std::unique_ptr<Cell>& cell : cells_) {
-        for (int b = 0; b < kBins; ++b) cell->sum[b] = shared_[at++];
-        cell->credits = uint32_t(shared_[at++]);
-        for (int b = 0; b < kBins; ++b) cell->pending[b] = shared_[at++];
-        cell->pending_credits = uint32_t(shared_[at++]);
+    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
+        Cell& cell = *cells_[slot];
+        for (int b = 0; b < kBins; ++b) cell.sum[b] = shared_[at++];
+        cell.credits = uint32_t(shared_[at++]);
+        if (slot < overlap_.size()) {
+            for (int b = 0; b < kBins; ++b) overlap_[slot]->pending[b] = shared_[at++];
+            cell.pending_credits = uint32_t(shared_[at++]);
+        }
     }
     return Status::Ok();
 }
@@ -294,13 +326,17 @@ void PathGuide::SaveState(ByteWriter* out) const {
     for (const Level& level : levels_) {
         out->PutArray(level.slot.get(), level.size);
         out->PutArray(level.count.get(), level.size);
-        out->PutArray(level.pending_count.get(), level.size);
+        if (level.pending_count) out->PutArray(level.pending_count.get(), level.size);
     }
     out->Put(uint32_t(cells_.size()));
-    for (const std::unique_ptr<Cell>& cell : cells_) {
+    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
+        const std::unique_ptr<Cell>& cell = cells_[slot];
         out->Put(cell->sum);
-        out->Put(cell->pending);
         out->Put(cell->cdf);
+        if (slot < overlap_.size()) {
+            out->Put(overlap_[slot]->pending);
+            out->Put(overlap_[slot]->cdf);
+        }
         out->Put(cell->credits);
         out->Put(cell->pending_credits);
         out->Put(cell->since_round);
@@ -314,8 +350,10 @@ Status PathGuide::LoadState(ByteReader* in) {
     for (Level& level : levels_) {
         NAVE_RETURN_IF_ERROR(in->GetArray(level.slot.get(), level.size, "guide cell slots"));
         NAVE_RETURN_IF_ERROR(in->GetArray(level.count.get(), level.size, "guide cell counts"));
-        NAVE_RETURN_IF_ERROR(
-            in->GetArray(level.pending_count.get(), level.size, "guide cell pending counts"));
+        if (level.pending_count) {
+            NAVE_RETURN_IF_ERROR(
+                in->GetArray(level.pending_count.get(), level.size, "guide cell pending counts"));
+        }
     }
     uint32_t cells = 0;
     NAVE_RETURN_IF_ERROR(in->Get(&cells, "guide cell count"));
@@ -332,19 +370,23 @@ Status PathGuide::LoadState(ByteReader* in) {
         }
     }
     cells_.clear();
+    overlap_.clear();
     for (uint32_t c = 0; c < cells; ++c) {
-        auto cell = std::make_unique<Cell>();
+        AddCell(0);
+        Cell* cell = cells_.back().get();
         uint8_t guiding = 0;
         NAVE_RETURN_IF_ERROR(in->Get(&cell->sum, "guide cell sums"));
-        NAVE_RETURN_IF_ERROR(in->Get(&cell->pending, "guide cell pending sums"));
-        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distributions"));
+        NAVE_RETURN_IF_ERROR(in->Get(&cell->cdf, "guide cell distribution"));
+        if (!overlap_.empty()) {
+            NAVE_RETURN_IF_ERROR(in->Get(&overlap_.back()->pending, "guide cell pending sums"));
+            NAVE_RETURN_IF_ERROR(in->Get(&overlap_.back()->cdf, "guide cell odd distribution"));
+        }
         NAVE_RETURN_IF_ERROR(in->Get(&cell->credits, "guide cell credits"));
         NAVE_RETURN_IF_ERROR(in->Get(&cell->pending_credits, "guide cell pending credits"));
         NAVE_RETURN_IF_ERROR(in->Get(&cell->since_round, "guide cell round"));
         NAVE_RETURN_IF_ERROR(in->Get(&guiding, "guide cell flags"));
         cell->guiding[0] = (guiding & 1) != 0;
         cell->guiding[1] = (guiding & 2) != 0;
-        cells_.push_back(std::move(cell));
     }
     NAVE_RETURN_IF_ERROR(in->Get(&cells_guiding_, "guiding cell count"));
     // What a checkpoint holds is every process's credits together (a distributed render shares
@@ -367,7 +409,7 @@ const float* PathGuide::Distribution(const Vec3f& p, int side, uint32_t pass) co
         // A cell given its histogram by a later Update than made_by has not guided at made_by:
         // its flag of that parity was cleared when it was made and is set again only by an
         // Update after every round sampling made_by's has begun.
-        if (slot != kNoCell && cells_[slot]->guiding[parity]) return cells_[slot]->cdf[parity];
+        if (slot != kNoCell && cells_[slot]->guiding[parity]) return CdfOf(slot, parity);
     }
     return nullptr;
 }

@@ -29,7 +29,8 @@
 namespace nave::render {
 
 /// Path mode's guide: coarse cells of about a twelfth of the model's longest axis (8 m in the
-/// abbey), halved twice (2 m), at most 8192 of them with histograms (31 MB with the grids, in the
+/// abbey), halved twice (2 m), at most 8192 of them with histograms (60 MB with the grids and the
+/// second sums and distributions that overlapping rounds need (GuideRounds), in the
 /// memory reserve).
 inline constexpr int kGuideCoarseCellsLongAxis = 12;
 inline constexpr uint32_t kGuideMaxCells = 8192;
@@ -87,9 +88,10 @@ class PathGuide {
     PathGuide(const PathGuide&) = delete;
     PathGuide& operator=(const PathGuide&) = delete;
 
-    /// Bytes the guide holds at most for `max_cells` cells and `coarse_cells_long_axis` (the
-    /// render's memory reserve).
-    static uint64_t MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells);
+    /// Bytes the guide holds at most for `max_cells` cells, `coarse_cells_long_axis` and `rounds`
+    /// (the render's memory reserve).
+    static uint64_t MemoryBytes(int coarse_cells_long_axis, uint32_t max_cells,
+                                GuideRounds rounds = GuideRounds::kEveryUpdate);
 
     /// Histograms are kept apart by the side a surface faces (SideOf): a floor and the wall above
     /// it in one cell see different halves of the sphere.
@@ -158,12 +160,14 @@ class PathGuide {
 
   private:
     struct Cell;
+    struct Overlap;
     struct Level {
         int res[3] = {1, 1, 1};
         std::unique_ptr<uint32_t[]>
             slot;  // per grid cell and side: its index in cells_, or kNoCell
         std::unique_ptr<uint32_t[]> count;  // per grid cell and side without a histogram: credits
-        std::unique_ptr<uint32_t[]> pending_count;  // the same, of the round after the oldest
+        std::unique_ptr<uint32_t[]> pending_count;  // kDoublingPasses: the same, of the round after
+                                                    // the oldest open one
         uint32_t size = 0;                          // grid cells times kSides
     };
     static constexpr uint32_t kNoCell = 0xffffffffu;
@@ -191,6 +195,11 @@ class PathGuide {
     uint32_t rounds_closed_ = 0;
     Level levels_[kLevels];  // coarse to fine
     std::vector<std::unique_ptr<Cell>> cells_;
+    std::vector<std::unique_ptr<Overlap>> overlap_;  // kDoublingPasses: one per cell
+    /// The distribution of cell `slot` that the last Update of a round of parity `parity` made.
+    float* CdfOf(uint32_t slot, int parity) const;
+    /// Appends a cell (and its Overlap when rounds overlap) made by the Update of `since_round`.
+    void AddCell(int32_t since_round);
     uint32_t cells_guiding_ = 0;
     /// Everything credited, flattened as ShareCredits sums it.
     std::vector<uint64_t> FlatCredits() const;
