@@ -79,7 +79,7 @@ SceneConfig BallGridConfig(const std::string& mode) {
     if (!config.ok()) return SceneConfig();
     config->render.final_gather = gather;
     if (guided) {
-        // Rounds 0 | 1 | 2-3 | ... | 32-63: passes 2-63 sample what rounds 0-4 taught.
+        // Rounds 0-1 | 2-3 | 4-7 | ... | 32-63: passes 4-63 sample what rounds 0-3 taught.
         config->render.path_guiding = true;
         config->render.spp = 64;
     }

@@ -262,10 +262,10 @@ TEST(PathGuide, RoundsEndTheSameWhetherTheirLastCreditsComeBeforeOrAfterAnUpdate
         Vec3f p, w;
         double value;
     };
-    // Rounds 0 | 1 | 2-3 | 4-7, 600 credits a pass.
+    // Rounds 0-1 | 2-3 | 4-7 | 8-15, 300 credits a pass.
     std::vector<Credit> rounds[4];
-    for (uint32_t pass = 0; pass < 8; ++pass) {
-        for (int i = 0; i < 600; ++i) {
+    for (uint32_t pass = 0; pass < FirstPassOfRound(4); ++pass) {
+        for (int i = 0; i < 300; ++i) {
             const Vec3f w = UniformDirection(rng);
             const double v = std::exp(std::uniform_real_distribution<double>(-4, 2)(rng));
             rounds[RoundOfPass(pass)].push_back({pass, points[i % 2], w, v});
@@ -280,12 +280,13 @@ TEST(PathGuide, RoundsEndTheSameWhetherTheirLastCreditsComeBeforeOrAfterAnUpdate
     PathGuide drained = make();
     credit(drained, rounds[0], 0, rounds[0].size());
     credit(drained, rounds[1], 0, rounds[1].size());
-    EXPECT_FALSE(drained.Guides(points[0], kSide, 1)) << "round 1 samples nothing";
+    const uint32_t round_1 = FirstPassOfRound(1), round_2 = FirstPassOfRound(2);
+    EXPECT_FALSE(drained.Guides(points[0], kSide, round_1)) << "round 1 samples nothing";
     drained.Update();  // closes round 0: round 2 samples it
-    EXPECT_TRUE(drained.Guides(points[0], kSide, 2)) << "the coarse cells learned from round 0";
-    EXPECT_FALSE(drained.Guides(points[0], kSide, 1));
+    EXPECT_TRUE(drained.Guides(points[0], kSide, round_2)) << "the coarse cells learned";
+    EXPECT_FALSE(drained.Guides(points[0], kSide, round_1));
     const Vec3f w = Normalize(Vec3f(0.3f, -0.2f, 0.9f));
-    const float round_0_pdf = drained.Pdf(points[0], kSide, w, 2);
+    const float round_0_pdf = drained.Pdf(points[0], kSide, w, round_2);
     credit(drained, rounds[2], 0, rounds[2].size());
     drained.Update();  // closes round 1: round 3 samples it
     credit(drained, rounds[3], 0, rounds[3].size());
@@ -295,7 +296,7 @@ TEST(PathGuide, RoundsEndTheSameWhetherTheirLastCreditsComeBeforeOrAfterAnUpdate
     credit(overlapped, rounds[0], 0, rounds[0].size());
     credit(overlapped, rounds[1], 0, 100);
     overlapped.Update();
-    EXPECT_EQ(overlapped.Pdf(points[0], kSide, w, 2), round_0_pdf)
+    EXPECT_EQ(overlapped.Pdf(points[0], kSide, w, round_2), round_0_pdf)
         << "round 1's credits before the Update are not round 0's";
     credit(overlapped, rounds[1], 100, rounds[1].size());
     credit(overlapped, rounds[2], 0, 700);
@@ -309,7 +310,8 @@ TEST(PathGuide, RoundsEndTheSameWhetherTheirLastCreditsComeBeforeOrAfterAnUpdate
     drained.SaveState(&a);
     overlapped.SaveState(&b);
     EXPECT_EQ(a.Take(), b.Take());
-    for (uint32_t pass : {2u, 4u, 8u}) {
+    for (uint32_t round : {2u, 3u, 4u}) {
+        const uint32_t pass = FirstPassOfRound(round);
         EXPECT_EQ(overlapped.Pdf(points[1], kSide, w, pass), drained.Pdf(points[1], kSide, w, pass))
             << "pass " << pass;
     }

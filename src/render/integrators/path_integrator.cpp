@@ -91,7 +91,7 @@ StatusOr<int> PathIntegrator::RenderRounds(int passes, bool boundaries) {
     const int group =
         checks ? std::min(passes_per_wave, std::max(s == 0 ? 2 : 1, s / 4)) : passes_per_wave;
     int s_end = std::min(spp, s + group);
-    // The guide learns in rounds of passes that double (0 | 1 | 2-3 | 4-7 ...), and a round
+    // The guide learns in rounds of passes (0-1 | 2-3 | 4-7 | 8-15 ...), and a round
     // samples what the guide learned up to two rounds before (GuideRounds::kDoublingPasses): before
     // round r begins, round r - 2 must have ended, and its Update is made, at the same point of
     // every render, so that what each pass samples does not depend on the waves, the memory

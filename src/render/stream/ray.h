@@ -49,11 +49,14 @@ inline uint8_t ExtendSpecularChain(uint8_t flags, bool specular) {
 }
 
 /// The round of pass `pass` (a camera ray's sample index) in a render that learns in rounds of
-/// doubling length, passes 0 | 1 | 2-3 | 4-7 | ... (path guiding, GuideRounds::kDoublingPasses):
-/// the scheduler counts the rays in flight per round (StreamScheduler::DrainRoundsBefore).
-inline uint32_t RoundOfPass(uint32_t pass) { return uint32_t(std::bit_width(pass)); }
+/// doubling length after two of two passes, passes 0-1 | 2-3 | 4-7 | 8-15 | ... (path guiding,
+/// GuideRounds::kDoublingPasses): the scheduler counts the rays in flight per round
+/// (StreamScheduler::DrainRoundsBefore).
+inline uint32_t RoundOfPass(uint32_t pass) {
+    return pass < 2 ? 0 : uint32_t(std::bit_width(pass)) - 1;
+}
 /// The first pass of round `round`.
-inline uint32_t FirstPassOfRound(uint32_t round) { return round == 0 ? 0 : 1u << (round - 1); }
+inline uint32_t FirstPassOfRound(uint32_t round) { return round == 0 ? 0 : 1u << round; }
 
 struct RayRecord {
     Vec3f origin;

@@ -95,10 +95,9 @@ PathGuide::PathGuide(const Bounds3f& bounds, int coarse_cells_long_axis, uint32_
     cells_.reserve(max_cells_);
     if (rounds_ == GuideRounds::kDoublingPasses) overlap_.reserve(max_cells_);
     // With rounds that begin before the one two rounds back has ended, a cell given its
-    // histogram by an Update learns from the second round after it and guides from the fourth
-    // (passes 8-15): the coarse cells, when they take at most half the cap, have theirs from the
-    // start, so that the first round's paths teach them and the third round's (passes 2-3) are
-    // guided by them.
+    // histogram by the Update closing round 0 (at pass 4) learns from round 2 on and guides from
+    // round 4 (pass 16): the coarse cells, when they take at most half the cap, have theirs from
+    // the start, so that round 0's paths teach them and round 2's (passes 4-7) are guided by them.
     if (rounds_ == GuideRounds::kDoublingPasses && levels_[0].size <= max_cells_ / 2) {
         for (uint32_t i = 0; i < levels_[0].size; ++i) {
             levels_[0].slot[i] = uint32_t(cells_.size());

@@ -51,8 +51,9 @@ enum class GuideRounds {
     /// credits and samples need no pass (photon mode's gather guide: an Update per iteration,
     /// after a complete drain).
     kEveryUpdate,
-    /// Rounds of passes that double (passes 0 | 1 | 2-3 | 4-7 ..., RoundOfPass), and a pass of
-    /// round r samples what the Update closing round r - 2 made (none before round 2). Round r
+    /// Rounds of passes that double after two of two (passes 0-1 | 2-3 | 4-7 | 8-15 ...,
+    /// RoundOfPass), and a pass of round r samples what the Update closing round r - 2 made (none
+    /// before round 2, pass 4). Round r
     /// may then start while round r - 1's last rays are still in flight, and only round r - 2
     /// must have ended: a render under a memory budget overlaps the tail of one round, scattered
     /// over many bricks, with the next round's rays instead of draining it to the last ray
