@@ -70,7 +70,10 @@ TEST(RenderMemoryPlanTest, RenderStateCountsTheFilmAndTheModesState) {
     path.path_guiding = true;
     RenderStateBytes state = RenderStateMemory(path, 64, 48, false, false);
     EXPECT_EQ(state.film, Film::MemoryBytes(64, 48));
-    EXPECT_EQ(state.transport, PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells));
+    // Path mode's rounds overlap: the guide holds a second sum and distribution per cell.
+    EXPECT_EQ(state.transport, PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells,
+                                                      GuideRounds::kDoublingPasses));
+    EXPECT_GT(state.transport, PathGuide::MemoryBytes(kGuideCoarseCellsLongAxis, kGuideMaxCells));
     EXPECT_EQ(state.checkpoint, 0u);
     path.path_guiding = false;
     EXPECT_EQ(RenderStateMemory(path, 64, 48, false, false).transport, 0u);

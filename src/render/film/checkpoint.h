@@ -22,7 +22,8 @@
 namespace nave::render {
 
 inline constexpr char kCheckpointMagic[8] = {'N', 'A', 'V', 'E', 'C', 'K', 'P', 'T'};
-inline constexpr uint16_t kCheckpointMajor = 1;
+/// 2: path mode's guide learns in overlapping rounds (PathGuide's state holds them: 2026-12-02).
+inline constexpr uint16_t kCheckpointMajor = 2;
 inline constexpr uint16_t kCheckpointMinor = 0;
 inline constexpr uint32_t kCheckpointHeaderBytes = 40;
 
