@@ -121,6 +121,10 @@ void ExpectPagedEqualsInCore(const std::string& mode, double bound) {
     // overlap; then without the brick cache (every reload decodes the brick again); then with
     // queues spilled to disk beyond 64 KiB.
     for (int variant = 0; variant < 5; ++variant) {
+        // A guided render takes 64 passes to guide at all: prefetching on and small waves are its
+        // variants (the others' paging does not depend on the mode), which keeps it within the
+        // ThreadSanitizer suite's time.
+        if (mode == "path_guided" && variant != 0 && variant != 2) continue;
         const bool prefetch = variant != 1;
         const uint32_t wave_paths = variant == 2 ? 500 : 0;
         PagerOptions options = SmallBudget(*in_core->source, prefetch);
