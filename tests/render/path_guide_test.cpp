@@ -79,7 +79,7 @@ TEST(PathGuide, SamplesFollowThePdfThatIntegratesToOne) {
         const Vec3f w(std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi),
                       z);
         ASSERT_EQ(PathGuide::BinOf(w), b);
-        integral += guide.Pdf(p, kSide, w) * 4 * kPi / PathGuide::kBins;
+        integral += guide.Pdf(p, kSide, w, 0) * 4 * kPi / PathGuide::kBins;
     }
     EXPECT_NEAR(integral, 1.0, 1e-5);
     // Sampled directions land in the bins in proportion to pdf x the bin's solid angle, and each
@@ -87,10 +87,10 @@ TEST(PathGuide, SamplesFollowThePdfThatIntegratesToOne) {
     std::vector<double> counts(PathGuide::kBins, 0), expected(PathGuide::kBins, 0);
     constexpr int kSamples = 100000;
     for (int i = 0; i < kSamples; ++i) {
-        std::optional<GuideSample> s = guide.Sample(p, kSide, u(rng), u(rng), u(rng));
+        std::optional<GuideSample> s = guide.Sample(p, kSide, u(rng), u(rng), u(rng), 0);
         ASSERT_TRUE(s);
         ASSERT_NEAR(Length(s->wi), 1.f, 1e-5f);
-        ASSERT_FLOAT_EQ(s->pdf, guide.Pdf(p, kSide, s->wi));
+        ASSERT_FLOAT_EQ(s->pdf, guide.Pdf(p, kSide, s->wi, 0));
         counts[size_t(PathGuide::BinOf(s->wi))] += 1;
         expected[size_t(PathGuide::BinOf(s->wi))] = s->pdf * 4 * kPi / PathGuide::kBins * kSamples;
     }
@@ -138,7 +138,7 @@ TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
     ASSERT_TRUE(a.Guides(p, kSide));
     for (int i = 0; i < 1000; ++i) {
         const Vec3f w = UniformDirection(rng);
-        ASSERT_EQ(a.Pdf(p, kSide, w), b.Pdf(p, kSide, w));  // bit for bit
+        ASSERT_EQ(a.Pdf(p, kSide, w, 0), b.Pdf(p, kSide, w, 0));  // bit for bit
     }
 }
 
@@ -344,8 +344,8 @@ TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {
     EXPECT_FALSE(guide.Guides(outside, kSide));
     EXPECT_EQ(guide.cells_used(), 1u);
     EXPECT_EQ(guide.cells_guiding(), 1u);
-    EXPECT_EQ(guide.Pdf(second, kSide, up), 0.f);
-    EXPECT_FALSE(guide.Sample(second, kSide, 0.5f, 0.5f, 0.5f));
+    EXPECT_EQ(guide.Pdf(second, kSide, up, 0), 0.f);
+    EXPECT_FALSE(guide.Sample(second, kSide, 0.5f, 0.5f, 0.5f, 0));
 }
 
 TEST(GuidedBsdf, MixtureSamplesFollowTheMixturePdf) {
@@ -354,7 +354,7 @@ TEST(GuidedBsdf, MixtureSamplesFollowTheMixturePdf) {
     const Vec3f p(1, 1, 1);
     DiffuseBxdf diffuse(SampledSpectrum(0.8f));
     const Bsdf bsdf(Vec3f(0, 0, 1), Vec3f(1, 0, 0), Bxdf(diffuse));
-    const GuidedBsdf continuation(bsdf, &guide, p, kSide);
+    const GuidedBsdf continuation(bsdf, &guide, p, kSide, 0);
     ASSERT_TRUE(continuation.guided());
     const SampledWavelengths lambda = SampledWavelengths::SampleVisible(0.3f);
     const Vec3f wo = Normalize(Vec3f(0.3f, -0.2f, 1));
@@ -369,7 +369,7 @@ TEST(GuidedBsdf, MixtureSamplesFollowTheMixturePdf) {
         const double x = continuation.Pdf(wo, w, lambda) * 4 * kPi;
         integral += x;
         squares += x * x;
-        if (w.z < 0) below += guide.Pdf(p, kSide, w) * 4 * kPi;
+        if (w.z < 0) below += guide.Pdf(p, kSide, w, 0) * 4 * kPi;
     }
     // Within 4 standard errors of the estimate (the guide's peaked bins make it 0.45 % at this
     // count), which is itself small enough that a pdf off by a few percent fails.

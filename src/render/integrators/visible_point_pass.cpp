@@ -36,7 +36,7 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
         // (power heuristic, as in path mode), which goes on to the vertex whose photons it reads.
         // A photon's power then reaches pixels scattered across the image instead of a disc of
         // the gather radius around it.
-        const GuidedBsdf gather(bsdf, gather_guide_, h.p, side);
+        const GuidedBsdf gather(bsdf, gather_guide_, h.p, side, r.sample);
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, &gather, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);
         // Caustics here come from the caustic photons (visible_points.h): the gather finds them
@@ -63,7 +63,7 @@ bool VisiblePointPass::ScatterAt(RayRecord& r, uint32_t b, const ResidentBrick& 
                              r.beta, r.lambda);
         return false;
     }
-    const GuidedBsdf continuation(bsdf, nullptr, h.p, side);
+    const GuidedBsdf continuation(bsdf, nullptr, h.p, side, r.sample);
     if (flags & kBxdfGlossy) {
         EstimateDirect(r, b, brick, h, bsdf, wo, rng, &continuation, scene_.sky != nullptr,
                        PathGuide::kNoCredit, 0, out);

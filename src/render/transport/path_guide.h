@@ -131,10 +131,12 @@ class PathGuide {
     }
     /// A direction at `p` on a surface of side `side` from its finest cell guiding pass `pass`,
     /// and three uniform numbers; nothing if no cell there guides.
+    /// No default pass: in path mode a wrong one samples another round's distribution, and the
+    /// mixture's pdf then disagrees with what was sampled.
     std::optional<GuideSample> Sample(const Vec3f& p, int side, float u_bin, float u0, float u1,
-                                      uint32_t pass = 0) const;
+                                      uint32_t pass) const;
     /// The solid-angle pdf of Sample at `p`, `side` for direction `w` (0 if no cell there guides).
-    float Pdf(const Vec3f& p, int side, const Vec3f& w, uint32_t pass = 0) const;
+    float Pdf(const Vec3f& p, int side, const Vec3f& w, uint32_t pass) const;
 
     /// In a distributed render (docs/distributed.md), before each Update and before a checkpoint
     /// is written: gives every process's
@@ -220,8 +222,7 @@ class GuidedBsdf {
 
     /// The continuation at `p` of `bsdf` (both must outlive this) on a surface of side `side`
     /// (PathGuide::SideOf), of a path of pass `pass`; `guide` null: the BSDF alone.
-    GuidedBsdf(const Bsdf& bsdf, const PathGuide* guide, const Vec3f& p, int side,
-               uint32_t pass = 0)
+    GuidedBsdf(const Bsdf& bsdf, const PathGuide* guide, const Vec3f& p, int side, uint32_t pass)
         : bsdf_(bsdf),
           guide_(guide != nullptr && !(bsdf.Flags() & kBxdfSpecular) && guide->Guides(p, side, pass)
                      ? guide
