@@ -205,7 +205,10 @@ done
 
 # Paging under a small budget with the spill (ray queues beyond 64 KiB, the decoded-brick cache) on
 # the small disk: a failed spill is an error; a failed brick-cache write only stops the caching.
-paged=("${base[@]}" --memory 290M --pager prefer_resident=2,queue_memory=64K)
+# The budget leaves about five of the 16 bricks' worth of room beside the reserve (film, queues,
+# path guide), so that bricks are evicted and reloaded through the cache.
+budget=320M
+paged=("${base[@]}" --memory "$budget" --pager prefer_resident=2,queue_memory=64K)
 "${paged[@]}" --temp-dir "$work" -o "$work/ref_paged.exr" >"$work/run.log" 2>&1 ||
     { echo "reference paged render failed: $(tail -1 "$work/run.log")"; exit 1; }
 # What the spill held at most: the ray queues' and the brick cache's figures of the summary, in MiB.
@@ -213,7 +216,7 @@ spill_need=$(awk '/ray queues:/ { match($0, /at most [0-9.]+ MiB/); q = substr($
                   /brick cache:/ { match($0, /[0-9.]+ MiB on disk/); c = substr($0, RSTART, RLENGTH - 12) }
                   END { printf "%d", (q + c) * 1048576 }' "$work/run.log")
 ((spill_need > 0)) || { echo "no spill in the reference paged render: $(tail -4 "$work/run.log")"; exit 1; }
-echo "render under --memory 290M: the spill holds at most $spill_need bytes"
+echo "render under --memory $budget: the spill holds at most $spill_need bytes"
 for size in $(sizes_for "$spill_need"); do
     mount_disk "$size"
     trial "${paged[@]}" -q --temp-dir "$disk" -o "$work/out.exr" >"$work/run.log" 2>&1

@@ -29,6 +29,9 @@ namespace {
 
 const Bounds3f kBox(Vec3f(0, 0, 0), Vec3f(4, 4, 4));
 const int kSide = PathGuide::SideOf(Vec3f(0, 0, 1));  // the unit tests' surfaces face up
+// The pass of the credits and queries on guides whose every Update closes a round
+// (GuideRounds::kEveryUpdate, the default), which ignore it.
+constexpr uint32_t kAnyPass = 0;
 
 Vec3f UniformDirection(std::mt19937& rng) {
     std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -46,9 +49,10 @@ std::unique_ptr<PathGuide> LearnedGuide() {
     // Cells get their histograms at an update, and learn from the credits after it.
     for (int pass = 0; pass < 2; ++pass) {
         for (int i = 0; i < 300; ++i)
-            guide->Credit(guide->CreditKey(p, kSide, Normalize(Vec3f(1, 0.1f, 0.05f))), 2.0);
+            guide->Credit(guide->CreditKey(p, kSide, Normalize(Vec3f(1, 0.1f, 0.05f))), 2.0,
+                          kAnyPass);
         for (int i = 0; i < 100; ++i)
-            guide->Credit(guide->CreditKey(p, kSide, Vec3f(0, 0, -1)), 1.0);
+            guide->Credit(guide->CreditKey(p, kSide, Vec3f(0, 0, -1)), 1.0, kAnyPass);
         guide->Update();
     }
     return guide;
@@ -58,7 +62,7 @@ TEST(PathGuide, SamplesFollowThePdfThatIntegratesToOne) {
     const std::unique_ptr<PathGuide> learned = LearnedGuide();
     const PathGuide& guide = *learned;
     const Vec3f p(1.2f, 1.3f, 1.4f);  // same cell
-    ASSERT_TRUE(guide.Guides(p, kSide));
+    ASSERT_TRUE(guide.Guides(p, kSide, kAnyPass));
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     // The bins have equal solid angles: uniform directions fall in them equally (chi² with 255
@@ -129,13 +133,13 @@ TEST(PathGuide, TheOrderOfCreditsDoesNotChangeTheDistribution) {
     PathGuide a(kBox, 4, 16, 1.0), b(kBox, 4, 16, 1.0);
     const Vec3f p(3.5f, 0.5f, 2.5f);
     for (int pass = 0; pass < 2; ++pass) {
-        for (const auto& [w, v] : credits) a.Credit(a.CreditKey(p, kSide, w), v);
+        for (const auto& [w, v] : credits) a.Credit(a.CreditKey(p, kSide, w), v, kAnyPass);
         std::shuffle(credits.begin(), credits.end(), rng);
-        for (const auto& [w, v] : credits) b.Credit(b.CreditKey(p, kSide, w), v);
+        for (const auto& [w, v] : credits) b.Credit(b.CreditKey(p, kSide, w), v, kAnyPass);
         a.Update();
         b.Update();
     }
-    ASSERT_TRUE(a.Guides(p, kSide));
+    ASSERT_TRUE(a.Guides(p, kSide, kAnyPass));
     for (int i = 0; i < 1000; ++i) {
         const Vec3f w = UniformDirection(rng);
         ASSERT_EQ(a.Pdf(p, kSide, w, 0), b.Pdf(p, kSide, w, 0));  // bit for bit
@@ -200,15 +204,15 @@ TEST(PathGuide, SharedCreditsGiveEveryProcessTheGuideOfOne) {
             const Vec3f p = points[i % 2];
             const Vec3f w = UniformDirection(rng);
             const double v = std::exp(std::uniform_real_distribution<double>(-6, 2)(rng));
-            one.Credit(one.CreditKey(p, kSide, w), v);
+            one.Credit(one.CreditKey(p, kSide, w), v, kAnyPass);
             PathGuide& half = (i / 7) % 2 == 0 ? a : b;
-            half.Credit(half.CreditKey(p, kSide, w), v);
+            half.Credit(half.CreditKey(p, kSide, w), v, kAnyPass);
         }
         sum.Share(a, b);
         SCOPED_TRACE(::testing::Message() << "pass " << pass);
         ExpectUpdatesAlike(one, a, b);
     }
-    EXPECT_TRUE(one.Guides(points[0], kSide));
+    EXPECT_TRUE(one.Guides(points[0], kSide, kAnyPass));
 }
 
 // A checkpoint of a distributed render: the processes share their credits mid-pass, one saves the
@@ -222,9 +226,9 @@ TEST(PathGuide, ProcessesResumedFromASharedCheckpointShareOnlyNewCredits) {
         for (int i = 0; i < n; ++i) {
             const Vec3f w = UniformDirection(rng);
             const double v = std::exp(std::uniform_real_distribution<double>(-6, 2)(rng));
-            one.Credit(one.CreditKey(p, kSide, w), v);
+            one.Credit(one.CreditKey(p, kSide, w), v, kAnyPass);
             PathGuide& half = i % 3 == 0 ? x : y;
-            half.Credit(half.CreditKey(p, kSide, w), v);
+            half.Credit(half.CreditKey(p, kSide, w), v, kAnyPass);
         }
     };
     TwoProcessSum before;
@@ -247,7 +251,7 @@ TEST(PathGuide, ProcessesResumedFromASharedCheckpointShareOnlyNewCredits) {
     TwoProcessSum after;
     after.Share(c, d);
     ExpectUpdatesAlike(one, c, d);
-    EXPECT_TRUE(one.Guides(p, kSide));
+    EXPECT_TRUE(one.Guides(p, kSide, kAnyPass));
 }
 
 // Path mode's rounds (GuideRounds::kDoublingPasses): a render under a memory budget begins round
@@ -323,25 +327,25 @@ TEST(PathGuide, GuidesOnlyCellsThatLearnedEnoughWithinTheCap) {
     const Vec3f up(0, 0, 1);
     EXPECT_EQ(guide.CreditKey(outside, kSide, up), PathGuide::kNoCredit);
     auto credit = [&](const Vec3f& p, int n) {
-        for (int i = 0; i < n; ++i) guide.Credit(guide.CreditKey(p, kSide, up), 1.0);
+        for (int i = 0; i < n; ++i) guide.Credit(guide.CreditKey(p, kSide, up), 1.0, kAnyPass);
     };
     // Counted, not learned: the cell with most credits gets the one histogram at the update.
     credit(first, 20);
     credit(second, 19);
     guide.Update();
     EXPECT_EQ(guide.cells_used(), 1u);
-    EXPECT_FALSE(guide.Guides(first, kSide)) << "no credits since its histogram came";
+    EXPECT_FALSE(guide.Guides(first, kSide, kAnyPass)) << "no credits since its histogram came";
     credit(first, 63);
     credit(second, 100);
     guide.Update();
-    EXPECT_FALSE(guide.Guides(first, kSide)) << "63 credits are fewer than Update's 64";
+    EXPECT_FALSE(guide.Guides(first, kSide, kAnyPass)) << "63 credits are fewer than Update's 64";
     credit(first, 1);
     guide.Update();
-    EXPECT_TRUE(guide.Guides(first, kSide));
-    EXPECT_FALSE(guide.Guides(first, PathGuide::SideOf(Vec3f(0.1f, -0.9f, 0.3f))))
+    EXPECT_TRUE(guide.Guides(first, kSide, kAnyPass));
+    EXPECT_FALSE(guide.Guides(first, PathGuide::SideOf(Vec3f(0.1f, -0.9f, 0.3f)), kAnyPass))
         << "a wall in the same cell keeps its own histogram";
-    EXPECT_FALSE(guide.Guides(second, kSide)) << "beyond the cap";
-    EXPECT_FALSE(guide.Guides(outside, kSide));
+    EXPECT_FALSE(guide.Guides(second, kSide, kAnyPass)) << "beyond the cap";
+    EXPECT_FALSE(guide.Guides(outside, kSide, kAnyPass));
     EXPECT_EQ(guide.cells_used(), 1u);
     EXPECT_EQ(guide.cells_guiding(), 1u);
     EXPECT_EQ(guide.Pdf(second, kSide, up, 0), 0.f);

@@ -31,7 +31,10 @@ PathIntegrator::PathIntegrator(const RenderScene& scene, Film* film, StreamSched
                                std::unique_ptr<PathGuide> guide)
     : CameraPaths(scene, film, scheduler, *lights, guide.get()),
       owned_lights_(std::move(lights)),
-      owned_guide_(std::move(guide)) {}
+      owned_guide_(std::move(guide)) {
+    // A path's sample index is its pass: the guide's rounds wait for the rays of their passes.
+    scheduler.CountRoundsOfPasses();
+}
 
 double PathIntegrator::GuideRadianceScale(const RenderScene& scene) {
     // The radiance of a white surface in full sun (or, without a sun, the sky's brightest axis):

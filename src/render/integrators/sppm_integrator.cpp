@@ -343,8 +343,10 @@ bool SppmIntegrator::ShadePhoton(RayRecord& r, uint32_t b, const ResidentBrick& 
         // direct light is next-event estimated). Jensen 1995, "Importance driven path tracing
         // using the photon map", guides the bounce by the photons around the vertex likewise.
         const int side = PathGuide::SideSeenFrom(h.ns, wo);
+        // The gather guide closes a round at every Update (GuideRounds::kEveryUpdate): the
+        // photon's iteration is the round, whatever pass is given.
         gather_guide_->Credit(gather_guide_->CreditKey(h.p, side, wo),
-                              std::max(0.0, double(r.beta.Average())));
+                              std::max(0.0, double(r.beta.Average())), iteration_);
     }
     // As for paths, a photon at its last bounce still passes through thin glass.
     const bool last = uint32_t(r.depth) + 1 >= uint32_t(scene_.settings.max_depth);

@@ -190,7 +190,7 @@ std::string SentPerBrick::Text() const {
 }
 
 void StreamScheduler::CountRounds(std::span<const RayRecord> rays, int64_t sign) {
-    if (ranks_ != nullptr) return;
+    if (!count_rounds_ || ranks_ != nullptr) return;
     std::array<int64_t, kRounds> n{};
     for (const RayRecord& r : rays) ++n[RoundOfPass(r.sample)];
     for (size_t k = 0; k < kRounds; ++k) {
@@ -232,7 +232,7 @@ Status StreamScheduler::Drain(RayProcessor& processor, size_t stop_below) {
 }
 
 Status StreamScheduler::DrainRoundsBefore(RayProcessor& processor, uint32_t round) {
-    if (ranks_ != nullptr) return Drain(processor);
+    if (!count_rounds_ || ranks_ != nullptr) return Drain(processor);
     NAVE_RETURN_IF_ERROR(DrainUntil(processor, 0, round));
     for (uint32_t i = 0; i < queues_.brick_count(); ++i) {
         if (queues_.Waiting(i) > 0) {

@@ -151,8 +151,13 @@ class StreamScheduler {
     /// meanwhile (the fullest brick first, as always) and may stay in flight. A render that learns
     /// in rounds then waits for the round it learns from without draining the one after it, whose
     /// tail, a few rays over many bricks, rides on the next round's loads instead of costing loads
-    /// of its own. A distributed render drains completely instead (its processes count no rounds).
+    /// of its own. A distributed render drains completely instead (its processes count no rounds),
+    /// as does a scheduler that was not asked to count rounds.
     Status DrainRoundsBefore(RayProcessor& processor, uint32_t round);
+    /// Counts the rays waiting per round from now on, for DrainRoundsBefore: for renders whose
+    /// rays' sample index is a pass (path mode); photon mode's sample indices are not, and it has
+    /// no use for the counts. Call before the first ray is queued.
+    void CountRoundsOfPasses() { count_rounds_ = true; }
     /// How the last wave of DrainInWaves ends: with its tail still in flight (the next pass's first
     /// wave joins it), or drained to the last ray.
     enum class LastWave { kTailInFlight, kDrained };
@@ -246,6 +251,7 @@ class StreamScheduler {
     // One process: the rays waiting in the queues per round (RoundOfPass of their sample index,
     // 0..32), for DrainRoundsBefore.
     static constexpr size_t kRounds = 33;
+    bool count_rounds_ = false;
     std::array<std::atomic<int64_t>, kRounds> waiting_by_round_{};
 };
 

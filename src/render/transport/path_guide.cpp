@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "src/core/byte_stream.h"
@@ -270,28 +271,27 @@ void PathGuide::Update(uint32_t min_credits) {
     if (!shared_.empty()) shared_ = FlatCredits();
 }
 
-std::vector<uint64_t> PathGuide::FlatCredits() const {
-    // The levels' counts, then each cell's bins and credit count. Cells only ever join at the end
-    // (Update), so earlier entries keep their place.
-    size_t size = 0;
-    for (const Level& level : levels_) size += size_t(level.size) * (level.pending_count ? 2 : 1);
-    size += cells_.size() * (kBins + 1) + overlap_.size() * (kBins + 1);
-    std::vector<uint64_t> values(size);
-    size_t at = 0;
-    for (const Level& level : levels_) {
-        for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.count[i];
+template <class Guide, class F>
+void PathGuide::ForEachCredit(Guide& self, F&& f) {
+    for (auto& level : self.levels_) {
+        for (uint32_t i = 0; i < level.size; ++i) f(level.count[i]);
         if (!level.pending_count) continue;
-        for (uint32_t i = 0; i < level.size; ++i) values[at++] = level.pending_count[i];
+        for (uint32_t i = 0; i < level.size; ++i) f(level.pending_count[i]);
     }
-    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
-        const Cell& cell = *cells_[slot];
-        for (int b = 0; b < kBins; ++b) values[at++] = cell.sum[b];
-        values[at++] = cell.credits;
-        if (slot < overlap_.size()) {
-            for (int b = 0; b < kBins; ++b) values[at++] = overlap_[slot]->pending[b];
-            values[at++] = cell.pending_credits;
+    for (uint32_t slot = 0; slot < self.cells_.size(); ++slot) {
+        auto& cell = *self.cells_[slot];
+        for (int b = 0; b < kBins; ++b) f(cell.sum[b]);
+        f(cell.credits);
+        if (slot < self.overlap_.size()) {
+            for (int b = 0; b < kBins; ++b) f(self.overlap_[slot]->pending[b]);
+            f(cell.pending_credits);
         }
     }
+}
+
+std::vector<uint64_t> PathGuide::FlatCredits() const {
+    std::vector<uint64_t> values;
+    ForEachCredit(*this, [&](auto value) { values.push_back(uint64_t(value)); });
     return values;
 }
 
@@ -303,20 +303,9 @@ Status PathGuide::ShareCredits(const std::function<Status(std::span<uint64_t>)>&
     NAVE_RETURN_IF_ERROR(sum(values));
     for (size_t i = 0; i < size; ++i) shared_[i] += values[i];
     size_t at = 0;
-    for (Level& level : levels_) {
-        for (uint32_t i = 0; i < level.size; ++i) level.count[i] = uint32_t(shared_[at++]);
-        if (!level.pending_count) continue;
-        for (uint32_t i = 0; i < level.size; ++i) level.pending_count[i] = uint32_t(shared_[at++]);
-    }
-    for (uint32_t slot = 0; slot < cells_.size(); ++slot) {
-        Cell& cell = *cells_[slot];
-        for (int b = 0; b < kBins; ++b) cell.sum[b] = shared_[at++];
-        cell.credits = uint32_t(shared_[at++]);
-        if (slot < overlap_.size()) {
-            for (int b = 0; b < kBins; ++b) overlap_[slot]->pending[b] = shared_[at++];
-            cell.pending_credits = uint32_t(shared_[at++]);
-        }
-    }
+    ForEachCredit(*this, [&](auto& value) {
+        value = static_cast<std::remove_reference_t<decltype(value)>>(shared_[at++]);
+    });
     return Status::Ok();
 }
 

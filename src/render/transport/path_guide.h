@@ -113,7 +113,7 @@ class PathGuide {
     /// of pass `pass` (kDoublingPasses: of a round not yet closed; kEveryUpdate: ignored), to the
     /// bin of `key` in each level's cell that had a histogram when that round began, and counts
     /// the credit for the others. Thread-safe; the order of credits does not change the sums.
-    void Credit(uint32_t key, double value, uint32_t pass = 0);
+    void Credit(uint32_t key, double value, uint32_t pass);
 
     /// Closes the oldest round still open (kDoublingPasses: every pass of it must have ended;
     /// its successor may still be in flight): the credits of every closed round become the
@@ -126,7 +126,7 @@ class PathGuide {
     uint32_t rounds_closed() const { return rounds_closed_; }
 
     /// Whether a cell at `p` guides a path of pass `pass` (Sample and Pdf are then meaningful).
-    bool Guides(const Vec3f& p, int side, uint32_t pass = 0) const {
+    bool Guides(const Vec3f& p, int side, uint32_t pass) const {
         return Distribution(p, side, pass) != nullptr;
     }
     /// A direction at `p` on a surface of side `side` from its finest cell guiding pass `pass`,
@@ -204,6 +204,12 @@ class PathGuide {
     /// Appends a cell (and its Overlap when rounds overlap) made by the Update of `since_round`.
     void AddCell(int32_t since_round);
     uint32_t cells_guiding_ = 0;
+    /// Calls `f` on every credit the guide holds, in one fixed order: the levels' counts, then
+    /// each cell's bins and credit count. Cells only ever join at the end (Update), so earlier
+    /// entries keep their place. `self` is the guide, const or not; `f` takes the value by
+    /// reference (uint32_t or uint64_t).
+    template <class Guide, class F>
+    static void ForEachCredit(Guide& self, F&& f);
     /// Everything credited, flattened as ShareCredits sums it.
     std::vector<uint64_t> FlatCredits() const;
     // The credits as of the last ShareCredits (every count, then every cell's sums and credits),
