@@ -411,10 +411,11 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                   "Ignore the model's textures (textures.enabled = false)");
     cmd->add_option(
            "--lod", opts->lod,
-           "Levels of detail (render.lod): auto traces each ray against the coarsest level "
-           "of each brick its footprint allows, in stores made with `nave preprocess "
-           "--levels`; full (the default) traces full detail everywhere. Levels still "
-           "bias the image (docs/render.md, \"Levels of detail\")")
+           "Levels of detail (render.lod): auto traces each ray scattered by a diffuse or "
+           "glossy surface against the coarsest level of each brick its footprint allows "
+           "(camera rays keep full detail), in stores made with `nave preprocess --levels`; "
+           "full (the default) traces full detail everywhere (docs/render.md, \"Levels of "
+           "detail\")")
         ->check(CLI::IsMember({"auto", "full"}));
     cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
                     "Write the render's state to FILE between passes (photon mode: iterations), at "

@@ -16,6 +16,7 @@
 #include "src/render/stream/level_choice.h"
 #include "src/render/stream/pager.h"
 #include "src/render/stream/stream_scheduler.h"
+#include "src/render/transport/transport_common.h"
 
 namespace nave::render {
 namespace {
@@ -68,6 +69,33 @@ TEST(LevelChoice, ShadowRaysAreAsWideAsTheirLight) {
     r.cone_spread = std::max(r.cone_spread, sun.ShadowSpread());
     EXPECT_EQ(ChooseLevel(errors, 2, ConeWidthAt(r, 4.f)), 0u);
     EXPECT_EQ(ChooseLevel(errors, 2, ConeWidthAt(r, 6.f)), 1u);
+}
+
+// A pixel's value is the mean of what covers it, and a coarse level does not cover what the full
+// mesh does (thin parts thin out): a camera ray, and a path that has since only crossed glass or
+// met mirrors, keep full detail however wide their footprint grows; a diffuse or glossy bounce
+// (LeaveSurface, scattered) lets the path use levels, and shadow rays and photons use them as wide
+// as they are.
+TEST(LevelChoice, PathsUseLevelsOnlyPastADiffuseOrGlossyBounce) {
+    RayRecord camera{};
+    camera.kind = kPathRay;
+    camera.cone_spread = 2.65e-3f;  // a pixel's
+    EXPECT_FALSE(UsesLevels(camera));
+    SurfaceHit mirror{};
+    mirror.ng = mirror.ns = Vec3f(0, 0, 1);
+    RayRecord reflected = camera;
+    LeaveSurface(reflected, mirror, Vec3f(0, 0, 1), 40.f, /*scattered=*/false);
+    EXPECT_FALSE(UsesLevels(reflected)) << "wide, but still the pixel's cone";
+    EXPECT_NEAR(reflected.cone_width, 0.106f, 1e-6f);
+    RayRecord bounced = camera;
+    LeaveSurface(bounced, mirror, Vec3f(0, 0, 1), 40.f, /*scattered=*/true);
+    EXPECT_TRUE(UsesLevels(bounced));
+    RayRecord shadow = camera;
+    shadow.kind = kShadowRay;
+    EXPECT_TRUE(UsesLevels(shadow));
+    RayRecord photon = camera;
+    photon.kind = kPhotonRay;
+    EXPECT_TRUE(UsesLevels(photon));
 }
 
 /// Levels of a few cm and a decimetre on these metre-sized test bricks.

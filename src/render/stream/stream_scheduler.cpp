@@ -157,6 +157,7 @@ uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) co
     r.t_enter = s.t_enter;
     r.t_exit = s.t_exit;
     if (s.brick == store::kNoBrick || source_.level_count() == 1) return s.brick;
+    if (!UsesLevels(r)) return source_.SlotOf(s.brick, 0);
     // Near its origin, and in the whole brick it starts in, a ray keeps the level of the surface
     // it leaves: that level's copy of the surface is the one it leaves, and another level's could
     // lie on either side of it (LevelReach). Elsewhere its footprint chooses, where it enters the
