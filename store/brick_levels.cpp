@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <unordered_map>
 
 #include "store/brick_codec.h"
 
@@ -52,6 +54,8 @@ struct Scratch {
     std::vector<Vec3f> positions;
     std::vector<uint32_t> indices;
     std::vector<uint32_t> simplified;
+    /// Per vertex of the source mesh: whether it must stay where it is (LockedVertices).
+    std::vector<bool> locked;
 };
 
 /// The area of the triangles `indices` (into `positions`) form.
@@ -73,6 +77,8 @@ constexpr int kAreaRetries = 3;
 /// while their area changes by at most `max_area_change`, appending the kept triangles (indices
 /// into `mesh`'s vertices) to `out`. Returns the absolute error reached: meshoptimizer's relative
 /// error times its scale (the submesh's extent), since the submesh alone is simplified.
+/// With `lock_borders` every border stays; otherwise s.locked (when not empty) names the vertices
+/// that stay.
 float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, float target_error,
                       bool lock_borders, double max_area_change, Scratch& s, BrickMesh* out) {
     // A compact copy of the submesh's vertices: meshoptimizer's work and its scale then depend on
@@ -92,6 +98,14 @@ float SimplifySubmesh(const BrickMesh& mesh, const Submesh& sub, float target_er
         }
     }
     for (uint32_t v : s.global_of) s.local_of[v] = kUnused;
+    // meshoptimizer 0.18 takes no per-vertex locks, but never moves a vertex that shares its
+    // position with more than one other, nor one whose twin has no open edge to match its own
+    // (its classifyVertices: Kind_Locked): an unreferenced copy of a vertex locks it.
+    if (!s.locked.empty()) {
+        const size_t referenced = s.positions.size();
+        for (size_t l = 0; l < referenced; ++l)
+            if (s.locked[s.global_of[l]]) s.positions.push_back(s.positions[l]);
+    }
 
     const auto keep_whole = [&] {
         for (uint32_t t : sub.triangles)
@@ -211,7 +225,66 @@ uint32_t LevelGridShift(const BrickMesh& level, float error, const GlobalGrid& g
     return 0;
 }
 
-std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options) {
+namespace {
+
+/// The vertices of `mesh` that a level keeps in place under BorderLock::kCutAndMaterials: those
+/// not strictly inside `cell`, and those whose position triangles of two materials use. A brick
+/// holds every triangle whose box overlaps its cell, so a border where it was cut from its
+/// neighbours has at least one end outside the cell or on a face (the missing neighbour would
+/// otherwise overlap the cell too): with those ends locked, the cut border stays where it is.
+std::vector<bool> LockedVertices(const BrickMesh& mesh, const Bounds3f& cell) {
+    std::vector<bool> locked(mesh.VertexCount(), false);
+    for (size_t v = 0; v < locked.size(); ++v) {
+        const Vec3f& p = mesh.positions[v];
+        for (int a = 0; a < 3; ++a)
+            if (!(p[a] > cell.min[a] && p[a] < cell.max[a])) locked[v] = true;
+    }
+    // One number per distinct position: the decoder may give a position several vertices (Draco
+    // splits them where the surface is not a manifold), and a border between materials is a
+    // border of positions.
+    struct PositionHash {
+        size_t operator()(const Vec3f& p) const {
+            uint32_t b[3];
+            std::memcpy(b, &p, sizeof(b));
+            return size_t((uint64_t(b[0]) * 0x9E3779B97F4A7C15ull) ^
+                          (uint64_t(b[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                          (uint64_t(b[2]) * 0x165667B19E3779F9ull));
+        }
+    };
+    struct PositionEqual {
+        bool operator()(const Vec3f& a, const Vec3f& b) const {
+            return a.x == b.x && a.y == b.y && a.z == b.z;
+        }
+    };
+    std::unordered_map<Vec3f, uint32_t, PositionHash, PositionEqual> number_of;
+    number_of.reserve(mesh.VertexCount());
+    std::vector<uint32_t> position_of(mesh.VertexCount());
+    for (size_t v = 0; v < position_of.size(); ++v) {
+        position_of[v] =
+            number_of.try_emplace(mesh.positions[v], uint32_t(number_of.size())).first->second;
+    }
+    // The material of each position's first triangle, or kShared once a second one appears.
+    constexpr uint32_t kShared = kUnused - 1;
+    std::vector<uint32_t> material_at(number_of.size(), kUnused);
+    for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
+        const uint32_t m = mesh.material_ids[t];
+        for (int c = 0; c < 3; ++c) {
+            uint32_t& at = material_at[position_of[mesh.indices[3 * t + c]]];
+            if (at == kUnused)
+                at = m;
+            else if (at != m)
+                at = kShared;
+        }
+    }
+    for (size_t v = 0; v < locked.size(); ++v)
+        if (material_at[position_of[v]] == kShared) locked[v] = true;
+    return locked;
+}
+
+}  // namespace
+
+std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options,
+                                        const Bounds3f* cell) {
     std::vector<BrickLevel> levels;
     // Each level is simplified from the one before, by reference: no reallocation.
     levels.reserve(options.relative_errors.size());
@@ -220,6 +293,9 @@ std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOption
     Bounds3f box;
     for (const Vec3f& p : full.positions) box.Extend(p);
     const double extent = double(Length(box.Diagonal()));
+    using BorderLock = LevelOptions::BorderLock;
+    const bool selective = options.border_lock == BorderLock::kCutAndMaterials && cell != nullptr;
+    const bool lock_every_border = options.border_lock != BorderLock::kNone && !selective;
     Scratch scratch;
     const BrickMesh* source = &full;
     float source_error = 0;  // the error `source` already carries
@@ -229,11 +305,12 @@ std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOption
         const float step_target = float(relative * extent) - source_error;
         if (!(step_target > 0)) break;
         scratch.local_of.assign(source->VertexCount(), kUnused);
+        if (selective) scratch.locked = LockedVertices(*source, *cell);
         BrickLevel level;
         float step_error = 0;
         for (const Submesh& sub : SplitByMaterial(*source)) {
             step_error = std::max(step_error,
-                                  SimplifySubmesh(*source, sub, step_target, options.lock_borders,
+                                  SimplifySubmesh(*source, sub, step_target, lock_every_border,
                                                   options.max_area_change, scratch, &level.mesh));
         }
         const size_t triangles = level.mesh.TriangleCount();

@@ -25,12 +25,23 @@ struct LevelOptions {
     /// A level that keeps more than this fraction of the previous level's triangles is not made
     /// (nor any coarser one): it would cost nearly as much to load as the level before.
     double max_kept_fraction = 0.5;
-    /// Keep the vertices on the borders of each material's surface where they are: the borders
-    /// where the brick was cut from its neighbours (which lie outside its cell, since a brick
-    /// holds every triangle overlapping it) and those between materials. Without, a level's border
-    /// recedes by up to its error, which opens holes inside the cell at its faces (a wall cut by a
-    /// cell face then lets light through at the coarse level: tests/render/levels_of_detail_test).
-    bool lock_borders = true;
+    /// Which borders of each material's surface stay where they are. A brick holds every triangle
+    /// crossing its cell, and the border where it was cut from its neighbours lies outside the
+    /// cell: were it to recede by up to the level's error, holes would open inside the cell at
+    /// its faces (a wall cut by a face would let light through at the coarse level:
+    /// tests/render/levels_of_detail_test). Borders between materials, left free, would open
+    /// cracks between them. The model's own open borders inside the cell (the ends of open
+    /// strips, of mouldings and tracery made of separate sheets) slide along themselves, as
+    /// meshoptimizer moves borders, within the level's error: locked too, they kept the
+    /// detail-9 abbey's level 1 at 28.8 % of its triangles instead of 13.1 %
+    /// (docs/store-format.md, "Levels").
+    enum class BorderLock {
+        kNone,             ///< every border slides along itself (small test surfaces)
+        kEvery,            ///< every border stays (meshopt_SimplifyLockBorder)
+        kCutAndMaterials,  ///< the brick's cut and the borders between materials stay
+    };
+    /// Without a cell (MakeBrickLevels' `cell`), kCutAndMaterials locks every border.
+    BorderLock border_lock = BorderLock::kCutAndMaterials;
     /// The largest change, as a fraction, of a material's surface area in a brick that a level may
     /// make. Collapsing a part smaller than the error (a stud, a crocket, a finial) keeps the
     /// error small but takes the whole part's area away, and with it the light it stops: such a
@@ -72,11 +83,13 @@ inline constexpr size_t kMinLevelSourceTriangles = 64;
 /// The levels of `full`, finest first, each with a larger error than the one before. Thread-safe.
 /// Empty when the mesh does not simplify (fewer than kMinLevelSourceTriangles triangles, or the
 /// first level keeps too much). Every triangle keeps its material (edges collapse only within one
-/// material's triangles); normals and texture coordinates are those of the vertices kept; with
-/// options.lock_borders (the default) the borders, those of the brick and those between
-/// materials, stay where they are, so a level has no hole its brick's full mesh lacks. `full`
-/// must satisfy ValidateBrickMesh; so does every level.
-std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options = {});
+/// material's triangles); normals and texture coordinates are those of the vertices kept; unless
+/// options.border_lock is kNone the brick's cut and the borders between materials stay where
+/// they are, so a level has no hole its brick's full mesh lacks. `cell` is the brick's cell,
+/// where its cut lies; null for a mesh that stands alone (every border then stays). `full` must
+/// satisfy ValidateBrickMesh; so does every level.
+std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOptions& options = {},
+                                        const Bounds3f* cell = nullptr);
 
 /// The grid shift s (EncodeMeshSection) for `level`, whose error is `error`: the largest such that
 /// every 2^s-th point of `grid` lies within options.max_grid_error_fraction * error of any point

@@ -113,7 +113,7 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
             codec::DecodeMeshSection(brick.mesh_bytes, grid, uint64_t(codec::kMaxMaterialId) + 1,
                                      "the brick just encoded"));
     }
-    std::vector<BrickLevel> levels = MakeBrickLevels(*encoded.decoded, options.levels);
+    std::vector<BrickLevel> levels = MakeBrickLevels(*encoded.decoded, options.levels, &cell);
     brick.simplify_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EncodeOptions level_options = options;

@@ -20,7 +20,7 @@ TEST(BrickOwners, RanksGetRunsOfNeighbouringBricksOfAboutEqualSize) {
     const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 128, .quads_y = 128});
     store::LevelOptions levels;
     levels.relative_errors = {0.02};
-    levels.lock_borders = false;
+    levels.border_lock = store::LevelOptions::BorderLock::kNone;
     auto source = testing::GridSourceWithLevels(mesh, testing::NamedMaterials({"a", "b", "c"}),
                                                 {4, 4, 1}, levels);
     ASSERT_TRUE(source != nullptr);
@@ -98,7 +98,7 @@ TEST(SentPerBrick, CountsTheRaysSentToEachOtherBrick) {
     const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 64, .quads_y = 64});
     store::LevelOptions levels;
     levels.relative_errors = {0.02};
-    levels.lock_borders = false;
+    levels.border_lock = store::LevelOptions::BorderLock::kNone;
     auto source =
         testing::GridSourceWithLevels(mesh, testing::NamedMaterials({"a"}), {4, 1, 1}, levels);
     ASSERT_TRUE(source != nullptr);

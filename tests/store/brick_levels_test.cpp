@@ -152,6 +152,67 @@ TEST(BrickLevels, FineSheetSimplifiesAsFarAsItsErrorTargetsAllow) {
     }
 }
 
+TEST(BrickLevels, ABrickKeepsItsCutAndItsMaterialBordersAndMovesItsOwnBorders) {
+    // The sheet spans x in [0, 10] with material 0 left of x = 5 and material 1 right of it; the
+    // brick's cell ends at x = 7.45, and the brick holds, as preprocess cuts, the triangles whose
+    // boxes overlap the cell: their vertices at x = 7.5 are the cut, held for the neighbour.
+    const Bounds3f cell({-1.f, -1.f, -1.f}, {7.45f, 11.f, 1.f});
+    const BrickMesh sheet = FineSheet();
+    BrickMesh full = sheet;
+    full.indices.clear();
+    full.material_ids.clear();
+    for (size_t t = 0; t < sheet.TriangleCount(); ++t) {
+        Bounds3f box;
+        for (const Vec3f& p : sheet.TrianglePositions(t)) box.Extend(p);
+        if (!box.Overlaps(cell)) continue;
+        full.indices.insert(full.indices.end(), &sheet.indices[3 * t], &sheet.indices[3 * t + 3]);
+        full.material_ids.push_back(sheet.material_ids[t]);
+    }
+    LevelOptions options;
+    options.relative_errors = {0.002};
+    const std::vector<BrickLevel> levels = MakeBrickLevels(full, options, &cell);
+    ASSERT_EQ(levels.size(), 1u);
+    std::set<PositionKey> kept;
+    for (const Vec3f& p : levels[0].mesh.positions) kept.insert(KeyOf(p));
+    size_t cut = 0, between_materials = 0, own_border = 0, own_border_kept = 0;
+    for (const Vec3f& p : full.positions) {
+        if (p.x > 7.55f) continue;  // no triangle of the brick uses it
+        if (p.x > 7.45f) {
+            ++cut;
+            EXPECT_TRUE(kept.count(KeyOf(p))) << "cut vertex " << p.x << ", " << p.y;
+        } else if (p.x == 5.f) {
+            ++between_materials;
+            EXPECT_TRUE(kept.count(KeyOf(p))) << "material border " << p.x << ", " << p.y;
+        } else if (p.x == 0.f) {  // the sheet's own straight border, inside the cell
+            ++own_border;
+            own_border_kept += kept.count(KeyOf(p));
+        }
+    }
+    EXPECT_EQ(cut, 101u);
+    EXPECT_EQ(between_materials, 101u);
+    ASSERT_EQ(own_border, 101u);
+    // A straight border slides along itself: few of its vertices are needed.
+    EXPECT_LT(own_border_kept, own_border / 4);
+    // Every coarse vertex lies within the level's error of the full surface.
+    for (size_t v = 0; v < levels[0].mesh.VertexCount(); v += 5) {
+        EXPECT_LE(DistanceToMesh(levels[0].mesh.positions[v], full), levels[0].error + 1e-5)
+            << "vertex " << v;
+    }
+    // With every border locked (or without a cell, where the cut is unknown) the sheet's own
+    // border stays whole, and the level keeps more.
+    options.border_lock = LevelOptions::BorderLock::kEvery;
+    const std::vector<BrickLevel> every = MakeBrickLevels(full, options, &cell);
+    const std::vector<BrickLevel> no_cell = MakeBrickLevels(full, LevelOptions{{0.002}});
+    ASSERT_EQ(every.size(), 1u);
+    ASSERT_EQ(no_cell.size(), 1u);
+    EXPECT_EQ(no_cell[0].mesh.indices, every[0].mesh.indices);
+    EXPECT_GT(every[0].mesh.TriangleCount(), levels[0].mesh.TriangleCount());
+    std::set<PositionKey> every_kept;
+    for (const Vec3f& p : every[0].mesh.positions) every_kept.insert(KeyOf(p));
+    for (uint32_t j = 0; j <= 100; ++j)
+        EXPECT_TRUE(every_kept.count(KeyOf(full.positions[j * 101]))) << "border vertex " << j;
+}
+
 TEST(BrickLevels, SmallMeshesAndTooFineErrorsMakeNoLevels) {
     testing::SurfaceOptions small;
     small.quads_x = 4;

@@ -102,7 +102,8 @@ TEST_F(NaveCli, InspectAndVerifyCoverTheLevels) {
     const std::filesystem::path with_levels = dir_ / "levels.nave";
     EncodeOptions options;
     options.levels.relative_errors = {0.002, 0.05};
-    options.levels.lock_borders = false;  // two levels on this small surface
+    options.levels.border_lock =
+        LevelOptions::BorderLock::kNone;  // two levels on this small surface
     ASSERT_TRUE(testing::WriteGridStore(
                     with_levels, testing::MakeSurface({.quads_x = 40, .quads_y = 40}),
                     testing::MakeMaterials(3), {2, 2, 1}, GlobalGrid{{0, 0, 0}, 1e-3}, options)

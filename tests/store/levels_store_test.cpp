@@ -36,7 +36,7 @@ void ExpectError(const Status& status, StatusCode code, std::initializer_list<st
 LevelOptions TwoLevels() {
     LevelOptions l;
     l.relative_errors = {0.002, 0.05};
-    l.lock_borders = false;
+    l.border_lock = LevelOptions::BorderLock::kNone;
     return l;
 }
 
