@@ -438,12 +438,14 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    ASSERT_TRUE(ParsePagerTunables("brick_cache=off,brick_cache_limit=3G", &o).ok());
+    EXPECT_FALSE(o.skip_air);
+    ASSERT_TRUE(ParsePagerTunables("brick_cache=off,brick_cache_limit=3G,skip_air=on", &o).ok());
+    EXPECT_TRUE(o.skip_air);
     EXPECT_FALSE(o.brick_cache);
     EXPECT_EQ(o.brick_cache_limit_bytes, uint64_t(3) << 30);
-    for (const char* bad :
-         {"prefetch=maybe", "nearly_empty_rays=-3", "prefer_resident=x", "speed=11", "prefetch",
-          "evict=random", "wave_overlap=2", "brick_cache=yes", "brick_cache_limit=lots"}) {
+    for (const char* bad : {"prefetch=maybe", "nearly_empty_rays=-3", "prefer_resident=x",
+                            "speed=11", "prefetch", "evict=random", "wave_overlap=2",
+                            "brick_cache=yes", "brick_cache_limit=lots", "skip_air=1"}) {
         Status s = ParsePagerTunables(bad, &o);
         EXPECT_FALSE(s.ok()) << bad;
         const std::string key = std::string(bad).substr(0, std::string(bad).find('='));

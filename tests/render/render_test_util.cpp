@@ -35,10 +35,10 @@ std::unique_ptr<BrickSource> GridSourceWithLevels(const store::BrickMesh& mesh,
     EXPECT_TRUE(device.ok()) << device.status().ToString();
     if (!device.ok()) return nullptr;
     GridBricks grid = SplitIntoGridBricks(mesh, cells.x, cells.y, cells.z);
-    const std::vector<Bounds3f> cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
+    const std::vector<Bounds3f> brick_cells = grid.tree.BrickCells(uint32_t(grid.meshes.size()));
     std::vector<std::vector<store::BrickLevel>> coarser;
     for (size_t b = 0; b < grid.meshes.size(); ++b)
-        coarser.push_back(store::MakeBrickLevels(grid.meshes[b], levels, &cells[b]));
+        coarser.push_back(store::MakeBrickLevels(grid.meshes[b], levels, &brick_cells[b]));
     return std::make_unique<MemoryBrickSource>(*device, std::move(grid.tree),
                                                std::move(grid.meshes), std::move(materials),
                                                std::move(coarser));

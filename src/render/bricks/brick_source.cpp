@@ -171,6 +171,12 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         return slot.error;
     }
     slot.brick = std::move(built).value();
+    if (LevelOfSlot(id) == 0 && slot.occupancy_owned == nullptr) {
+        const ResidentMesh& m = slot.brick->mesh();
+        slot.occupancy_owned =
+            std::make_unique<const OccupancyGrid>(OccupancyGrid::Of(m.positions, m.indices));
+        slot.occupancy.store(slot.occupancy_owned.get(), std::memory_order_release);
+    }
     {
         std::lock_guard<std::mutex> stats_lock(stats_mutex_);
         stats_.loads += 1;

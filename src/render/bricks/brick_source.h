@@ -16,6 +16,7 @@
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
 #include "src/render/bricks/embree_device.h"
+#include "src/render/bricks/occupancy_grid.h"
 #include "src/render/bricks/resident_brick.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
@@ -123,6 +124,12 @@ class BrickSource {
     /// piece. NotFound if the source holds no medium grid; InvalidArgument if bricks are resident.
     Status UseStoredMedium(float scale);
     BrickSourceStats stats() const;
+    /// Where brick `brick`'s full mesh has triangles (OccupancyGrid), once it has been loaded at
+    /// full detail; null before. Kept when the brick is evicted: OccupancyGrid::kMemoryBytes per
+    /// brick, counted by the memory plan. Thread-safe.
+    const OccupancyGrid* Occupancy(uint32_t brick) const {
+        return slots_[brick]->occupancy.load(std::memory_order_acquire);
+    }
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
     /// portals).
     EmbreeDevice& device() const { return *device_; }
@@ -202,6 +209,10 @@ class BrickSource {
         std::unique_ptr<ResidentBrick> brick;
         std::atomic<uint32_t> pins{0};
         Status error;  // sticky load error
+        // Level 0's only: where the full mesh has triangles, made at its first load and kept
+        // through evictions (Occupancy).
+        std::unique_ptr<const OccupancyGrid> occupancy_owned;
+        std::atomic<const OccupancyGrid*> occupancy{nullptr};
     };
     std::shared_ptr<EmbreeDevice> device_;
     store::BrickTree tree_;

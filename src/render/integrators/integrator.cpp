@@ -7,6 +7,9 @@ namespace nave::render {
 
 StatusOr<std::unique_ptr<Integrator>> Integrator::Create(const RenderScene& scene, Film* film,
                                                          StreamScheduler& scheduler) {
+    // Between surfaces only a medium acts on a ray: without one, a brick crossed in its air may be
+    // passed over.
+    if (!scene.medium) scheduler.SkipBricksCrossedInAir();
     switch (scene.settings.mode) {
         case RenderSettings::Mode::kPath: {
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<PathIntegrator> path,

@@ -52,8 +52,9 @@ size_t MaxBatchRays(uint64_t queue_memory_bytes) {
 uint64_t RenderReserveBytes(const RenderMemoryInputs& in, const RenderSettings& settings,
                             uint64_t queue_memory_bytes) {
     const uint64_t pixels = uint64_t(in.width) * uint64_t(in.height);
-    // The process without bricks, and per brick its queue, slot and statistics.
-    const uint64_t process = in.process_bytes + kRenderGrowthBytes + uint64_t(in.brick_count) * 256;
+    // The process without bricks, and per brick its queue, slot, statistics and occupancy grid.
+    const uint64_t process =
+        in.process_bytes + kRenderGrowthBytes + uint64_t(in.brick_count) * 256 + in.occupancy_bytes;
     // Ray queues: the camera paths of a wave each with a shadow ray in flight, and the batch taken
     // from a queue (at most one record per ray in flight).
     const uint64_t per_pass =
@@ -85,6 +86,7 @@ RenderMemoryInputs RenderMemoryInputs::Measure(const BrickSource& source,
     inputs.pager = pager;
     inputs.brick_count = source.slot_count();
     inputs.bricks = MinimumBrickBudget(source, pager.prefetch);
+    inputs.occupancy_bytes = uint64_t(source.brick_count()) * OccupancyGrid::kMemoryBytes;
     // One decode at a time under a budget: the largest load's scratch is the most beside bricks.
     for (uint32_t b = 0; b < source.slot_count(); ++b) {
         inputs.load_scratch_bytes = std::max(inputs.load_scratch_bytes, source.LoadScratchBytes(b));

@@ -68,6 +68,8 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
                     "pager tunable queue_memory={}: expected a size (64M; 0: no spilling)", value);
             }
             options->queue_memory_bytes = *bytes;
+        } else if (key == "skip_air") {
+            NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->skip_air));
         } else if (key == "bvh_compact") {
             NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->bvh.compact));
         } else if (key == "evict") {

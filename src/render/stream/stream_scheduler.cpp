@@ -54,6 +54,7 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
             ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
+    scheduler->skip_air_allowed_ = paging.skip_air;
     NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
     return scheduler;
 }
@@ -151,23 +152,38 @@ Status StreamScheduler::ForEachBrick(
 }
 
 uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) const {
-    const uint32_t current_brick =
-        current == store::kNoBrick ? current : source_.BrickOfSlot(current);
-    BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current_brick);
-    r.t_enter = s.t_enter;
-    r.t_exit = s.t_exit;
-    if (s.brick == store::kNoBrick || source_.level_count() == 1) return s.brick;
-    if (!UsesLevels(r)) return source_.SlotOf(s.brick, 0);
+    uint32_t current_brick = current == store::kNoBrick ? current : source_.BrickOfSlot(current);
+    for (;;) {
+        const BrickSegment s = NextBrick(tree_, r.origin, r.dir, from_t, r.t_max, current_brick);
+        r.t_enter = s.t_enter;
+        r.t_exit = s.t_exit;
+        if (s.brick == store::kNoBrick) return s.brick;
+        const uint32_t level = LevelOfSegment(r, s.brick);
+        if (level == 0 && skip_air_) {
+            // At full detail a segment ends where TraceInBrick's does (SegmentEnd, no overlap).
+            const OccupancyGrid* grid = source_.Occupancy(s.brick);
+            if (grid != nullptr &&
+                grid->SegmentEmpty(r.origin, r.dir, s.t_enter,
+                                   std::min(SegmentEndWithSlack(s.t_exit), r.t_max))) {
+                from_t = s.t_exit;
+                current_brick = s.brick;
+                continue;
+            }
+        }
+        return source_.SlotOf(s.brick, level);
+    }
+}
+
+uint32_t StreamScheduler::LevelOfSegment(const RayRecord& r, uint32_t brick) const {
+    if (source_.level_count() == 1 || !UsesLevels(r)) return 0;
     // Near its origin, and in the whole brick it starts in, a ray keeps the level of the surface
     // it leaves: that level's copy of the surface is the one it leaves, and another level's could
     // lie on either side of it (LevelReach). Elsewhere its footprint chooses, where it enters the
     // cell: the footprint is narrowest there, so every hit inside is at least as wide.
-    const bool near_origin = s.t_enter == 0 || s.t_enter < r.level_reach;
-    const uint32_t level = near_origin
-                               ? std::min<uint32_t>(r.origin_level, source_.LevelsOf(s.brick) - 1)
-                               : ChooseLevel(source_.LevelErrors(s.brick), source_.level_count(),
-                                             ConeWidthAt(r, s.t_enter));
-    return source_.SlotOf(s.brick, level);
+    const bool near_origin = r.t_enter == 0 || r.t_enter < r.level_reach;
+    return near_origin ? std::min<uint32_t>(r.origin_level, source_.LevelsOf(brick) - 1)
+                       : ChooseLevel(source_.LevelErrors(brick), source_.level_count(),
+                                     ConeWidthAt(r, r.t_enter));
 }
 
 void SentPerBrick::Count(const BrickSource& source, uint32_t from_slot, const RayOutbox& out) {

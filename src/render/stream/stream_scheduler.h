@@ -129,8 +129,16 @@ class StreamScheduler {
                         const std::function<Status(uint32_t brick, const ResidentBrick&)>& visit);
     /// Sets r's segment to the first brick after `from_t` other than `current`'s; returns its slot
     /// at the level of detail r's footprint there chooses (level_choice.h), or store::kNoBrick
-    /// (the ray leaves the model, or reaches t_max, first). `current` is a slot.
+    /// (the ray leaves the model, or reaches t_max, first). `current` is a slot. With
+    /// SkipBricksCrossedInAir, a brick whose full mesh r's segment cannot meet
+    /// (BrickSource::Occupancy) is passed over as a trace there would miss it.
     uint32_t Route(RayRecord& r, float from_t, uint32_t current) const;
+    /// Where the paging options ask for it (PagerOptions::skip_air), Route passes over the
+    /// full-detail bricks a ray crosses only through empty voxels of their occupancy grids
+    /// (docs/pager.md, "Rays that cross a brick's air"): for renders without a medium, whose rays
+    /// do nothing between surfaces (a medium's flight over a passed brick would be drawn over
+    /// another stretch).
+    void SkipBricksCrossedInAir() { skip_air_ = skip_air_allowed_; }
     /// Whether this process makes ray `r`, one of the rays made outside a batch (a camera ray or
     /// a photon, `index` its pixel or photon): every process makes them all in the same way and
     /// keeps those whose first brick it owns, and of those that meet no brick, every size-th
@@ -251,7 +259,12 @@ class StreamScheduler {
     // One process: the rays waiting in the queues per round (RoundOfPass of their sample index,
     // 0..32), for DrainRoundsBefore.
     static constexpr size_t kRounds = 33;
+    /// The level Route gives r in `brick`, r's segment there already set.
+    uint32_t LevelOfSegment(const RayRecord& r, uint32_t brick) const;
+
     bool count_rounds_ = false;
+    bool skip_air_allowed_ = false;  // PagerOptions::skip_air
+    bool skip_air_ = false;          // SkipBricksCrossedInAir
     std::array<std::atomic<int64_t>, kRounds> waiting_by_round_{};
 };
 
