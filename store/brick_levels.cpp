@@ -3,12 +3,13 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
-#include <unordered_map>
 
+#include "src/core/key_table.h"
 #include "store/brick_codec.h"
 
 namespace nave::store {
@@ -242,30 +243,18 @@ std::vector<bool> LockedVertices(const BrickMesh& mesh, const Bounds3f& cell) {
     // One number per distinct position: the decoder may give a position several vertices (Draco
     // splits them where the surface is not a manifold), and a border between materials is a
     // border of positions.
-    struct PositionHash {
-        size_t operator()(const Vec3f& p) const {
-            uint32_t b[3];
-            std::memcpy(b, &p, sizeof(b));
-            return size_t((uint64_t(b[0]) * 0x9E3779B97F4A7C15ull) ^
-                          (uint64_t(b[1]) * 0xC2B2AE3D27D4EB4Full) ^
-                          (uint64_t(b[2]) * 0x165667B19E3779F9ull));
-        }
-    };
-    struct PositionEqual {
-        bool operator()(const Vec3f& a, const Vec3f& b) const {
-            return a.x == b.x && a.y == b.y && a.z == b.z;
-        }
-    };
-    std::unordered_map<Vec3f, uint32_t, PositionHash, PositionEqual> number_of;
-    number_of.reserve(mesh.VertexCount());
+    KeyTable<std::array<uint32_t, 3>> positions;
+    positions.Reset(mesh.VertexCount());
     std::vector<uint32_t> position_of(mesh.VertexCount());
     for (size_t v = 0; v < position_of.size(); ++v) {
+        const Vec3f& p = mesh.positions[v];
         position_of[v] =
-            number_of.try_emplace(mesh.positions[v], uint32_t(number_of.size())).first->second;
+            positions.Insert({std::bit_cast<uint32_t>(p.x), std::bit_cast<uint32_t>(p.y),
+                              std::bit_cast<uint32_t>(p.z)});
     }
     // The material of each position's first triangle, or kShared once a second one appears.
     constexpr uint32_t kShared = kUnused - 1;
-    std::vector<uint32_t> material_at(number_of.size(), kUnused);
+    std::vector<uint32_t> material_at(positions.size(), kUnused);
     for (size_t t = 0; t < mesh.TriangleCount(); ++t) {
         const uint32_t m = mesh.material_ids[t];
         for (int c = 0; c < 3; ++c) {

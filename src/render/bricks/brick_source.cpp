@@ -171,7 +171,8 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         return slot.error;
     }
     slot.brick = std::move(built).value();
-    if (LevelOfSlot(id) == 0 && slot.occupancy_owned == nullptr) {
+    if (LevelOfSlot(id) == 0 && slot.occupancy_owned == nullptr &&
+        make_occupancy_.load(std::memory_order_relaxed)) {
         const ResidentMesh& m = slot.brick->mesh();
         slot.occupancy_owned =
             std::make_unique<const OccupancyGrid>(OccupancyGrid::Of(m.positions, m.indices));

@@ -124,9 +124,12 @@ class BrickSource {
     /// piece. NotFound if the source holds no medium grid; InvalidArgument if bricks are resident.
     Status UseStoredMedium(float scale);
     BrickSourceStats stats() const;
+    /// Whether each brick's first full-detail load from now on makes its occupancy grid (off by
+    /// default: only renders that pass over bricks crossed in air read them). Thread-safe.
+    void MakeOccupancyGrids(bool on) { make_occupancy_.store(on, std::memory_order_relaxed); }
     /// Where brick `brick`'s full mesh has triangles (OccupancyGrid), once it has been loaded at
-    /// full detail; null before. Kept when the brick is evicted: OccupancyGrid::kMemoryBytes per
-    /// brick, counted by the memory plan. Thread-safe.
+    /// full detail with MakeOccupancyGrids on; null before. Kept when the brick is evicted:
+    /// OccupancyGrid::kMemoryBytes per brick, counted by the memory plan. Thread-safe.
     const OccupancyGrid* Occupancy(uint32_t brick) const {
         return slots_[brick]->occupancy.load(std::memory_order_acquire);
     }
@@ -224,8 +227,9 @@ class BrickSource {
     TraceRecorder* trace_ = nullptr;
     BrickCache* brick_cache_ = nullptr;
     int decode_limit_ = 0;
-    std::optional<float> medium_scale_;  // UseStoredMedium's
-    std::mutex decode_mutex_;            // with decode_cv_: counts decodes_ under decode_limit_
+    std::atomic<bool> make_occupancy_{false};  // MakeOccupancyGrids
+    std::optional<float> medium_scale_;        // UseStoredMedium's
+    std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
     std::condition_variable decode_cv_;
     int decodes_ = 0;
     uint32_t brick_count_ = 0;

@@ -57,9 +57,12 @@ OccupancyGrid OccupancyGrid::Of(std::span<const Vec3f> positions,
     g.origin_ = box.min - Vec3d(pad, pad, pad);
     for (int a = 0; a < 3; ++a) g.voxel_size_[a] = (diagonal[a] + 2 * pad) / kN;
     g.empty_box_ = false;
+    const Vec3d half = g.voxel_size_ * (0.5 + kGrowVoxels);
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+        const Vec3d v[3] = {Vec3d(positions[indices[i]]), Vec3d(positions[indices[i + 1]]),
+                            Vec3d(positions[indices[i + 2]])};
         Bounds3d t;
-        for (int c = 0; c < 3; ++c) t.Extend(Vec3d(positions[indices[i + c]]));
+        for (const Vec3d& p : v) t.Extend(p);
         int lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::clamp(
@@ -72,7 +75,6 @@ OccupancyGrid OccupancyGrid::Of(std::span<const Vec3f> positions,
         // A triangle within one or two voxels along every axis marks its box; a larger one (a
         // vault's web, a slanted roof) only the voxels its plane crosses.
         const bool small = hi[0] - lo[0] < 2 && hi[1] - lo[1] < 2 && hi[2] - lo[2] < 2;
-        const Vec3d half = g.voxel_size_ * (0.5 + kGrowVoxels);
         for (int z = lo[2]; z <= hi[2]; ++z) {
             for (int y = lo[1]; y <= hi[1]; ++y) {
                 for (int x = lo[0]; x <= hi[0]; ++x) {
@@ -80,13 +82,11 @@ OccupancyGrid OccupancyGrid::Of(std::span<const Vec3f> positions,
                         const Vec3d centre = g.origin_ + Vec3d(g.voxel_size_.x * (x + 0.5),
                                                                g.voxel_size_.y * (y + 0.5),
                                                                g.voxel_size_.z * (z + 0.5));
-                        if (!TriangleOverlapsBox(Vec3d(positions[indices[i]]) - centre,
-                                                 Vec3d(positions[indices[i + 1]]) - centre,
-                                                 Vec3d(positions[indices[i + 2]]) - centre, half))
+                        if (!TriangleOverlapsBox(v[0] - centre, v[1] - centre, v[2] - centre, half))
                             continue;
                     }
-                    const uint32_t v = uint32_t((z * kN + y) * kN + x);
-                    g.bits_[v >> 6] |= uint64_t(1) << (v & 63);
+                    const uint32_t bit = uint32_t((z * kN + y) * kN + x);
+                    g.bits_[bit >> 6] |= uint64_t(1) << (bit & 63);
                 }
             }
         }

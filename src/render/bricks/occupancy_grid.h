@@ -5,7 +5,7 @@
 // cells of pillars and vaults it never touches; without this, each such crossing costs the
 // brick's load under a budget. The answer is exact in the only direction that matters: a segment
 // called empty meets no triangle of the brick, so skipping the brick gives the ray the same next
-// stop a trace that missed would have, and the image does not change.
+// stop a trace that missed would have.
 
 #include <cstdint>
 #include <span>

@@ -74,7 +74,8 @@ struct RenderMemoryInputs {
     uint32_t brick_count = 0;
     BrickBudgetMinimum bricks;        ///< MinimumBrickBudget of the model under pager.prefetch
     uint64_t load_scratch_bytes = 0;  ///< the most one brick's load needs beside the brick
-    /// The bricks' occupancy grids (BrickSource::Occupancy), each kept once its brick is loaded.
+    /// The bricks' occupancy grids (BrickSource::Occupancy), each kept once its brick is loaded;
+    /// 0 unless pager.skip_air.
     uint64_t occupancy_bytes = 0;
     /// The process's resident size when the render is planned (code, libraries, the store's
     /// tables, the scene, the texture system if loaded).

@@ -138,7 +138,11 @@ class StreamScheduler {
     /// (docs/pager.md, "Rays that cross a brick's air"): for renders without a medium, whose rays
     /// do nothing between surfaces (a medium's flight over a passed brick would be drawn over
     /// another stretch).
-    void SkipBricksCrossedInAir() { skip_air_ = skip_air_allowed_; }
+    /// The bricks' grids are made from then on (BrickSource::MakeOccupancyGrids) only then.
+    void SkipBricksCrossedInAir() {
+        skip_air_ = skip_air_allowed_;
+        source_.MakeOccupancyGrids(skip_air_);
+    }
     /// Whether this process makes ray `r`, one of the rays made outside a batch (a camera ray or
     /// a photon, `index` its pixel or photon): every process makes them all in the same way and
     /// keeps those whose first brick it owns, and of those that meet no brick, every size-th
