@@ -24,19 +24,20 @@ Status AsBadData(Status status) {
 
 bool IsMediumFile(const std::filesystem::path& path) { return LowerExtension(path) == ".vdb"; }
 
-Status CheckMediumGrid(const std::filesystem::path& file, const std::string& grid) {
+Status CheckMediumGrid(const std::filesystem::path& file, const std::string& grid,
+                       uint64_t memory_budget) {
     NAVE_ASSIGN_OR_RETURN(const volumes::VdbPlugin* plugin, volumes::LoadVdbPlugin());
     // No boxes: the plugin checks the file, the grid's type and transform, and counts its voxels.
     return AsBadData(
         plugin
-            ->CutScalarGrid(file, grid, {},
+            ->CutScalarGrid(file, grid, {}, memory_budget,
                             [](size_t, const volumes::GridPiece&) { return Status::Ok(); })
             .status());
 }
 
 Status StoreMedium(const std::filesystem::path& file, const std::string& grid, const Bounds3f& root,
-                   std::vector<store::BrickTreeNode>& nodes, store::StoreWriter& writer,
-                   PreprocessStats* stats) {
+                   uint64_t memory_budget, std::vector<store::BrickTreeNode>& nodes,
+                   store::StoreWriter& writer, PreprocessStats* stats) {
     NAVE_ASSIGN_OR_RETURN(const volumes::VdbPlugin* plugin, volumes::LoadVdbPlugin());
     NAVE_RETURN_IF_ERROR(writer.SetMediumGrid(grid));
     // Every leaf, a brick's or an empty one: the medium fills space the surfaces leave empty too.
@@ -69,10 +70,11 @@ Status StoreMedium(const std::filesystem::path& file, const std::string& grid, c
         stats->medium_max_density = std::max(stats->medium_max_density, medium.max_density);
         return Status::Ok();
     };
-    auto summary = plugin->CutScalarGrid(file, grid, cells, store_piece);
+    auto summary = plugin->CutScalarGrid(file, grid, cells, memory_budget, store_piece);
     if (!summary.ok()) return AsBadData(summary.status());
     bar.Finish();
     stats->medium_voxels = summary->active_voxels;
+    stats->medium_cut_peak_bytes = summary->peak_bytes;
     stats->medium_dropped_voxels = summary->voxels_outside;
     if (summary->voxels_outside > 0) {
         const std::string warning = fmt::format(

@@ -310,7 +310,7 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
     stats.memory_budget = plan.memory_budget;
     // A bad medium fails the run before any model is read.
     if (!plan.medium.empty())
-        NAVE_RETURN_IF_ERROR(CheckMediumGrid(plan.medium, options.medium_grid));
+        NAVE_RETURN_IF_ERROR(CheckMediumGrid(plan.medium, options.medium_grid, plan.memory_budget));
 
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<TriangleSource> source, OpenSource(options, plan));
     RemoveStaleOutputTemporaries(options.output);
@@ -346,8 +346,8 @@ StatusOr<PreprocessStats> RunPreprocess(const PreprocessOptions& options) {
         EncodeBricks(leaves, encode, plan.threads, grid.grid, options, nodes, *writer, &stats));
     if (!plan.medium.empty()) {
         NAVE_RETURN_IF_ERROR(CheckCancelled(options.interrupt));
-        NAVE_RETURN_IF_ERROR(
-            StoreMedium(plan.medium, options.medium_grid, grid.root, nodes, *writer, &stats));
+        NAVE_RETURN_IF_ERROR(StoreMedium(plan.medium, options.medium_grid, grid.root,
+                                         plan.memory_budget, nodes, *writer, &stats));
         stats.bricks += stats.medium_only_bricks;
     }
     for (const auto& n : nodes) {
@@ -428,11 +428,11 @@ std::string FormatSummary(const PreprocessStats& s) {
         out += fmt::format(
             "\nmedium:      grid '{}' of {}: {} voxels stored in {} bricks ({} without triangles), "
             "{}, largest density {:.6g}; {} of the grid's {} voxels dropped outside the model's "
-            "box",
+            "box; the cut held at most {}",
             s.medium_grid, s.medium_file, FormatCount(double(s.medium_stored_voxels)),
             s.medium_bricks, s.medium_only_bricks, FormatBytes(s.medium_bytes),
             s.medium_max_density, FormatCount(double(s.medium_dropped_voxels)),
-            FormatCount(double(s.medium_voxels)));
+            FormatCount(double(s.medium_voxels)), FormatBytes(s.medium_cut_peak_bytes));
     }
     if (s.textures_converted > 0) {
         out += fmt::format("\ntextures:    {} converted to tiled MIP-maps, {} in {}",

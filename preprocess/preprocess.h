@@ -84,6 +84,8 @@ struct PreprocessStats {
     uint64_t medium_voxels = 0, medium_stored_voxels = 0, medium_dropped_voxels = 0;
     uint64_t medium_bytes = 0, medium_bricks = 0, medium_only_bricks = 0;
     float medium_max_density = 0;
+    /// The most the medium's cut held at once (volumes::GridCutSummary::peak_bytes).
+    uint64_t medium_cut_peak_bytes = 0;
     std::vector<std::string> warnings;
 };
 

@@ -19,7 +19,7 @@
 namespace nave::volumes {
 
 /// Bumped whenever VdbPlugin's methods or the types they take change.
-inline constexpr int kVdbPluginVersion = 2;
+inline constexpr int kVdbPluginVersion = 3;
 
 /// A grid of voxels, each of constant value over its cell, in world space. Immutable: thread-safe.
 class ScalarGrid {
@@ -54,6 +54,11 @@ struct GridCutSummary {
     /// Active voxels whose cells overlap none of the boxes (outside them all: not in any piece).
     uint64_t voxels_outside = 0;
     Bounds3f bounds;  ///< world box of the source's active voxels' cells
+    /// Bytes of the grid's topology (its tree without values, as delayed loading reads it).
+    uint64_t topology_bytes = 0;
+    /// The most the cut held at once, measured: the topology, one box's region as read (its
+    /// topology and the values of the leaves overlapping the box), the piece and its bytes.
+    uint64_t peak_bytes = 0;
 };
 
 /// The OpenVDB side. Every method is thread-safe; every failure is a Status naming the file.
@@ -77,8 +82,14 @@ class VdbPlugin {
     /// grid is checked as ReadScalarGrid checks it (same errors), its values where a box reads
     /// them: voxels outside every box are counted, not read. With no boxes, it checks the file and
     /// the grid's type and transform and counts its voxels (reading their masks, not their values).
+    /// `memory_limit` (bytes; 0: none) bounds what the cut holds at once: before a box's values
+    /// are read, that is estimated from the topology (twice the topology, and three times the
+    /// loaded leaves of the box's voxels: as read, in the piece, serialized), and a box over the
+    /// limit is ResourceExhausted naming the file, the grid, the box and both sizes; with no
+    /// boxes, the topology alone (twice) is checked.
     virtual StatusOr<GridCutSummary> CutScalarGrid(
         const std::filesystem::path& file, const std::string& grid, std::span<const Bounds3f> boxes,
+        uint64_t memory_limit,
         const std::function<Status(size_t box, GridPiece piece)>& emit) const = 0;
     /// Writes a float grid named `grid` of `dims` voxels of side `voxel_m`, voxel (0, 0, 0)'s
     /// cell starting at `origin`, with value(i, j, k) (0 is left inactive), to `file`. IoError on

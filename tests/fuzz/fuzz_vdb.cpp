@@ -55,7 +55,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const nave::Bounds3f boxes[] = {{{-100, -100, -100}, {28, 100, 100}},
                                     {{28, -100, -100}, {100, 100, 100}},
                                     {{500, 500, 500}, {501, 501, 501}}};
-    (void)plugin->CutScalarGrid(file, "density", boxes,
+    (void)plugin->CutScalarGrid(file, "density", boxes, /*memory_limit=*/0,
                                 [&](size_t, nave::volumes::GridPiece piece) {
                                     ReadPiece(*plugin, piece.bytes);
                                     return nave::Status::Ok();

@@ -57,7 +57,7 @@ TEST(FuzzRegression, DamagedVdbBlockIsAnError) {
     EXPECT_THAT(whole.status().message(), HasSubstr("blosc_size_damaged.vdb"));
     const Bounds3f everywhere(Vec3f(-1e3f, -1e3f, -1e3f), Vec3f(1e3f, 1e3f, 1e3f));
     auto cut =
-        (*plugin)->CutScalarGrid(file, "density", {&everywhere, 1},
+        (*plugin)->CutScalarGrid(file, "density", {&everywhere, 1}, /*memory_limit=*/0,
                                  [](size_t, const volumes::GridPiece&) { return Status::Ok(); });
     EXPECT_FALSE(cut.ok());
     EXPECT_THAT(cut.status().message(), HasSubstr("blosc_size_damaged.vdb"));

@@ -163,7 +163,8 @@ TEST_F(PreprocessMedium, EmptyCellWithVoxelsGetsABrickWithoutTriangles) {
     nodes[1].brick = (*writer)->Append(*encoded).value();
 
     PreprocessStats stats;
-    ASSERT_TRUE(StoreMedium(vdb_, "density", root, nodes, **writer, &stats).ok());
+    ASSERT_TRUE(
+        StoreMedium(vdb_, "density", root, /*memory_budget=*/0, nodes, **writer, &stats).ok());
     ASSERT_NE(nodes[2].brick, store::kNoBrick);
     EXPECT_EQ(stats.medium_only_bricks, 1u);
     EXPECT_EQ(stats.medium_bricks, 2u);
@@ -218,6 +219,7 @@ TEST_F(PreprocessMedium, CommandLineReportsTheMediumAndFailsOnBadGrids) {
                                             " --brick-triangles 1000 --threads 2");
     ASSERT_EQ(run.exit_code, 0) << run.output;
     EXPECT_THAT(run.output, HasSubstr("medium:      grid 'density' of " + vdb));
+    EXPECT_THAT(run.output, HasSubstr("the cut held at most "));
     test::CommandResult inspect = test::RunNave("inspect --bricks " + out);
     EXPECT_EQ(inspect.exit_code, 0) << inspect.output;
     EXPECT_THAT(inspect.output, HasSubstr("medium       grid 'density': "));

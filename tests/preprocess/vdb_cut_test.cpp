@@ -49,11 +49,12 @@ class VdbCut : public ::testing::Test {
     StatusOr<GridCutSummary> Cut(const std::filesystem::path& file, const std::string& grid,
                                  const std::vector<Bounds3f>& boxes) {
         pieces_.clear();
-        return plugin_->CutScalarGrid(file, grid, boxes, [&](size_t box, GridPiece piece) {
-            EXPECT_TRUE(pieces_.empty() || pieces_.rbegin()->first < box) << "in order of box";
-            pieces_.emplace(box, std::move(piece));
-            return Status::Ok();
-        });
+        return plugin_->CutScalarGrid(
+            file, grid, boxes, /*memory_limit=*/0, [&](size_t box, GridPiece piece) {
+                EXPECT_TRUE(pieces_.empty() || pieces_.rbegin()->first < box) << "in order of box";
+                pieces_.emplace(box, std::move(piece));
+                return Status::Ok();
+            });
     }
 
     test::ScratchDir dir_{"vdb_cut"};
@@ -143,6 +144,53 @@ TEST_F(VdbCut, CutShortPiecesAreDataLossNamingThem) {
     }
 }
 
+// What a cut holds at once is measured, and a limit below it is refused before a box's values
+// are read, naming the file, the grid and the box; a limit above it changes nothing.
+TEST_F(VdbCut, AMemoryLimitBoundsWhatTheCutHolds) {
+    const std::vector<Bounds3f> boxes = {Bounds3f(Vec3f(-1, -1, -1), Vec3f(2, 9, 9)),
+                                         Bounds3f(Vec3f(2, -1, -1), Vec3f(9, 9, 9))};
+    auto free = Cut(file_, "density", boxes);
+    ASSERT_TRUE(free.ok()) << free.status().ToString();
+    EXPECT_GT(free->topology_bytes, 0u);
+    EXPECT_GT(free->peak_bytes, free->topology_bytes);
+    const std::map<size_t, GridPiece> unlimited = std::move(pieces_);
+
+    auto cut_within = [&](uint64_t limit) {
+        pieces_.clear();
+        return plugin_->CutScalarGrid(file_, "density", boxes, limit,
+                                      [&](size_t box, GridPiece piece) {
+                                          pieces_.emplace(box, std::move(piece));
+                                          return Status::Ok();
+                                      });
+    };
+    // The estimate holds what was measured: a limit at the measured peak may still be refused,
+    // one at four times it is not.
+    auto roomy = cut_within(4 * free->peak_bytes);
+    ASSERT_TRUE(roomy.ok()) << roomy.status().ToString();
+    ASSERT_EQ(pieces_.size(), unlimited.size());
+    for (const auto& entry : unlimited) {
+        // Not the bytes: OpenVDB's archive header carries a UUID of its own.
+        EXPECT_EQ(pieces_.at(entry.first).active_voxels, entry.second.active_voxels);
+        EXPECT_EQ(pieces_.at(entry.first).max_value, entry.second.max_value);
+        EXPECT_EQ(pieces_.at(entry.first).memory_bytes, entry.second.memory_bytes);
+    }
+
+    auto tight = cut_within(2 * free->topology_bytes + 1);
+    ASSERT_FALSE(tight.ok());
+    EXPECT_EQ(tight.status().code(), StatusCode::kResourceExhausted);
+    EXPECT_THAT(tight.status().message(),
+                HasSubstr("dust.vdb: grid 'density': the piece for box 0"));
+    EXPECT_TRUE(pieces_.empty()) << "refused before any piece";
+
+    auto none = cut_within(free->topology_bytes);
+    ASSERT_FALSE(none.ok());
+    EXPECT_THAT(none.status().message(), HasSubstr("its topology alone"));
+    auto checked = plugin_->CutScalarGrid(file_, "density", {}, free->topology_bytes,
+                                          [](size_t, const GridPiece&) { return Status::Ok(); });
+    EXPECT_EQ(checked.status().code(), StatusCode::kResourceExhausted)
+        << "checked with no boxes too";
+}
+
 TEST_F(VdbCut, NoBoxesChecksTheGridAndCountsItsVoxels) {
     auto summary = Cut(file_, "density", {});
     ASSERT_TRUE(summary.ok()) << summary.status().ToString();
@@ -155,7 +203,7 @@ TEST_F(VdbCut, EmitErrorStopsTheCut) {
     int calls = 0;
     auto summary = plugin_->CutScalarGrid(
         file_, "density", std::vector<Bounds3f>(3, Bounds3f(Vec3f(0, 0, 0), Vec3f(5, 5, 5))),
-        [&](size_t, const GridPiece&) {
+        /*memory_limit=*/0, [&](size_t, const GridPiece&) {
             ++calls;
             return IoError("disk full");
         });

@@ -8,6 +8,7 @@
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Count.h>
 #include <openvdb/tools/RayIntersector.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "src/core/memory.h"
 #include "src/volumes/vdb_plugin.h"
 
 namespace nave::volumes::vdb {
@@ -220,12 +222,30 @@ std::string GridNames(openvdb::io::File& in) {
     return names.empty() ? "none" : names;
 }
 
+/// Bytes a float leaf (8^3 voxels) takes in memory with its values loaded.
+uint64_t LoadedLeafBytes() {
+    static const uint64_t bytes =
+        openvdb::FloatTree::LeafNodeType(openvdb::Coord(0), 0.f).memUsage();
+    return bytes;
+}
+
+/// What the cut will hold at once for a box of `voxels` active voxels (CutScalarGrid's
+/// memory_limit): the topology (kept) and the region's own; the leaves holding the voxels, once
+/// as read, once in the piece, once serialized. `voxels_per_leaf`: the grid's mean over its
+/// leaves, since a leaf is read whole however few of its voxels are active (a tile's voxels fill
+/// leaves of the piece: counted alike, which over-estimates them).
+uint64_t EstimatedCutBytes(uint64_t topology_bytes, uint64_t voxels, double voxels_per_leaf) {
+    const double leaves = double(voxels) / std::max(1.0, voxels_per_leaf);
+    return 2 * topology_bytes + uint64_t(3.0 * std::ceil(leaves) * double(LoadedLeafBytes()));
+}
+
 /// VdbPlugin::CutScalarGrid, letting OpenVDB's exceptions through (the caller turns them into a
-/// Status). Memory: the grid's topology once (value masks, no values: delayed loading) to count
-/// its voxels, then, box by box, the topology again and the values of the leaves that overlap the
-/// box (File::readGrid(name, bbox) reads no other leaf's values) and the piece.
+/// Status). Memory: the grid's topology (value masks, no values: delayed loading), kept to count
+/// its voxels and each box's, then, box by box, the box's region as read (the topology again and
+/// the values of the leaves that overlap the box: File::readGrid(name, bbox) reads no other
+/// leaf's values) and the piece.
 StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::string& name,
-                                 std::span<const Bounds3f> boxes,
+                                 std::span<const Bounds3f> boxes, uint64_t memory_limit,
                                  const std::function<Status(size_t, GridPiece)>& emit) {
     const std::string where = file.string();
     NAVE_RETURN_IF_ERROR(FileLayout().CheckWhole(file));
@@ -245,12 +265,23 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
     const openvdb::math::Transform::Ptr transform = header->transform().copy();
 
     GridCutSummary summary;
-    openvdb::CoordBBox active;
-    {
-        // With delayed loading the leaves' values stay in the file: counting reads the masks.
-        const openvdb::GridBase::Ptr topology = in.readGrid(name);
-        summary.active_voxels = topology->activeVoxelCount();
-        active = topology->evalActiveVoxelBoundingBox();
+    // With delayed loading the leaves' values stay in the file: counting reads the masks.
+    const openvdb::FloatGrid::Ptr topology =
+        openvdb::gridPtrCast<openvdb::FloatGrid>(in.readGrid(name));
+    if (!topology) return InvalidArgumentError("{}: grid '{}' is not a float grid", where, name);
+    summary.active_voxels = topology->activeVoxelCount();
+    const openvdb::CoordBBox active = topology->evalActiveVoxelBoundingBox();
+    summary.topology_bytes = openvdb::tools::memUsage(topology->tree());
+    summary.peak_bytes = summary.topology_bytes;
+    const double voxels_per_leaf =
+        double(topology->tree().activeLeafVoxelCount()) /
+        double(std::max<openvdb::Index64>(1, topology->tree().leafCount()));
+    if (memory_limit > 0 && 2 * summary.topology_bytes > memory_limit) {
+        return ResourceExhaustedError(
+            "{}: grid '{}': its topology alone ({} voxels in {} leaves) needs {} while it is cut, "
+            "more than the {} allowed: give more --memory",
+            where, name, summary.active_voxels, topology->tree().leafCount(),
+            FormatBytes(2 * summary.topology_bytes), FormatBytes(memory_limit));
     }
     if (summary.active_voxels > 0) {
         const openvdb::Vec3d lo =
@@ -271,6 +302,17 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
     for (size_t i = 0; i < boxes.size() && summary.active_voxels > 0; ++i) {
         const openvdb::CoordBBox& want = wanted[i];
         if (want.empty() || !want.hasOverlap(active)) continue;
+        const uint64_t box_voxels = openvdb::tools::countActiveVoxels(topology->tree(), want);
+        if (box_voxels == 0) continue;
+        const uint64_t estimate =
+            EstimatedCutBytes(summary.topology_bytes, box_voxels, voxels_per_leaf);
+        if (memory_limit > 0 && estimate > memory_limit) {
+            return ResourceExhaustedError(
+                "{}: grid '{}': the piece for box {} of {} ({} voxels) needs about {} while it is "
+                "cut, more than the {} allowed: give more --memory, or smaller bricks",
+                where, name, i, boxes.size(), box_voxels, FormatBytes(estimate),
+                FormatBytes(memory_limit));
+        }
         earlier.clear();
         for (size_t j = 0; j < i; ++j)
             if (wanted[j].hasOverlap(want)) earlier.push_back(&wanted[j]);
@@ -306,6 +348,9 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
         std::ostringstream bytes(std::ios::binary);
         openvdb::io::Stream(bytes).write(openvdb::GridCPtrVec{piece});
         const std::string serialized = std::move(bytes).str();
+        summary.peak_bytes =
+            std::max<uint64_t>(summary.peak_bytes, summary.topology_bytes + region->memUsage() +
+                                                       out.memory_bytes + 2 * serialized.size());
         out.bytes.resize(serialized.size());
         std::memcpy(out.bytes.data(), serialized.data(), serialized.size());
         NAVE_RETURN_IF_ERROR(emit(i, std::move(out)));
@@ -374,13 +419,14 @@ class Plugin final : public VdbPlugin {
 
     StatusOr<GridCutSummary> CutScalarGrid(
         const std::filesystem::path& file, const std::string& name, std::span<const Bounds3f> boxes,
+        uint64_t memory_limit,
         const std::function<Status(size_t, GridPiece)>& emit) const override {
         InitializeOnce();
         std::error_code ec;
         if (!std::filesystem::exists(file, ec))
             return NotFoundError("{}: no such file", file.string());
         try {
-            return CutGrid(file, name, boxes, emit);
+            return CutGrid(file, name, boxes, memory_limit, emit);
         } catch (const std::exception& e) {
             // OpenVDB reports a file that is not its format, or cut short, by exceptions.
             return InvalidArgumentError("{}: not a readable OpenVDB file: {}", file.string(),
