@@ -58,10 +58,8 @@ std::vector<float> Rgb(const fs::path& exr) {
 class MpiRender : public ::testing::Test {
   protected:
     // One store for every test: the detail-1 abbey in 64 small bricks, rendered in path mode with
-    // the abbey's config, path guiding included (the ranks share the guide's credits). Each rank
-    // holds its bricks in memory: a paged render is not yet reproducible bit for bit between two
-    // runs of one process (docs/pager.md, "Determinism"), so the comparison with one process
-    // cannot be.
+    // the abbey's config, path guiding included (the ranks share the guide's credits). Most tests
+    // hold each rank's bricks in memory; RanksPageTheirBricksUnderTheirBudgets pages them.
     static void SetUpTestSuite() {
         dir_ = new fs::path(fs::temp_directory_path() / ("nave_mpi_" + std::to_string(getpid())));
         fs::create_directories(*dir_);
@@ -288,8 +286,9 @@ TEST_F(MpiRender, EachRankWritesItsOwnTrace) {
     }
 }
 
-// Each rank pages its own bricks under its own --memory, in path and photon mode, and the job
-// completes with every ray and photon exchanged (the image is not compared: see SetUpTestSuite).
+// Each rank pages its own bricks under its own --memory, in path and photon mode: the job
+// completes with every ray and photon exchanged, and its image is the one process's in-core image
+// bit for bit (the budget changes only which bricks are resident when, never a ray's numbers).
 TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {
     // The smallest --memory a rank of this build can render with (MPI and sanitizers make the
     // process larger), from the refusal of a budget far too small, and 64 MiB more (the reserve
@@ -306,15 +305,21 @@ TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {
     const std::string memory = std::to_string((minimum >> 20) + 64) + "M";
     for (const std::string mode : {"path", "photon"}) {
         SCOPED_TRACE(mode);
+        const std::string settings = " --iterations 2 --photons 60000";
+        const std::string in_core = "in_core_" + mode + ".exr";
+        const test::CommandResult one = Shell(Render(in_core, mode) + settings);
+        ASSERT_EQ(one.exit_code, 0) << one.output;
         const std::string name = "paged_" + mode + ".exr";
-        const test::CommandResult r = Shell(Mpirun(2) + Render(name, mode) +
-                                            " --iterations 2 --photons 60000 --memory " + memory);
+        const test::CommandResult r =
+            Shell(Mpirun(2) + Render(name, mode) + settings + " --memory " + memory);
         ASSERT_EQ(r.exit_code, 0) << r.output;
         EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
         const size_t evictions = r.output.find("evictions ");
         ASSERT_NE(evictions, std::string::npos) << r.output;
         EXPECT_NE(r.output.compare(evictions, 11, "evictions 0"), 0) << r.output;
-        EXPECT_FALSE(Rgb(*dir_ / name).empty());
+        const std::vector<float> reference = Rgb(*dir_ / in_core);
+        ASSERT_FALSE(reference.empty());
+        EXPECT_EQ(Rgb(*dir_ / name), reference);
     }
 }
 
