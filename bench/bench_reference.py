@@ -22,6 +22,8 @@ Markdown table for docs/render.md.
                                                                     # checks the recipe in about 2 minutes
     /usr/bin/python3 bench/bench_reference.py --lod --detail 30 --modes path --memory "" ...
                                                                     # levels of detail against full detail
+    /usr/bin/python3 bench/bench_reference.py --lod --store dragon.nave --config configs/dragon.toml \
+        --config-camera --modes path --memory ""                    # the same on another model, its own camera
 
 The reference's error must be well below the errors it measures (the table says both); a reference of two
 hours of path tracing on two cores reaches about 0.005 on RGB at 960x640 on the nave view.
@@ -45,6 +47,9 @@ def main():
     ap.add_argument("--config", default="configs/abbey.toml")
     ap.add_argument("--views", default="nave,crossing_vault,north_aisle",
                     help=f"comma-separated camera spots: {', '.join(nave_bench.VIEWS)}")
+    ap.add_argument("--config-camera", action="store_true",
+                    help="one view: the config's own camera, named after the config (for models other than "
+                         "the abbey, with --store)")
     ap.add_argument("--modes", default="photon,path", help="render modes to measure")
     ap.add_argument("--resolution", default="960x640")
     ap.add_argument("--time", type=float, default=120, help="seconds of each measured render")
@@ -58,7 +63,8 @@ def main():
                          "--lod auto, against a full-detail reference (the bias of coarse geometry)")
     args = ap.parse_args()
 
-    views = nave_bench.parse_views(args.views)
+    config_view = os.path.splitext(os.path.basename(args.config))[0]
+    views = [config_view] if args.config_camera else nave_bench.parse_views(args.views)
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     os.makedirs(args.dir, exist_ok=True)
     log = open(os.path.join(args.dir, "runs.log"), "w")
@@ -86,7 +92,7 @@ def main():
     for view in views:
         config = os.path.join(args.dir, f"abbey_{view}.toml")
         with open(config, "w") as f:
-            f.write(nave_bench.config_for_view(base_text, view))
+            f.write(base_text if args.config_camera else nave_bench.config_for_view(base_text, view))
         ref = [os.path.join(args.dir, f"{view}_reference_seed{s}.exr") for s in (1, 2)]
         for seed, out in zip((1, 2), ref):
             if not os.path.exists(out):

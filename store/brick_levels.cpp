@@ -303,10 +303,10 @@ std::vector<BrickLevel> MakeBrickLevels(const BrickMesh& full, const LevelOption
                                                   options.max_area_change, scratch, &level.mesh));
         }
         const size_t triangles = level.mesh.TriangleCount();
-        if (triangles == 0 ||
-            double(triangles) > options.max_kept_fraction * double(source->TriangleCount())) {
-            break;
-        }
+        if (triangles == 0) break;
+        if (double(triangles) > options.max_kept_fraction * double(source->TriangleCount()))
+            continue;  // hardly coarser: the next error, from the same source
+
         CompactVertices(*source, options.keep_normals, &level.mesh);
         // A level simplified from the one before differs from the full mesh by at most both
         // errors (triangle inequality): conservative, and larger than the previous level's. A

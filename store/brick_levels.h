@@ -22,9 +22,12 @@ struct LevelOptions {
     /// wherever the brick's detail lies. Why 0.001 and 0.004 (a few cm and about 10 cm in the
     /// abbey's bricks): docs/store-format.md, "Levels".
     std::vector<double> relative_errors = {0.001, 0.004};
-    /// A level that keeps more than this fraction of the previous level's triangles is not made
-    /// (nor any coarser one): it would cost nearly as much to load as the level before.
-    double max_kept_fraction = 0.5;
+    /// A level that would keep more than this fraction of its source's triangles (the full mesh
+    /// or the level before) is not made, and the next error is tried from the same source: such a
+    /// level costs nearly as much to load and trace as its source, and takes store room. On a
+    /// scanned model decimated already (the Stanford dragon's 100 k triangles) the first error
+    /// kept 45 %, and made the store 42 % larger where the second error alone adds 8 %.
+    double max_kept_fraction = 1.0 / 3.0;
     /// Which borders of each material's surface stay where they are. A brick holds every triangle
     /// crossing its cell, and the border where it was cut from its neighbours lies outside the
     /// cell: were it to recede by up to the level's error, holes would open inside the cell at

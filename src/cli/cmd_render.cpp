@@ -51,6 +51,7 @@ struct RenderOptions {
     std::string rank_timeout = "10m";  // --rank-timeout: under mpirun, the longest wait for rays
     bool no_textures = false;
     std::string lod;
+    bool no_lod = false;         // --no-lod: --lod full
     CheckpointFlags checkpoint;  // --checkpoint, --checkpoint-every, --resume, --stop-after
 };
 
@@ -107,7 +108,7 @@ StatusOr<render::SceneConfig> BuildConfig(const RenderOptions& o) {
     if (o.mode == "photon") config.render.mode = render::RenderSettings::Mode::kPhoton;
     if (o.no_textures) config.textures.enabled = false;
     if (o.lod == "auto") config.render.lod = render::RenderSettings::Lod::kAuto;
-    if (o.lod == "full") config.render.lod = render::RenderSettings::Lod::kFull;
+    if (o.lod == "full" || o.no_lod) config.render.lod = render::RenderSettings::Lod::kFull;
     return config;
 }
 
@@ -409,14 +410,16 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
         "trace events (JSON for ui.perfetto.dev or chrome://tracing; docs/pager.md)");
     cmd->add_flag("--no-textures", opts->no_textures,
                   "Ignore the model's textures (textures.enabled = false)");
-    cmd->add_option(
-           "--lod", opts->lod,
-           "Levels of detail (render.lod): auto traces each ray scattered by a diffuse or "
-           "glossy surface against the coarsest level of each brick its footprint allows "
-           "(camera rays keep full detail), in stores made with `nave preprocess --levels`; "
-           "full (the default) traces full detail everywhere (docs/render.md, \"Levels of "
-           "detail\")")
-        ->check(CLI::IsMember({"auto", "full"}));
+    CLI::Option* lod =
+        cmd->add_option(
+               "--lod", opts->lod,
+               "Levels of detail (render.lod): auto (the default) traces each ray scattered by a "
+               "diffuse or glossy surface against the coarsest level of each brick its footprint "
+               "allows (camera rays keep full detail), in stores made with `nave preprocess "
+               "--levels`; full traces full detail everywhere (docs/render.md, \"Levels of "
+               "detail\")")
+            ->check(CLI::IsMember({"auto", "full"}));
+    cmd->add_flag("--no-lod", opts->no_lod, "Full detail everywhere: --lod full")->excludes(lod);
     cmd->add_option("--checkpoint", opts->checkpoint.checkpoint,
                     "Write the render's state to FILE between passes (photon mode: iterations), at "
                     "most every "

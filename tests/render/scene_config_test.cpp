@@ -108,6 +108,21 @@ TEST(SceneConfig, PhotonsPerIterationFitIn32Bits) {
         << over.status().message();
 }
 
+// A store's levels of detail are used unless the config says "full"; a bad value names the key.
+TEST(SceneConfig, LevelsOfDetailAreUsedUnlessFullIsAsked) {
+    const std::string camera = "[camera]\nposition = [0,0,0]\nlook_at = [1,0,0]\n[render]\n";
+    auto plain = ParseSceneConfig(camera, "s.toml");
+    ASSERT_TRUE(plain.ok()) << plain.status().ToString();
+    EXPECT_EQ(plain->render.lod, RenderSettings::Lod::kAuto);
+    auto full = ParseSceneConfig(camera + "lod = \"full\"\n", "s.toml");
+    ASSERT_TRUE(full.ok()) << full.status().ToString();
+    EXPECT_EQ(full->render.lod, RenderSettings::Lod::kFull);
+    auto bad = ParseSceneConfig(camera + "lod = \"coarse\"\n", "s.toml");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.status().message().find("render.lod"), std::string::npos)
+        << bad.status().message();
+}
+
 TEST(SceneConfig, FinalGatherAndTheSkysDirectLightFromPhotonsExcludeEachOther) {
     auto c = ParseSceneConfig(
         "[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0]\n[render]\nmode = \"photon\"\n"

@@ -223,11 +223,20 @@ TEST(BrickLevels, SmallMeshesAndTooFineErrorsMakeNoLevels) {
     LevelOptions none;
     none.relative_errors.clear();
     EXPECT_TRUE(MakeBrickLevels(full, none).empty());
-    // A level whose error allows almost no collapse keeps more than half: not made, nor the
-    // coarser one after it.
+    // A level whose error allows almost no collapse keeps more than a third: not made.
     LevelOptions too_fine;
-    too_fine.relative_errors = {1e-7, 0.1};
+    too_fine.relative_errors = {1e-7};
     EXPECT_TRUE(MakeBrickLevels(full, too_fine).empty());
+    // The coarser error after it is tried from the full mesh, and makes the one level.
+    too_fine.relative_errors = {1e-7, 0.1};
+    const std::vector<BrickLevel> skipped = MakeBrickLevels(full, too_fine);
+    ASSERT_EQ(skipped.size(), 1u);
+    LevelOptions coarse_only;
+    coarse_only.relative_errors = {0.1};
+    const std::vector<BrickLevel> direct = MakeBrickLevels(full, coarse_only);
+    ASSERT_EQ(direct.size(), 1u);
+    EXPECT_EQ(skipped[0].mesh.TriangleCount(), direct[0].mesh.TriangleCount());
+    EXPECT_EQ(skipped[0].error, direct[0].error);
     // One level only.
     LevelOptions one;
     one.relative_errors = {0.05};

@@ -102,8 +102,10 @@ TEST_F(NaveCli, InspectAndVerifyCoverTheLevels) {
     const std::filesystem::path with_levels = dir_ / "levels.nave";
     EncodeOptions options;
     options.levels.relative_errors = {0.002, 0.05};
-    options.levels.border_lock =
-        LevelOptions::BorderLock::kNone;  // two levels on this small surface
+    // Two levels on this small surface: no border locked, and a second level that keeps up to
+    // half of the first's triangles.
+    options.levels.border_lock = LevelOptions::BorderLock::kNone;
+    options.levels.max_kept_fraction = 0.5;
     ASSERT_TRUE(testing::WriteGridStore(
                     with_levels, testing::MakeSurface({.quads_x = 40, .quads_y = 40}),
                     testing::MakeMaterials(3), {2, 2, 1}, GlobalGrid{{0, 0, 0}, 1e-3}, options)

@@ -197,11 +197,12 @@ struct RenderSettings {
     /// Path mode: paths learn where the light reflected toward each part of the model comes from
     /// and draw half of their continuations from it (PathGuide).
     bool path_guiding = false;
-    /// Levels of detail (docs/render.md, "Levels of detail"): "auto" traces each ray against the
-    /// coarsest level of each brick its footprint allows, where the store has levels; "full"
-    /// (the default while levels bias the image) traces full detail everywhere.
+    /// Levels of detail (docs/render.md, "Levels of detail"): "auto" (the default) traces each
+    /// ray against the coarsest level of each brick its footprint allows, where the store has
+    /// levels (their image is within the noise of full detail's: "Paths through panes"); "full"
+    /// traces full detail everywhere.
     enum class Lod { kAuto, kFull };
-    Lod lod = Lod::kFull;
+    Lod lod = Lod::kAuto;
 };
 
 struct OutputConfig {
