@@ -310,8 +310,10 @@ TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {
         const test::CommandResult one = Shell(Render(in_core, mode) + settings);
         ASSERT_EQ(one.exit_code, 0) << one.output;
         const std::string name = "paged_" + mode + ".exr";
-        const test::CommandResult r =
-            Shell(Mpirun(2) + Render(name, mode) + settings + " --memory " + memory);
+        std::string paged = Mpirun(2) + Render(name, mode);
+        paged += settings;
+        paged += " --memory " + memory;
+        const test::CommandResult r = Shell(paged);
         ASSERT_EQ(r.exit_code, 0) << r.output;
         EXPECT_NE(r.output.find("rays sent between them"), std::string::npos) << r.output;
         const size_t evictions = r.output.find("evictions ");
