@@ -64,20 +64,31 @@ std::unique_ptr<BrickSource> BallGridSource() {
 }
 
 /// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
-/// and its guide, "path_guided": path guiding over 16 passes, or "path_haze" and "photon_haze":
-/// with a medium over the model).
+/// and its guide, "path_guided": path guiding over 16 passes, "path_haze" and "photon_haze": with a
+/// medium over the model, or "path_water" and "photon_water": balls of water that scatters, in
+/// that haze).
 SceneConfig BallGridConfig(const std::string& mode) {
-    const bool gather = mode == "photon_gather",
-               haze = mode == "path_haze" || mode == "photon_haze", guided = mode == "path_guided";
-    const std::string base = gather || mode == "photon_haze"
-                                 ? "photon"
-                                 : (mode == "path_haze" || guided ? "path" : mode);
+    const bool gather = mode == "photon_gather", guided = mode == "path_guided",
+               water = mode == "path_water" || mode == "photon_water",
+               haze = mode == "path_haze" || mode == "photon_haze" || water;
+    const std::string base = mode.starts_with("photon") ? "photon" : "path";
     const std::string text = fmt::format(fmt::runtime(kBallGrid), base) +
                              (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
     auto config = ParseSceneConfig(text, "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     if (!config.ok()) return SceneConfig();
     config->render.final_gather = gather;
+    if (water) {
+        MaterialConfig& ball = config->materials["ball"];
+        ball = MaterialConfig();
+        ball.kind = MaterialConfig::Kind::kDielectric;
+        ball.eta = SpectrumSpec::Constant(1.33f);
+        ball.medium = MediumConfig();
+        ball.medium->name = "materials.ball.medium";
+        ball.medium->sigma_s = SpectrumSpec::Constant(2.f);
+        ball.medium->sigma_a = SpectrumSpec::Constant(0.3f);
+        ball.medium->g = 0.3f;
+    }
     if (guided) {
         // Rounds 0-1 | 2-3 | 4-7 | ... | 32-63: passes 4-63 sample what rounds 0-3 taught.
         config->render.path_guiding = true;
@@ -200,6 +211,11 @@ TEST_F(PagerTest, PagedRenderEqualsInCorePathInHaze) { ExpectPagedEqualsInCore("
 // Photons too scatter in whichever brick their flight ends.
 TEST_F(PagerTest, PagedRenderEqualsInCorePhotonInHaze) {
     ExpectPagedEqualsInCore("photon_haze", 1e-9);
+}
+
+TEST_F(PagerTest, PagedRenderEqualsInCoreThroughBallsOfWater) {
+    ExpectPagedEqualsInCore("path_water", 1e-9);
+    ExpectPagedEqualsInCore("photon_water", 1e-9);
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }

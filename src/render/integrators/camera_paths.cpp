@@ -76,7 +76,7 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
         if (!ShadowThroughBrick(r, brick, t1, out.counts)) return;
         const uint32_t next = scheduler_.Route(r, r.t_exit, b);
         // What the medium lets through from here to the next brick (or the light).
-        if (!DimShadowRay(scene_.medium.get(), &brick, t0,
+        if (!DimShadowRay(scene_.MediumOf(r.medium), &brick, t0,
                           next == store::kNoBrick ? r.t_max : r.t_enter, &r))
             return;
         if (next == store::kNoBrick) {
@@ -90,7 +90,7 @@ void CameraPaths::ProcessRay(RayRecord r, uint32_t b, const ResidentBrick& brick
         r, b, brick, scheduler_, out,
         [&](RayRecord& path, float t0, float t1) { return FlyTo(path, t0, t1, b, &brick, out); },
         [&](RayRecord& path, const BrickHit& hit) {
-            EndFlightAtSurface(scene_.medium.get(), &path);
+            EndFlightAtSurface(scene_.MediumOf(path.medium), &path);
             const bool goes_on = ShadePath(path, b, brick, hit, out);
             if (!goes_on && progress_ != nullptr) progress_->Add(1);
             return goes_on;
@@ -118,14 +118,15 @@ float CameraPaths::PathFlightDepth(const RayRecord& r) const {
     // Keyed to the path's vertex, which does not change along the ray's flight: every brick the
     // ray crosses draws the same numbers.
     const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
-    return FlightDepth(*scene_.medium, r.lambda, rng.Uniform(kDimFlightChoice),
+    return FlightDepth(*scene_.MediumOf(r.medium), r.lambda, rng.Uniform(kDimFlightChoice),
                        rng.Uniform(kDimFlightDistance));
 }
 
 bool CameraPaths::FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
                         RayOutbox& out) {
-    if (!scene_.medium) return true;
-    const DensityField* field = scene_.medium->DensityIn(brick);
+    const Medium* medium = scene_.MediumOf(r.medium);
+    if (medium == nullptr) return true;
+    const DensityField* field = medium->DensityIn(brick);
     if (field == nullptr || !(t1 > t0)) return true;
     const float depth = PathFlightDepth(r);
     const float t = Fly(field, depth, t0, t1, &r);
@@ -135,13 +136,14 @@ bool CameraPaths::FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const Resi
 }
 
 void CameraPaths::LeaveModel(RayRecord r) {
-    if (scene_.medium) r.beta *= NoScatterWeight(*scene_.medium, r.lambda, r.flight_depth);
+    if (const Medium* medium = scene_.MediumOf(r.medium))
+        r.beta *= NoScatterWeight(*medium, r.lambda, r.flight_depth);
     Escape(r);
 }
 
 void CameraPaths::ScatterInMedium(RayRecord r, float t, float depth, uint32_t b,
                                   const ResidentBrick* brick, RayOutbox& out) {
-    const Medium& medium = *scene_.medium;
+    const Medium& medium = *scene_.MediumOf(r.medium);
     const Vec3f p = r.origin + r.dir * t;
     r.t_max = t;  // the ray ends at its vertex (the light sampler's cones start there)
     r.beta *= ScatterWeight(medium, r.lambda, depth);
@@ -247,12 +249,12 @@ bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, f
 void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out) {
     ++out.counts.rays;
     uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
-    if (scene_.medium) {
+    if (scene_.MediumOf(r.medium) != nullptr) {
         // The medium between the ray's origin and its first brick (outside every brick's cell:
         // only a field that holds everywhere has density there).
         const float t1 = next == store::kNoBrick ? r.t_max : r.t_enter;
         if (r.kind == kShadowRay) {
-            if (!DimShadowRay(scene_.medium.get(), brick, 0, t1, &r)) return;
+            if (!DimShadowRay(scene_.MediumOf(r.medium), brick, 0, t1, &r)) return;
         } else {
             r.flight_depth = 0;
             if (!FlyTo(r, 0, t1, b, brick, out)) return;

@@ -9,7 +9,7 @@ StatusOr<std::unique_ptr<Integrator>> Integrator::Create(const RenderScene& scen
                                                          StreamScheduler& scheduler) {
     // Between surfaces only a medium acts on a ray: without one, a brick crossed in its air may be
     // passed over.
-    if (!scene.medium) scheduler.SkipBricksCrossedInAir();
+    if (!scene.HasMedia()) scheduler.SkipBricksCrossedInAir();
     switch (scene.settings.mode) {
         case RenderSettings::Mode::kPath: {
             NAVE_ASSIGN_OR_RETURN(std::unique_ptr<PathIntegrator> path,

@@ -252,7 +252,7 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
                 return FlyPhoton(photon, t0, t1, brick, &resident, out);
             },
             [&](RayRecord& photon, const BrickHit& hit) {
-                EndFlightAtSurface(scene_.medium.get(), &photon);
+                EndFlightAtSurface(scene_.MediumOf(photon.medium), &photon);
                 return ShadePhoton(photon, brick, resident, hit);
             },
             [](const RayRecord&) {});  // photons leaving the model carry nothing back
@@ -261,8 +261,8 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
 
 bool SppmIntegrator::FlyPhoton(RayRecord& r, float t0, float t1, uint32_t b,
                                const ResidentBrick* brick, RayOutbox& out) {
-    if (!scene_.medium) return true;
-    const Medium& medium = *scene_.medium;
+    if (scene_.MediumOf(r.medium) == nullptr) return true;
+    const Medium& medium = *scene_.MediumOf(r.medium);
     const DensityField* field = medium.DensityIn(brick);
     if (field == nullptr || !(t1 > t0)) return true;
     // The photon stream's flight dimensions, which no surface vertex uses (as a path's).

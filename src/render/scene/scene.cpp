@@ -4,7 +4,9 @@
 #include <fnmatch.h>
 
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <variant>
 
 #include "src/core/log.h"
 #include "src/core/rgb_to_spectrum.h"
@@ -233,9 +235,11 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
 
 namespace {
 
-/// The scene's medium from [medium] (the model's bounds when it gives no box). Errors: negative
-/// coefficients, a medium beyond the model's box in photon mode, an empty model without a box.
-Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
+/// The medium of [medium] or of a material's medium table (the model's bounds when it gives no
+/// box: a solid's inside lies within them). Errors: negative coefficients, a medium beyond the
+/// model's box in photon mode, an empty model without a box.
+StatusOr<std::shared_ptr<const Medium>> MakeMedium(const MediumConfig& config,
+                                                   const RenderScene& scene) {
     Spectrum sigma_a = ToSpectrum(config.sigma_a), sigma_s = ToSpectrum(config.sigma_s);
     if (config.extinction_albedo) {
         const Spectrum sigma_t = ToSpectrum(config.extinction_albedo->first);
@@ -243,8 +247,8 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
         for (float nm = kLambdaMinNm; nm <= kLambdaMaxNm; nm += 1)
             if (!(albedo.Evaluate(nm) >= 0 && albedo.Evaluate(nm) <= 1))
                 return InvalidArgumentError(
-                    "{}: medium.albedo is {} at {} nm: a fraction of the extinction, in [0, 1]",
-                    config.where, albedo.Evaluate(nm), nm);
+                    "{}: {}.albedo is {} at {} nm: a fraction of the extinction, in [0, 1]",
+                    config.where, config.name, albedo.Evaluate(nm), nm);
         // σs = α σt and σa = (1 - α) σt (the single-scattering albedo's definition).
         sigma_s = Spectrum::FromFunction(
             [&](double nm) { return sigma_t.Evaluate(float(nm)) * albedo.Evaluate(float(nm)); });
@@ -256,13 +260,13 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
         for (const auto& [key, spectrum] : {std::pair{"sigma_a", &sigma_a}, {"sigma_s", &sigma_s}})
             if (!(spectrum->Evaluate(nm) >= 0))
                 return InvalidArgumentError(
-                    "{}: medium.{} is {} at {} nm: a coefficient (m^-1) cannot be negative",
-                    config.where, key, spectrum->Evaluate(nm), nm);
+                    "{}: {}.{} is {} at {} nm: a coefficient (m^-1) cannot be negative",
+                    config.where, config.name, key, spectrum->Evaluate(nm), nm);
     }
     std::shared_ptr<const DensityField> density;
     if (config.stored_grid) {
         // The density comes brick by brick with the bricks (Medium::DensityIn).
-        if (Status s = scene->source->UseStoredMedium(config.density_scale); !s.ok())
+        if (Status s = scene.source->UseStoredMedium(config.density_scale); !s.ok())
             return Status(s.code(), fmt::format("{}: [medium] grid = \"{}\": {}", config.where,
                                                 kStoredGrid, s.message()));
     } else if (!config.grid.empty()) {
@@ -273,16 +277,16 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
                                                             grid.status().message()));
         density = *grid;
     } else {
-        const Bounds3f box = config.box.value_or(scene->source->bounds());
+        const Bounds3f box = config.box.value_or(scene.source->bounds());
         if (box.Empty())
-            return InvalidArgumentError(
-                "{}: [medium] has no box_min/box_max and the model is empty", config.where);
+            return InvalidArgumentError("{}: [{}] has no box_min/box_max and the model is empty",
+                                        config.where, config.name);
         density = std::make_shared<BoxDensity>(box);
     }
-    if (density && scene->settings.mode == RenderSettings::Mode::kPhoton) {
+    if (density && scene.settings.mode == RenderSettings::Mode::kPhoton) {
         // Photons fly only from the first brick they enter (they start far outside the model):
         // a medium beyond the model's box would dim them by how far away they were started.
-        const Bounds3f model = scene->source->bounds(), b = density->bounds();
+        const Bounds3f model = scene.source->bounds(), b = density->bounds();
         const float slack = 1e-4f * Length(model.Diagonal());
         for (int a = 0; a < 3; ++a)
             if (b.min[a] < model.min[a] - slack || b.max[a] > model.max[a] + slack)
@@ -292,7 +296,38 @@ Status MakeMedium(const MediumConfig& config, RenderScene* scene) {
                     "inside it (give box_min/box_max inside it, or render.mode = \"path\")",
                     config.where, fmt::streamed(b), fmt::streamed(model));
     }
-    scene->medium = std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g);
+    return std::shared_ptr<const Medium>(
+        std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g));
+}
+
+/// Gives `m`, made from config table `mc` (named `name`), its inside: a solid dielectric's is
+/// kClearSolid or the medium of its table (one per table, made once, `made` remembering which).
+/// Errors: a medium table on a material with no inside, more media than a ray's byte can name.
+Status GiveInside(const MaterialConfig& mc, const std::string& name, RenderScene* scene,
+                  std::map<std::string, uint8_t>* made, SurfaceMaterial* m) {
+    const bool solid = !m->black && std::holds_alternative<DielectricMaterial>(m->material);
+    if (!solid) {
+        if (mc.medium)
+            return InvalidArgumentError(
+                "{}: {}: only a solid dielectric has an inside to fill; materials.{} is not one",
+                mc.medium->where, mc.medium->name, name);
+        return Status::Ok();
+    }
+    m->medium_inside = kClearSolid;
+    if (!mc.medium) return Status::Ok();
+    if (auto it = made->find(name); it != made->end()) {
+        m->medium_inside = it->second;
+        return Status::Ok();
+    }
+    if (scene->inside_media.size() + kClearSolid > 255)
+        return InvalidArgumentError(
+            "{}: {}: more than {} materials with a medium inside (a ray names its medium in a "
+            "byte)",
+            mc.medium->where, mc.medium->name, 255 - kClearSolid);
+    NAVE_ASSIGN_OR_RETURN(std::shared_ptr<const Medium> medium, MakeMedium(*mc.medium, *scene));
+    m->medium_inside = uint8_t(scene->inside_media.size() + kClearSolid);
+    scene->inside_media.push_back(std::move(medium));
+    made->emplace(name, m->medium_inside);
     return Status::Ok();
 }
 
@@ -310,6 +345,8 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
     const std::string file = config.path.string();
 
     // Materials: every model material needs a mapping (or the default).
+    scene.inside_media = {nullptr};  // kClearSolid
+    std::map<std::string, uint8_t> inside_made;
     const auto& records = source.materials();
     for (size_t i = 0; i < records.size(); ++i) {
         const store::MaterialRecord& rec = records[i];
@@ -346,6 +383,7 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
             m.emission =
                 RgbEmission(Vec3f(rec.emission[0], rec.emission[1], rec.emission[2])).ToSpectrum();
         }
+        NAVE_RETURN_IF_ERROR(GiveInside(mc, it->first, &scene, &inside_made, &m));
         scene.materials.push_back(std::move(m));
     }
     for (const auto& entry : config.materials) {
@@ -370,7 +408,9 @@ StatusOr<RenderScene> BuildRenderScene(const SceneConfig& config, BrickSource& s
                                             sun.azimuth_deg, 90.0 - sun.zenith_deg);
     }
     for (const LightConfig& lc : config.lights) scene.lights.push_back(MakeLight(lc));
-    if (config.medium) NAVE_RETURN_IF_ERROR(MakeMedium(*config.medium, &scene));
+    if (config.medium) {
+        NAVE_ASSIGN_OR_RETURN(scene.medium, MakeMedium(*config.medium, scene));
+    }
     if (config.sky.kind == SkyConfig::Kind::kUniform) {
         scene.sky = std::make_unique<SkyLight>(ToSpectrum(config.sky.radiance));
     } else if (config.sky.kind == SkyConfig::Kind::kPreetham && scene.sun >= 0) {

@@ -4,6 +4,7 @@
 // mapping exists), config spectra are tabulated, and the sun's direction and spectrum are computed
 // from date and place.
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "src/render/scene/materials/frame.h"
 #include "src/render/scene/materials/materials.h"
 #include "src/render/scene/media/medium.h"
+#include "src/render/scene/media/medium_index.h"
 #include "src/render/scene/scene_config.h"
 #include "src/render/scene/sun/sky.h"
 #include "src/render/scene/texture/surface_textures.h"
@@ -39,6 +41,9 @@ struct SurfaceMaterial {
     bool emissive = false;
     Spectrum emission;    ///< radiance, W m^-2 sr^-1 nm^-1, both sides
     bool portal = false;  ///< photons are aimed at it (render.photon_target = "portals")
+    /// A solid dielectric's inside (RenderScene::MediumOf: kClearSolid, or its medium table's);
+    /// kOutsideMedium for a surface with no inside (any other material, thin glass included).
+    uint8_t medium_inside = kOutsideMedium;
     /// The model's textures for this material (albedo of a diffuse material, alpha, emission);
     /// null: none.
     std::shared_ptr<const SurfaceTextures> textures;
@@ -117,8 +122,21 @@ struct RenderScene {
     /// The sun; only when `sun` >= 0.
     const SunLight& sun_light() const { return static_cast<const SunLight&>(*lights[size_t(sun)]); }
     std::unique_ptr<SkyLight> sky;  ///< uniform or physical, or null
-    /// The medium filling the air ([medium]), or null. Path mode only.
+    /// The medium filling the air ([medium]), or null.
     std::shared_ptr<const Medium> medium;
+    /// The insides of solid dielectrics (SurfaceMaterial::medium_inside - kClearSolid indexes it):
+    /// first null, the inside of clear solids, then one medium per material table with a medium.
+    std::vector<std::shared_ptr<const Medium>> inside_media;
+    /// The medium of a ray's RayRecord::medium `index`: the air's or a solid's inside (null: none
+    /// there).
+    const Medium* MediumOf(uint8_t index) const {
+        return index == kOutsideMedium ? medium.get() : inside_media[index - kClearSolid].get();
+    }
+    /// Whether any ray meets a medium anywhere: the air's, or inside a solid.
+    bool HasMedia() const {
+        return medium != nullptr || std::any_of(inside_media.begin(), inside_media.end(),
+                                                [](const auto& m) { return m != nullptr; });
+    }
     RenderSettings settings;
     OutputConfig output;
     std::string sun_description;  ///< "azimuth 92.1 deg, elevation 31.4 deg" for the summary

@@ -444,8 +444,20 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     return r.Finish();
 }
 
-Status ParseMedium(TableReader& r, MediumConfig* m) {
+/// [medium], or with `inside_solid` a material's medium table (named `name`), which fills the
+/// solid's inside and takes no box or grid.
+Status ParseMedium(TableReader& r, MediumConfig* m, const std::string& name = "medium",
+                   bool inside_solid = false) {
     m->where = r.WhereTable();
+    m->name = name;
+    if (inside_solid) {
+        for (const char* key : {"box_min", "box_max", "grid", "grid_name", "density_scale"})
+            if (r.Has(key))
+                return InvalidArgumentError(
+                    "{}: {}.{}: a solid's medium fills its inside, the whole of it: it takes "
+                    "sigma_a and sigma_s (or extinction and albedo) and g only",
+                    m->where, name, key);
+    }
     if (r.Has("box_min") != r.Has("box_max"))
         return InvalidArgumentError(
             "{}: {}: give both box_min and box_max, or neither (the "
@@ -516,8 +528,21 @@ Status ParseMaterialTextures(TableReader& r, MaterialConfig* m) {
     return r.Float("emission_scale", &m->emission_scale, 0, 1e9);
 }
 
+/// The material's `medium` table, if any: what fills a solid dielectric's inside.
+Status ParseMaterialMedium(TableReader& r, MaterialConfig* m) {
+    NAVE_ASSIGN_OR_RETURN(const toml::table* medium, r.Table("medium"));
+    if (medium == nullptr) return Status::Ok();
+    const std::string name = r.Name("medium");
+    TableReader t(*medium, name, r.file());
+    MediumConfig config;
+    NAVE_RETURN_IF_ERROR(ParseMedium(t, &config, name, /*inside_solid=*/true));
+    m->medium = std::move(config);
+    return Status::Ok();
+}
+
 Status ParseMaterial(TableReader& r, MaterialConfig* m) {
     m->where = r.WhereTable();
+    NAVE_RETURN_IF_ERROR(ParseMaterialMedium(r, m));
     if (r.Has("builtin")) {
         // A named material of nave's physics library (limestone, glass_blue, gold, bk7...).
         if (r.Has("type")) {
@@ -601,6 +626,11 @@ Status ParseMaterial(TableReader& r, MaterialConfig* m) {
                         "thin_dielectric, black)",
                         type));
     }
+    if (m->medium && m->kind != MaterialConfig::Kind::kDielectric)
+        return InvalidArgumentError(
+            "{}: {}: only a solid dielectric (type = \"dielectric\") has an inside to fill; a "
+            "{} material has none",
+            m->medium->where, m->medium->name, type);
     NAVE_ASSIGN_OR_RETURN(m->emission, r.OptionalSpectrum("emission"));
     NAVE_RETURN_IF_ERROR(r.Bool("portal", &m->portal));
     NAVE_RETURN_IF_ERROR(ParseMaterialTextures(r, m));
@@ -640,7 +670,8 @@ Status ParseRender(TableReader& r, RenderSettings* s) {
         r.Int("photons_per_iteration", &s->photons_per_iteration, 1, int64_t(UINT32_MAX)));
     NAVE_RETURN_IF_ERROR(r.Float("initial_radius_m", &s->initial_radius_m, 0, 1e6));
     NAVE_RETURN_IF_ERROR(r.Float("alpha", &s->alpha, 0.01, 1));
-    NAVE_RETURN_IF_ERROR(r.Int("max_depth", &s->max_depth, 1, 1000));
+    // A ray counts its scatterings in a byte (RayRecord::depth).
+    NAVE_RETURN_IF_ERROR(r.Int("max_depth", &s->max_depth, 1, 255));
     NAVE_RETURN_IF_ERROR(r.Int("seed", &s->seed, 0, INT64_MAX));
     NAVE_RETURN_IF_ERROR(r.Int("threads", &s->threads, 0, 4096));
     s->wave_paths_chosen = r.Has("wave_paths");

@@ -91,6 +91,31 @@ struct LightConfig {
     std::string where;                                ///< "scene.toml:12" for messages
 };
 
+/// [medium]: a homogeneous participating medium (haze, dust) filling a box, or the model's bounds.
+/// [medium] grid's value that names the grid stored in the bricks rather than a file.
+inline constexpr const char* kStoredGrid = "store";
+
+struct MediumConfig {
+    /// box_min, box_max (model units, metres); none: the model's bounds.
+    std::optional<Bounds3f> box;
+    /// A density grid instead of a box: an OpenVDB file (relative paths from the config's
+    /// directory), the float grid's name in it, and a factor on its values.
+    std::filesystem::path grid;
+    /// grid = "store" (kStoredGrid): the grid `nave preprocess` cut into the store's bricks, each
+    /// brick's piece loaded and evicted with the brick.
+    bool stored_grid = false;
+    std::string grid_name = "density";
+    float density_scale = 1.f;
+    SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1
+    SpectrumSpec sigma_s = SpectrumSpec::Constant(0.f);  ///< scattering coefficient, m^-1
+    /// Instead of sigma_a and sigma_s: the extinction coefficient σt (m^-1) and the single-
+    /// scattering albedo σs / σt.
+    std::optional<std::pair<SpectrumSpec, SpectrumSpec>> extinction_albedo;
+    float g = 0.f;                ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
+    std::string where;            ///< file:line of the table, for messages
+    std::string name = "medium";  ///< the table's name, for messages ("materials.water.medium")
+};
+
 struct MaterialConfig {
     enum class Kind { kDiffuse, kConductor, kDielectric, kThinDielectric, kBlack };
     Kind kind = Kind::kDiffuse;
@@ -121,31 +146,10 @@ struct MaterialConfig {
     /// an RGB texel of luminance 1 emits a spectrum of luminance `emission_scale` (W m^-2 sr^-1
     /// nm^-1 units).
     float emission_scale = 1.f;
+    /// [materials.NAME.medium]: the homogeneous medium filling a solid dielectric's inside (water,
+    /// milky or tinted glass): coefficients and g as [medium]'s, no box or grid.
+    std::optional<MediumConfig> medium;
     std::string where;
-};
-
-/// [medium]: a homogeneous participating medium (haze, dust) filling a box, or the model's bounds.
-/// [medium] grid's value that names the grid stored in the bricks rather than a file.
-inline constexpr const char* kStoredGrid = "store";
-
-struct MediumConfig {
-    /// box_min, box_max (model units, metres); none: the model's bounds.
-    std::optional<Bounds3f> box;
-    /// A density grid instead of a box: an OpenVDB file (relative paths from the config's
-    /// directory), the float grid's name in it, and a factor on its values.
-    std::filesystem::path grid;
-    /// grid = "store" (kStoredGrid): the grid `nave preprocess` cut into the store's bricks, each
-    /// brick's piece loaded and evicted with the brick.
-    bool stored_grid = false;
-    std::string grid_name = "density";
-    float density_scale = 1.f;
-    SpectrumSpec sigma_a = SpectrumSpec::Constant(0.f);  ///< absorption coefficient, m^-1
-    SpectrumSpec sigma_s = SpectrumSpec::Constant(0.f);  ///< scattering coefficient, m^-1
-    /// Instead of sigma_a and sigma_s: the extinction coefficient σt (m^-1) and the single-
-    /// scattering albedo σs / σt.
-    std::optional<std::pair<SpectrumSpec, SpectrumSpec>> extinction_albedo;
-    float g = 0.f;      ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
-    std::string where;  ///< file:line of the table, for messages
 };
 
 struct RenderSettings {

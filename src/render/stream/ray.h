@@ -8,6 +8,7 @@
 
 #include "src/core/spectrum.h"
 #include "src/core/vecmath.h"
+#include "src/render/scene/media/medium_index.h"
 
 namespace nave::render {
 
@@ -66,7 +67,11 @@ struct RayRecord {
     float t_exit = 0;     ///< end of the segment in the current brick's cell
     uint32_t pixel = 0;   ///< pixel index (y * width + x), or photon index
     uint32_t sample = 0;  ///< sample index within the pixel
-    uint16_t depth = 0;   ///< scatterings so far (straight passes through thin glass do not count)
+    uint8_t depth = 0;    ///< scatterings so far (straight passes through thin glass do not count;
+                          ///< render.max_depth is at most 255)
+    /// The medium the ray travels in (RenderScene::MediumOf): kOutsideMedium, the air's, or the
+    /// inside of the closed solid it entered last through its surface (MediumPast).
+    uint8_t medium = kOutsideMedium;
     uint8_t kind = kPathRay;
     uint8_t flags = 0;
     uint16_t vertex =

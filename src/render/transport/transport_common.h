@@ -103,11 +103,27 @@ inline void CarryFootprint(RayRecord& r, const SurfaceHit& h, float t, bool scat
     r.level_reach = LevelReach(h.lod.error, r.cone_width, h.lod.coarsest_error);
 }
 
-/// Carries `r`'s footprint off `h` (CarryFootprint) into `wi` and returns where the ray starts:
-/// off the surface by OffsetOrigin and, from a coarse level, by LevelOffset along its normal.
+/// The medium ray `r`, arriving at `h` along r.dir, travels in once it leaves toward `wi`. Through
+/// a solid's surface (a refraction: it arrived on one side of the geometric normal and leaves on
+/// the other) it goes into the solid's inside or back out to the air; solids do not nest (a ray
+/// leaving one is outside all), and a solid's normals face out, as its absorption already assumes
+/// (AbsorbInsideGlass). Anywhere else (a reflection, thin glass, any other material) it stays in
+/// the medium it was in.
+inline uint8_t MediumPast(const RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
+    const uint8_t inside = h.material->medium_inside;
+    if (inside == kOutsideMedium) return r.medium;
+    const float arriving = Dot(r.dir, h.ng), leaving = Dot(wi, h.ng);
+    if (!(arriving * leaving > 0)) return r.medium;  // reflected
+    return leaving < 0 ? inside : kOutsideMedium;
+}
+
+/// Carries `r`'s footprint and medium (MediumPast) off `h`, where it arrived along r.dir, into
+/// `wi` and returns where the ray starts: off the surface by OffsetOrigin and, from a coarse
+/// level, by LevelOffset along its normal.
 inline Vec3f LeaveSurface(RayRecord& r, const SurfaceHit& h, const Vec3f& wi, float t,
                           bool scattered) {
     CarryFootprint(r, h, t, scattered);
+    r.medium = MediumPast(r, h, wi);
     const Vec3f origin = OffsetOrigin(h.p, h.ng, wi);
     const float offset = LevelOffset(h.lod.error);
     if (offset == 0) return origin;  // full detail
