@@ -110,7 +110,7 @@ inline void CarryFootprint(RayRecord& r, const SurfaceHit& h, float t, bool scat
 /// (AbsorbInsideGlass). Anywhere else (a reflection, thin glass, any other material) it stays in
 /// the medium it was in.
 inline uint8_t MediumPast(const RayRecord& r, const SurfaceHit& h, const Vec3f& wi) {
-    const uint8_t inside = h.material->medium_inside;
+    const uint8_t inside = h.material != nullptr ? h.material->medium_inside : kOutsideMedium;
     if (inside == kOutsideMedium) return r.medium;
     const float arriving = Dot(r.dir, h.ng), leaving = Dot(wi, h.ng);
     if (!(arriving * leaving > 0)) return r.medium;  // reflected
