@@ -249,12 +249,12 @@ bool CameraPaths::ShadowThroughBrick(RayRecord& r, const ResidentBrick& brick, f
 void CameraPaths::Spawn(RayRecord r, uint32_t b, const ResidentBrick* brick, RayOutbox& out) {
     ++out.counts.rays;
     uint32_t next = scheduler_.Route(r, 0, store::kNoBrick);
-    if (scene_.MediumOf(r.medium) != nullptr) {
+    if (const Medium* medium = scene_.MediumOf(r.medium); medium != nullptr) {
         // The medium between the ray's origin and its first brick (outside every brick's cell:
         // only a field that holds everywhere has density there).
         const float t1 = next == store::kNoBrick ? r.t_max : r.t_enter;
         if (r.kind == kShadowRay) {
-            if (!DimShadowRay(scene_.MediumOf(r.medium), brick, 0, t1, &r)) return;
+            if (!DimShadowRay(medium, brick, 0, t1, &r)) return;
         } else {
             r.flight_depth = 0;
             if (!FlyTo(r, 0, t1, b, brick, out)) return;

@@ -261,8 +261,9 @@ void SppmIntegrator::ProcessBatch(uint32_t brick, const ResidentBrick& resident,
 
 bool SppmIntegrator::FlyPhoton(RayRecord& r, float t0, float t1, uint32_t b,
                                const ResidentBrick* brick, RayOutbox& out) {
-    if (scene_.MediumOf(r.medium) == nullptr) return true;
-    const Medium& medium = *scene_.MediumOf(r.medium);
+    const Medium* in = scene_.MediumOf(r.medium);
+    if (in == nullptr) return true;
+    const Medium& medium = *in;
     const DensityField* field = medium.DensityIn(brick);
     if (field == nullptr || !(t1 > t0)) return true;
     // The photon stream's flight dimensions, which no surface vertex uses (as a path's).
