@@ -67,8 +67,9 @@ class VdbPlugin {
     virtual ~VdbPlugin() = default;
     /// The float grid `grid` of `file`. A file that is not OpenVDB (or is cut short) is
     /// InvalidArgument naming it; a missing grid lists the grids there; a grid of another value
-    /// type, a transform that is not a uniform scale and translation, or a negative active value
-    /// is InvalidArgument naming the grid.
+    /// type, a transform that is not a uniform scale and translation, a negative active value, or
+    /// no active voxel at all is InvalidArgument naming the grid. A file whose offsets or lengths
+    /// reach past its end is refused before OpenVDB allocates anything for them.
     virtual StatusOr<std::unique_ptr<ScalarGrid>> ReadScalarGrid(const std::filesystem::path& file,
                                                                  const std::string& grid) const = 0;
     /// A grid serialized as GridPiece::bytes; `what` names it in errors (e.g. "abbey.nave brick

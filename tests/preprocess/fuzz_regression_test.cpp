@@ -6,6 +6,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include "common/sanitizers.h"
 #include "preprocess/import/importer.h"
 #include "src/volumes/vdb_plugin.h"
@@ -61,6 +64,61 @@ TEST(FuzzRegression, DamagedVdbBlockIsAnError) {
                                  [](size_t, const volumes::GridPiece&) { return Status::Ok(); });
     EXPECT_FALSE(cut.ok());
     EXPECT_THAT(cut.status().message(), HasSubstr("blosc_size_damaged.vdb"));
+}
+
+// What a file and a store's piece give when read: the error of reading a fixture whole
+// (ReadScalarGrid), and of reading its bytes as a piece (ReadScalarGridBytes).
+struct VdbReadErrors {
+    std::string file, bytes;
+};
+VdbReadErrors ReadVdbFixture(const std::string& name) {
+    const std::filesystem::path file = Fixture("../volumes/" + name);
+    StatusOr<const volumes::VdbPlugin*> plugin = volumes::LoadVdbPlugin();
+    EXPECT_TRUE(plugin.ok()) << plugin.status().ToString();
+    if (!plugin.ok()) return {};
+    VdbReadErrors errors;
+    auto whole = (*plugin)->ReadScalarGrid(file, "density");
+    errors.file = whole.ok() ? "read" : whole.status().message();
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto piece = (*plugin)->ReadScalarGridBytes(
+        {reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()}, "the piece");
+    errors.bytes = piece.ok() ? "read" : piece.status().message();
+    return errors;
+}
+
+// dust.vdb mutated by fuzz_vdb: its tree keeps nodes but no active voxel. OpenVDB's box of the
+// active voxels is then inverted, +-2^31 voxels, which nave took for the grid's bounds: every ray
+// marched ~1.7e10 m of empty leaves (10 s a ray). A grid without active voxels is now an error.
+TEST(FuzzRegression, VdbGridWithoutActiveVoxelsIsAnError) {
+    const VdbReadErrors errors = ReadVdbFixture("no_active_voxels.vdb");
+    EXPECT_THAT(errors.file,
+                HasSubstr("no_active_voxels.vdb: grid 'density' has no active voxels"));
+}
+
+// dust.vdb mutated: a grid descriptor's name claims 4 GiB. OpenVDB allocated and zeroed 4 GiB
+// for it before finding the file short; nave's layout check refuses the length first.
+TEST(FuzzRegression, VdbNameLongerThanTheFileIsAnError) {
+    const VdbReadErrors errors = ReadVdbFixture("descriptor_name_4gib.vdb");
+    EXPECT_THAT(errors.file, HasSubstr("descriptor_name_4gib.vdb: damaged: grid descriptor 0's "));
+    EXPECT_THAT(errors.file, HasSubstr("past the end"));
+    EXPECT_THAT(errors.bytes, HasSubstr("the piece: damaged: grid descriptor 0's "));
+}
+
+// A piece whose grid metadata holds a string of 4 GiB: OpenVDB's Stream allocated it.
+TEST(FuzzRegression, VdbMetadataLongerThanTheBytesIsAnError) {
+    const VdbReadErrors errors = ReadVdbFixture("metadata_string_4gib.vdb");
+    EXPECT_THAT(errors.bytes, HasSubstr("the piece: damaged: grid 'density' metadata "));
+    EXPECT_THAT(errors.file, HasSubstr("metadata_string_4gib.vdb"));
+    EXPECT_NE(errors.file, "read");
+}
+
+// A piece announcing millions of grids: OpenVDB's Stream reserved a descriptor for each.
+TEST(FuzzRegression, VdbStreamWithManyGridsIsAnError) {
+    const VdbReadErrors errors = ReadVdbFixture("stream_grid_count_damaged.vdb");
+    EXPECT_THAT(errors.bytes, HasSubstr("the piece: "));
+    EXPECT_NE(errors.bytes, "read");
+    EXPECT_THAT(errors.file, HasSubstr("stream_grid_count_damaged.vdb"));
 }
 
 }  // namespace

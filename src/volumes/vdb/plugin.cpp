@@ -14,11 +14,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <sstream>
 
 #include "src/core/memory.h"
+#include "src/volumes/vdb/file_layout.h"
 #include "src/volumes/vdb_plugin.h"
 
 namespace nave::volumes::vdb {
@@ -34,6 +34,10 @@ using ActiveSpans = openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid, /*N
 class VdbScalarGrid final : public ScalarGrid {
   public:
     explicit VdbScalarGrid(openvdb::FloatGrid::ConstPtr grid) : grid_(std::move(grid)) {
+        voxel_m_ = grid_->voxelSize().x();
+        // Without active voxels the box OpenVDB gives is inverted, of +-2^31 voxels: such a grid
+        // has empty bounds and no spans to march.
+        if (grid_->activeVoxelCount() == 0) return;
         const openvdb::CoordBBox box = grid_->evalActiveVoxelBoundingBox();
         // Voxel ijk's cell is [i - 1/2, i + 1/2] in index space: OpenVDB puts its centre at ijk.
         const openvdb::Vec3d lo = grid_->indexToWorld(box.min().asVec3d() - openvdb::Vec3d(0.5));
@@ -42,9 +46,7 @@ class VdbScalarGrid final : public ScalarGrid {
                                  float(std::min(lo.z(), hi.z()))),
                            Vec3f(float(std::max(lo.x(), hi.x())), float(std::max(lo.y(), hi.y())),
                                  float(std::max(lo.z(), hi.z()))));
-        voxel_m_ = grid_->voxelSize().x();
-        // An empty grid has no spans (and the intersector refuses it).
-        if (!grid_->empty()) spans_ = std::make_unique<const ActiveSpans>(*grid_);
+        spans_ = std::make_unique<const ActiveSpans>(*grid_);
     }
 
     Bounds3f bounds() const override { return bounds_; }
@@ -164,55 +166,12 @@ openvdb::CoordBBox VoxelsOverlapping(const openvdb::math::Transform& transform,
     return openvdb::CoordBBox(lo, hi);
 }
 
-/// A `.vdb` file's layout, read with OpenVDB's own header and grid-descriptor readers (io::Archive,
-/// io::GridDescriptor), to check that every grid lies within the file before OpenVDB's File reads
-/// it: File trusts the offsets, and in a file cut short it reads lengths from past the end and
-/// allocates gigabytes before it fails (6 GB and 14 s on a 6 MB grid cut to two thirds).
-class FileLayout final : public openvdb::io::Archive {
-  public:
-    /// OK if every grid of `file` ends within its bytes; else InvalidArgument naming the grid and
-    /// both sizes, or saying the file ends inside its header. Lets OpenVDB's other exceptions
-    /// through (a file that is not OpenVDB).
-    Status CheckWhole(const std::filesystem::path& file) {
-        try {
-            return CheckGridsWithin(file);
-        } catch (const std::ios_base::failure&) {
-            return InvalidArgumentError(
-                "{}: cut short: its {} bytes end inside the header or the list of grids",
-                file.string(), std::filesystem::file_size(file));
-        }
-    }
-
-  private:
-    Status CheckGridsWithin(const std::filesystem::path& file) {
-        const std::string where = file.string();
-        const uint64_t size = std::filesystem::file_size(file);
-        std::ifstream in(where, std::ios::binary);
-        // Every read must be whole: a short one throws rather than leaving a length undefined.
-        in.exceptions(std::ios::failbit | std::ios::badbit | std::ios::eofbit);
-        readHeader(in);
-        setFormatVersion(in);
-        setLibraryVersion(in);
-        setDataCompression(in);
-        openvdb::MetaMap file_metadata;
-        file_metadata.readMeta(in);
-        const int32_t count = readGridCount(in);
-        if (count < 0)
-            return InvalidArgumentError("{}: {} grids: not an OpenVDB file", where, count);
-        for (int32_t i = 0; i < count; ++i) {
-            openvdb::io::GridDescriptor grid;
-            grid.read(in);
-            const int64_t end = grid.getEndPos();
-            if (!(grid.getGridPos() >= 0 && grid.getGridPos() <= grid.getBlockPos() &&
-                  grid.getBlockPos() <= end && uint64_t(end) <= size))
-                return InvalidArgumentError(
-                    "{}: cut short or damaged: grid '{}' lies at bytes {}..{} of a file of {}",
-                    where, grid.gridName(), grid.getGridPos(), end, size);
-            in.seekg(end, std::ios::beg);
-        }
-        return Status::Ok();
-    }
-};
+/// A density grid without active voxels: a medium that would be nowhere, most likely not what the
+/// file was meant to hold.
+Status EmptyGridError(const std::string& where, const std::string& name) {
+    return InvalidArgumentError("{}: grid '{}' has no active voxels: its density is 0 everywhere",
+                                where, name);
+}
 
 /// The names of the grids in an open file, comma-separated ("none" for a file without grids).
 std::string GridNames(openvdb::io::File& in) {
@@ -248,7 +207,7 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
                                  std::span<const Bounds3f> boxes, uint64_t memory_limit,
                                  const std::function<Status(size_t, GridPiece)>& emit) {
     const std::string where = file.string();
-    NAVE_RETURN_IF_ERROR(FileLayout().CheckWhole(file));
+    NAVE_RETURN_IF_ERROR(CheckFileLayout(file));
     openvdb::io::File in(where);
     // OpenVDB would first copy a file of up to 500 MB to a temporary one, in case it changed
     // while leaves wait to be loaded; every leaf this reads is loaded before the file closes.
@@ -270,6 +229,7 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
         openvdb::gridPtrCast<openvdb::FloatGrid>(in.readGrid(name));
     if (!topology) return InvalidArgumentError("{}: grid '{}' is not a float grid", where, name);
     summary.active_voxels = topology->activeVoxelCount();
+    if (summary.active_voxels == 0) return EmptyGridError(where, name);
     const openvdb::CoordBBox active = topology->evalActiveVoxelBoundingBox();
     summary.topology_bytes = openvdb::tools::memUsage(topology->tree());
     summary.peak_bytes = summary.topology_bytes;
@@ -283,14 +243,10 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
             where, name, summary.active_voxels, topology->tree().leafCount(),
             FormatBytes(2 * summary.topology_bytes), FormatBytes(memory_limit));
     }
-    if (summary.active_voxels > 0) {
-        const openvdb::Vec3d lo =
-            transform->indexToWorld(active.min().asVec3d() - openvdb::Vec3d(0.5));
-        const openvdb::Vec3d hi =
-            transform->indexToWorld(active.max().asVec3d() + openvdb::Vec3d(0.5));
-        for (const openvdb::Vec3d& corner : {lo, hi})
-            summary.bounds.Extend(Vec3f(float(corner.x()), float(corner.y()), float(corner.z())));
-    }
+    const openvdb::Vec3d lo = transform->indexToWorld(active.min().asVec3d() - openvdb::Vec3d(0.5));
+    const openvdb::Vec3d hi = transform->indexToWorld(active.max().asVec3d() + openvdb::Vec3d(0.5));
+    for (const openvdb::Vec3d& corner : {lo, hi})
+        summary.bounds.Extend(Vec3f(float(corner.x()), float(corner.y()), float(corner.z())));
 
     // A voxel whose cell overlaps several boxes goes into each; it counts as kept in the first.
     // Only boxes within a voxel of each other can share one: those whose index boxes overlap.
@@ -299,7 +255,7 @@ StatusOr<GridCutSummary> CutGrid(const std::filesystem::path& file, const std::s
     uint64_t kept = 0;
     const double voxel = transform->voxelSize().x();
     std::vector<const openvdb::CoordBBox*> earlier;
-    for (size_t i = 0; i < boxes.size() && summary.active_voxels > 0; ++i) {
+    for (size_t i = 0; i < boxes.size(); ++i) {
         const openvdb::CoordBBox& want = wanted[i];
         if (want.empty() || !want.hasOverlap(active)) continue;
         const uint64_t box_voxels = openvdb::tools::countActiveVoxels(topology->tree(), want);
@@ -370,7 +326,7 @@ class Plugin final : public VdbPlugin {
             return NotFoundError("{}: no such file", file.string());
         openvdb::GridBase::Ptr base;
         try {
-            NAVE_RETURN_IF_ERROR(FileLayout().CheckWhole(file));
+            NAVE_RETURN_IF_ERROR(CheckFileLayout(file));
             openvdb::io::File in(file.string());
             in.open(/*delayLoad=*/false);
             if (!in.hasGrid(name)) {
@@ -388,6 +344,7 @@ class Plugin final : public VdbPlugin {
         }
         NAVE_ASSIGN_OR_RETURN(openvdb::FloatGrid::Ptr grid,
                               CheckedDensityGrid(base, file.string(), name));
+        if (grid->activeVoxelCount() == 0) return EmptyGridError(file.string(), name);
         return std::unique_ptr<ScalarGrid>(std::make_unique<VdbScalarGrid>(grid));
     }
 
@@ -396,6 +353,7 @@ class Plugin final : public VdbPlugin {
         InitializeOnce();
         openvdb::GridPtrVecPtr grids;
         try {
+            NAVE_RETURN_IF_ERROR(CheckStreamLayout(bytes, what));
             std::istringstream in(
                 std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
                 std::ios::binary);
