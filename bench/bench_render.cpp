@@ -72,6 +72,16 @@ sigma_a = 0.005
 g = 0.6
 )";
 
+/// The same haze glowing (emission: gathered along every flight, EmissionAlong) for
+/// BM_PathRaysInGlowingMedium.
+constexpr const char* kGlowingMedium = R"(
+[medium]
+sigma_s = 0.08
+sigma_a = 0.005
+g = 0.6
+emission = 20
+)";
+
 std::unique_ptr<Fixture> MakeFixture(int split, const char* mode, const char* extra = "") {
     static const store::BrickMesh mesh = BenchMesh();
     auto f = std::make_unique<Fixture>();
@@ -131,6 +141,19 @@ void BM_PathRaysInMedium(benchmark::State& state) {
     RunPathRays(state, f.get());
 }
 BENCHMARK(BM_PathRaysInMedium)
+    ->Arg(1)
+    ->Arg(4)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+
+/// The haze glowing: the cost of gathering its emission along every flight.
+void BM_PathRaysInGlowingMedium(benchmark::State& state) {
+    ProgressBar::SetEnabled(false);
+    auto f = MakeFixture(int(state.range(0)), "path", kGlowingMedium);
+    RunPathRays(state, f.get());
+}
+BENCHMARK(BM_PathRaysInGlowingMedium)
     ->Arg(1)
     ->Arg(4)
     ->Unit(benchmark::kMillisecond)

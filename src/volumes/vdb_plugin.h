@@ -19,7 +19,7 @@
 namespace nave::volumes {
 
 /// Bumped whenever VdbPlugin's methods or the types they take change.
-inline constexpr int kVdbPluginVersion = 3;
+inline constexpr int kVdbPluginVersion = 4;
 
 /// A grid of voxels, each of constant value over its cell, in world space. Immutable: thread-safe.
 class ScalarGrid {
@@ -31,6 +31,10 @@ class ScalarGrid {
     virtual uint64_t memory_bytes() const = 0;
     /// Active voxels (those of active tiles included): GridPiece::active_voxels of a piece read.
     virtual uint64_t active_voxels() const = 0;
+    /// The side of a voxel, world units.
+    virtual float voxel_size() const = 0;
+    /// The value of the voxel whose cell holds world point `p` (0 outside the active voxels).
+    virtual float Value(const Vec3f& p) const = 0;
     /// Calls `visit(t0, t1, value)` for the voxels the ray o + t d (d unit) crosses with t in
     /// [t_begin, t_end] (world units), front to back, until it returns false: every voxel of the
     /// active leaves and tiles it crosses; voxels elsewhere are 0 and skipped.

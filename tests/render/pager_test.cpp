@@ -66,14 +66,16 @@ std::unique_ptr<BrickSource> BallGridSource() {
 /// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
 /// and its guide, "path_guided": path guiding over 16 passes, "path_haze" and "photon_haze": with a
 /// medium over the model, or "path_water" and "photon_water": balls of water that scatters, in
-/// that haze).
+/// that haze; "path_glow": the water and the haze glow).
 SceneConfig BallGridConfig(const std::string& mode) {
     const bool gather = mode == "photon_gather", guided = mode == "path_guided",
-               water = mode == "path_water" || mode == "photon_water",
+               glow = mode == "path_glow",
+               water = mode == "path_water" || mode == "photon_water" || glow,
                haze = mode == "path_haze" || mode == "photon_haze" || water;
     const std::string base = mode.starts_with("photon") ? "photon" : "path";
     const std::string text = fmt::format(fmt::runtime(kBallGrid), base) +
-                             (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "");
+                             (haze ? "[medium]\nsigma_s = 0.2\nsigma_a = 0.02\ng = 0.5\n" : "") +
+                             (glow ? "emission = 0.5\n" : "");
     auto config = ParseSceneConfig(text, "balls.toml");
     EXPECT_TRUE(config.ok()) << config.status().ToString();
     if (!config.ok()) return SceneConfig();
@@ -88,6 +90,7 @@ SceneConfig BallGridConfig(const std::string& mode) {
         ball.medium->sigma_s = SpectrumSpec::Constant(2.f);
         ball.medium->sigma_a = SpectrumSpec::Constant(0.3f);
         ball.medium->g = 0.3f;
+        if (glow) ball.medium->emission = SpectrumSpec::Constant(0.2f);
     }
     if (guided) {
         // Rounds 0-1 | 2-3 | 4-7 | ... | 32-63: passes 4-63 sample what rounds 0-3 taught.
@@ -216,6 +219,11 @@ TEST_F(PagerTest, PagedRenderEqualsInCorePhotonInHaze) {
 TEST_F(PagerTest, PagedRenderEqualsInCoreThroughBallsOfWater) {
     ExpectPagedEqualsInCore("path_water", 1e-9);
     ExpectPagedEqualsInCore("photon_water", 1e-9);
+}
+
+// What media emit is gathered along each flight where it crosses a brick, resident or not.
+TEST_F(PagerTest, PagedRenderEqualsInCoreInGlowingMedia) {
+    ExpectPagedEqualsInCore("path_glow", 1e-9);
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }

@@ -90,6 +90,15 @@ StatusOr<std::unique_ptr<TestScene>> BuildTestScene(std::unique_ptr<BrickSource>
     return t;
 }
 
+std::string LampSceneError(const std::string& config_text, const std::string& file) {
+    StatusOr<SceneConfig> config = ParseSceneConfig(config_text, file);
+    EXPECT_TRUE(config.ok()) << config.status().message();
+    if (!config.ok()) return std::string();
+    StatusOr<std::unique_ptr<TestScene>> scene =
+        BuildTestScene(GridSource(LampMesh(), NamedMaterials({"lamp"}), Vec3i(1, 1, 1)), *config);
+    return scene.ok() ? std::string() : std::string(scene.status().message());
+}
+
 std::unique_ptr<TestRender> BuildAndRender(std::unique_ptr<BrickSource> source, SceneConfig config,
                                            const RunOptions& options) {
     EXPECT_TRUE(source != nullptr);

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "render_test_util.h"
+#include "src/core/color.h"
 #include "src/core/progress.h"
 #include "src/render/bricks/memory_brick_source.h"
 #include "src/render/bricks/procedural_meshes.h"
@@ -144,6 +145,62 @@ g = 0.3
     ASSERT_TRUE(in_bricks);
     ASSERT_TRUE(in_bricks->status.ok()) << in_bricks->status.ToString();
     EXPECT_LT(testing::MaxRelativeDifference(*one->film, *in_bricks->film), 1e-5);
+}
+
+// A slab 1 m thick of absorbing gas at 2000 K (a temperature grid, its own density: values 2000
+// times density_scale 0.001 = 2 m^-1 with σa = 1), in front of the lamp (radiance 1): it glows at
+// Planck's radiance B(λ, 2000 K) as far as it is opaque, L = B (1 - e^-2) + e^-2 (Kirchhoff's
+// law in the radiative transfer equation without scattering; Planck's law, CODATA 2018).
+TEST_F(VdbMediumTest, HotGasGlowsAtPlancksRadianceAsFarAsItIsOpaque) {
+    const float kelvin = 2000.f;
+    const fs::path file =
+        Write("hot", {1, -1, -1}, {2, 4, 4}, [&](int, int, int) { return kelvin; });
+    std::string config = testing::kLampConfig;
+    config.replace(config.find("spp = 4"), 7, "spp = 64");
+    const auto t = Render(testing::LampMesh(), {"lamp"},
+                          config + "[medium]\ngrid = \"" + file.string() +
+                              "\"\ndensity_scale = 0.001\nsigma_a = 1\n"
+                              "temperature_grid = \"density\"\n",
+                          2);
+    ASSERT_TRUE(t);
+    const double planck_y = SpectrumToXYZ(Spectrum::FromFunction([&](double nm) {
+                                return PlanckRadiance(nm, kelvin);
+                            })).y;
+    const double expected = planck_y * (1 - std::exp(-2.0)) + std::exp(-2.0);
+    EXPECT_GT(planck_y, 1.0);  // brighter than the lamp: the glow is what the image shows
+    EXPECT_NEAR(MeanY(*t->film), expected, 0.015 * expected);
+}
+
+// Glowing dust over the clutter scene (emission scaled by the dust's own grid): the points along
+// a ray where the emission is looked at are fixed by the ray, not the bricks, so 1 brick and 64
+// give the same image.
+TEST_F(VdbMediumTest, AGlowingGridRendersTheSameImageWithOneAnd64Bricks) {
+    const fs::path file = Write("glow", {-4, -4, 0}, {16, 16, 3}, [](int i, int j, int k) {
+        return (i + j + k) % 4 == 0 ? 0.f : 0.3f * float(1 + (i * j + k) % 3);
+    });
+    const std::string config = testing::ClutterScene(32, 24) + R"(
+[render]
+mode = "path"
+spp = 4
+seed = 5
+[medium]
+grid = ")" + file.string() + R"("
+sigma_s = 0.4
+sigma_a = 0.3
+emission = 0.8
+emission_grid = "density"
+)";
+    auto one = Render(testing::ClutterMesh(), {"floor", "ball", "chrome"}, config, 1, 1);
+    auto many = Render(testing::ClutterMesh(), {"floor", "ball", "chrome"}, config, 4, 2);
+    ASSERT_TRUE(one && many);
+    EXPECT_GT(many->stats.brick_moves, 0u);
+    // The glow is part of the image: without it the image is darker.
+    std::string dark_config = config;
+    dark_config.erase(dark_config.find("emission = 0.8"));
+    auto dark = Render(testing::ClutterMesh(), {"floor", "ball", "chrome"}, dark_config, 1, 1);
+    ASSERT_TRUE(dark);
+    EXPECT_GT(MeanY(*one->film), 1.05 * MeanY(*dark->film));
+    EXPECT_LT(testing::MaxRelativeDifference(*one->film, *many->film), 1e-4);
 }
 
 TEST_F(VdbMediumTest, FilesThatAreNotDensityGridsAreNamed) {

@@ -25,6 +25,11 @@ class DensityField {
     /// metres at density 1. Thread-safe.
     virtual float Walk(const Vec3f& o, const Vec3f& d, float t0, float t1, float target,
                        float* integral) const = 0;
+    /// The density at point `p`. Thread-safe.
+    virtual float Density(const Vec3f& p) const = 0;
+    /// A length over which the density may change (a voxel's side), or a fraction of the field's
+    /// size where it does not: the step of points sampled along a ray through it.
+    virtual float detail_m() const = 0;
 
     /// ∫ density ds over t in [t0, t1].
     float Integral(const Vec3f& o, const Vec3f& d, float t0, float t1) const {
@@ -44,6 +49,9 @@ class BoxDensity final : public DensityField {
   public:
     explicit BoxDensity(const Bounds3f& box) : box_(box) {}
     Bounds3f bounds() const override { return box_; }
+    float Density(const Vec3f& p) const override { return box_.Contains(p) ? 1.f : 0.f; }
+    /// Constant inside: 1/64 of the box's diagonal.
+    float detail_m() const override { return Length(box_.Diagonal()) / 64; }
     float Walk(const Vec3f& o, const Vec3f& d, float t0, float t1, float target,
                float* integral) const override {
         constexpr float kNever = std::numeric_limits<float>::infinity();
@@ -74,6 +82,10 @@ class CellShare final : public DensityField {
         const Bounds3f b = whole_->bounds();
         return Bounds3f(Max(b.min, cell_.min), Min(b.max, cell_.max));
     }
+    float Density(const Vec3f& p) const override {
+        return cell_.Contains(p) ? scale_ * whole_->Density(p) : 0.f;
+    }
+    float detail_m() const override { return whole_->detail_m(); }
     float Walk(const Vec3f& o, const Vec3f& d, float t0, float t1, float target,
                float* integral) const override {
         float a, b;

@@ -59,4 +59,9 @@ float VdbDensity::Walk(const Vec3f& o, const Vec3f& d, float t0, float t1, float
     return reached;
 }
 
+float VdbDensity::Density(const Vec3f& p) const {
+    if (empty_ || !bounds_.Contains(p)) return 0;
+    return scale_ * grid_->Value(p);
+}
+
 }  // namespace nave::render

@@ -33,6 +33,8 @@ class VdbDensity final : public DensityField {
     Bounds3f bounds() const override { return bounds_; }
     float Walk(const Vec3f& o, const Vec3f& d, float t0, float t1, float target,
                float* integral) const override;
+    float Density(const Vec3f& p) const override;
+    float detail_m() const override { return grid_->voxel_size(); }
     /// Bytes the grid takes in memory.
     uint64_t memory_bytes() const { return grid_->memory_bytes(); }
 

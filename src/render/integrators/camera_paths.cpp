@@ -129,10 +129,22 @@ bool CameraPaths::FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const Resi
     const DensityField* field = medium->DensityIn(brick);
     if (field == nullptr || !(t1 > t0)) return true;
     const float depth = PathFlightDepth(r);
+    const float depth0 = r.flight_depth;
     const float t = Fly(field, depth, t0, t1, &r);
+    if (medium->emission() != nullptr)
+        AddMediumEmission(r, *medium, *field, depth0, t0, std::min(t, t1));
     if (!(t < kInfinity)) return true;
     ScatterInMedium(r, t, depth, b, brick, out);
     return false;
+}
+
+void CameraPaths::AddMediumEmission(const RayRecord& r, const Medium& medium,
+                                    const DensityField& field, float depth0, float t0, float t1) {
+    // Keyed as the flight is: every brick the ray crosses looks at the same fraction of its voxels.
+    const VertexRng rng(RayKey(scene_.settings.seed, r, iteration(), kStreamPath));
+    const SampledSpectrum L =
+        EmissionAlong(medium, field, r, depth0, t0, t1, rng.Uniform(kDimEmissionPoint));
+    if (!L.IsZero()) film_->AddSample(r.pixel, r.beta * L, r.lambda, Half(r));
 }
 
 void CameraPaths::LeaveModel(RayRecord r) {

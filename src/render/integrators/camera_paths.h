@@ -99,6 +99,10 @@ class CameraPaths : public RayProcessor {
     /// went on from there (ScatterInMedium). True at once without a medium.
     bool FlyTo(RayRecord& r, float t0, float t1, uint32_t b, const ResidentBrick* brick,
                RayOutbox& out);
+    /// Adds to path `r`'s pixel the light `medium` emits over [t0, t1] of its ray through `field`,
+    /// its flight having entered t0 at `depth0` of the density's integral (EmissionAlong).
+    void AddMediumEmission(const RayRecord& r, const Medium& medium, const DensityField& field,
+                           float depth0, float t0, float t1);
     /// Path `r` scatters in the medium at t = `t` of its ray, where its flight reached `depth` (its
     /// PathFlightDepth): next-event estimation of the lights and the sky through the phase
     /// function, then the path goes on in a direction sampled from it. `b` and `brick` as for

@@ -235,6 +235,47 @@ Status AttachTextures(const SceneConfig& config, const std::filesystem::path& ba
 
 namespace {
 
+/// What the medium of `config` emits (null: nothing). Errors: a negative emission, photon mode
+/// (photons are not emitted from media), a grid the plugin cannot read (naming the table and key).
+StatusOr<std::shared_ptr<const MediumEmission>> MakeMediumEmission(const MediumConfig& config,
+                                                                   const RenderScene& scene) {
+    if (!config.emits()) return std::shared_ptr<const MediumEmission>();
+    if (scene.settings.mode == RenderSettings::Mode::kPhoton)
+        return InvalidArgumentError(
+            "{}: [{}] emits light ({}): photon mode emits no photons from media, so the light "
+            "would be missing: render it with render.mode = \"path\"",
+            config.where, config.name, config.emission ? "emission" : "temperature_grid");
+    const auto read_grid =
+        [&](const char* key,
+            const std::string& name) -> StatusOr<std::shared_ptr<const volumes::ScalarGrid>> {
+        NAVE_ASSIGN_OR_RETURN(const volumes::VdbPlugin* plugin, volumes::LoadVdbPlugin());
+        StatusOr<std::unique_ptr<volumes::ScalarGrid>> grid =
+            plugin->ReadScalarGrid(config.grid, name);
+        if (!grid.ok())
+            return Status(grid.status().code(),
+                          fmt::format("{}: [{}] {}: {}", config.where, config.name, key,
+                                      grid.status().message()));
+        return std::shared_ptr<const volumes::ScalarGrid>(std::move(*grid));
+    };
+    if (!config.temperature_grid.empty()) {
+        NAVE_ASSIGN_OR_RETURN(std::shared_ptr<const volumes::ScalarGrid> kelvin,
+                              read_grid("temperature_grid", config.temperature_grid));
+        return std::make_shared<const MediumEmission>(MediumEmission::Blackbody(
+            std::move(kelvin), config.temperature_scale, config.emission_scale));
+    }
+    const Spectrum le = ToSpectrum(*config.emission) * config.emission_scale;
+    for (float nm = kLambdaMinNm; nm <= kLambdaMaxNm; nm += 1)
+        if (!(le.Evaluate(nm) >= 0))
+            return InvalidArgumentError(
+                "{}: {}.emission is {} at {} nm: a radiance cannot be negative", config.where,
+                config.name, le.Evaluate(nm), nm);
+    if (config.emission_grid.empty())
+        return std::make_shared<const MediumEmission>(MediumEmission::Uniform(le));
+    NAVE_ASSIGN_OR_RETURN(std::shared_ptr<const volumes::ScalarGrid> scale,
+                          read_grid("emission_grid", config.emission_grid));
+    return std::make_shared<const MediumEmission>(MediumEmission::Scaled(le, std::move(scale)));
+}
+
 /// The medium of [medium] or of a material's medium table (the model's bounds when it gives no
 /// box: a solid's inside lies within them). Errors: negative coefficients, a medium beyond the
 /// model's box in photon mode, an empty model without a box.
@@ -296,8 +337,10 @@ StatusOr<std::shared_ptr<const Medium>> MakeMedium(const MediumConfig& config,
                     "inside it (give box_min/box_max inside it, or render.mode = \"path\")",
                     config.where, fmt::streamed(b), fmt::streamed(model));
     }
+    NAVE_ASSIGN_OR_RETURN(std::shared_ptr<const MediumEmission> emission,
+                          MakeMediumEmission(config, scene));
     return std::shared_ptr<const Medium>(
-        std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g));
+        std::make_shared<const Medium>(density, sigma_a, sigma_s, config.g, std::move(emission)));
 }
 
 /// Gives `m`, made from config table `mc` (named `name`), its inside: a solid dielectric's is

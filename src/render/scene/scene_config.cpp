@@ -444,6 +444,42 @@ Status ParseLight(TableReader& r, LightConfig* l) {
     return r.Finish();
 }
 
+/// The emission keys of a medium table (MediumConfig::emission).
+Status ParseMediumEmission(TableReader& r, MediumConfig* m) {
+    if (r.Has("emission")) {
+        SpectrumSpec emission;
+        NAVE_RETURN_IF_ERROR(r.Spectrum("emission", &emission));
+        m->emission = emission;
+    }
+    const bool file_grid = !m->grid.empty();
+    for (const auto& [key, out] : {std::pair{"emission_grid", &m->emission_grid},
+                                   {"temperature_grid", &m->temperature_grid}}) {
+        if (!r.Has(key)) continue;
+        if (!file_grid)
+            return InvalidArgumentError(
+                "{}: {}.{} names a grid of the medium's .vdb file: give that file as 'grid'{}",
+                m->where, m->name, key,
+                m->stored_grid ? " (a store holds the density grid only)" : "");
+        NAVE_RETURN_IF_ERROR(r.String(key, out));
+    }
+    if (!m->temperature_grid.empty() && m->emission)
+        return InvalidArgumentError(
+            "{}: {}: give emission (a radiance) or temperature_grid (a black body's), not both",
+            m->where, m->name);
+    if (!m->emission_grid.empty() && !m->emission)
+        return InvalidArgumentError(
+            "{}: {}.emission_grid scales a radiance: give it as 'emission' (W m^-2 sr^-1 nm^-1)",
+            m->where, m->name);
+    if (r.Has("temperature_scale") && m->temperature_grid.empty())
+        return InvalidArgumentError("{}: {}.temperature_scale needs a temperature_grid", m->where,
+                                    m->name);
+    if (r.Has("emission_scale") && !m->emits())
+        return InvalidArgumentError("{}: {}.emission_scale needs an emission or a temperature_grid",
+                                    m->where, m->name);
+    NAVE_RETURN_IF_ERROR(r.Float("temperature_scale", &m->temperature_scale, 0, 1e9));
+    return r.Float("emission_scale", &m->emission_scale, 0, 1e9);
+}
+
 /// [medium], or with `inside_solid` a material's medium table (named `name`), which fills the
 /// solid's inside and takes no box or grid.
 Status ParseMedium(TableReader& r, MediumConfig* m, const std::string& name = "medium",
@@ -451,11 +487,13 @@ Status ParseMedium(TableReader& r, MediumConfig* m, const std::string& name = "m
     m->where = r.WhereTable();
     m->name = name;
     if (inside_solid) {
-        for (const char* key : {"box_min", "box_max", "grid", "grid_name", "density_scale"})
+        for (const char* key : {"box_min", "box_max", "grid", "grid_name", "density_scale",
+                                "emission_grid", "temperature_grid", "temperature_scale"})
             if (r.Has(key))
                 return InvalidArgumentError(
                     "{}: {}.{}: a solid's medium fills its inside, the whole of it: it takes "
-                    "sigma_a and sigma_s (or extinction and albedo) and g only",
+                    "sigma_a and sigma_s (or extinction and albedo), g, emission and "
+                    "emission_scale only",
                     m->where, name, key);
     }
     if (r.Has("box_min") != r.Has("box_max"))
@@ -519,6 +557,7 @@ Status ParseMedium(TableReader& r, MediumConfig* m, const std::string& name = "m
     if (r.Has("sigma_a")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_a", &m->sigma_a));
     if (r.Has("sigma_s")) NAVE_RETURN_IF_ERROR(r.Spectrum("sigma_s", &m->sigma_s));
     NAVE_RETURN_IF_ERROR(r.Float("g", &m->g, -0.99, 0.99));
+    NAVE_RETURN_IF_ERROR(ParseMediumEmission(r, m));
     return r.Finish();
 }
 

@@ -111,7 +111,15 @@ struct MediumConfig {
     /// Instead of sigma_a and sigma_s: the extinction coefficient σt (m^-1) and the single-
     /// scattering albedo σs / σt.
     std::optional<std::pair<SpectrumSpec, SpectrumSpec>> extinction_albedo;
-    float g = 0.f;                ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
+    float g = 0.f;  ///< Henyey-Greenstein asymmetry, (-1, 1): > 0 scatters forward
+    /// What it emits (scene/media/medium_emission.h): a radiance (W m^-2 sr^-1 nm^-1) where its
+    /// density is, times the grid `emission_grid` of the `grid` file if named; or Planck's
+    /// radiance at the temperature the grid `temperature_grid` holds (kelvin, times
+    /// `temperature_scale`); either times `emission_scale`.
+    std::optional<SpectrumSpec> emission;
+    std::string emission_grid, temperature_grid;
+    float temperature_scale = 1.f, emission_scale = 1.f;
+    bool emits() const { return emission || !temperature_grid.empty(); }
     std::string where;            ///< file:line of the table, for messages
     std::string name = "medium";  ///< the table's name, for messages ("materials.water.medium")
 };

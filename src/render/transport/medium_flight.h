@@ -90,6 +90,57 @@ inline SampledSpectrum ScatterWeight(const Medium& medium, const SampledWaveleng
     return density > 0 ? sigma_s * transmittance / density : SampledSpectrum(0.f);
 }
 
+/// The radiance path ray `r` gathers from what `medium` emits (medium_emission.h) over [t0, t1) of
+/// its ray in `field`, a flight that entered t0 at `depth0` of the density's integral (its
+/// flight_depth there) and did not scatter before t1: a weight for r.beta. The emission term of the
+/// radiative transfer equation, ∫ T(s) σa ρ(s) Le(s) ds along the ray, is estimated with the
+/// flight's own sampling: the flight reaches s with probability P(s) = mean_j exp(-σs_j D(s)), so
+/// counting T(s) / P(s) σa ρ Le = NoScatterWeight(D(s)) σa ρ Le at points the flight crosses is
+/// unbiased whatever it does further on, and needs no walk beyond where it scattered. The points
+/// are a lattice along the ray, s = (k + u) Δ, shifted by the uniform number `u`: a stratified
+/// estimate of the integral, unbiased (Δ Σ_k f((k + u) Δ) has mean ∫ f), and fixed by the ray
+/// alone, so that however bricks cut the ray each point is counted once, by the brick whose span
+/// holds it: 1 brick or many give the same sum. Δ is the emission grid's voxel (points only in its
+/// emitting voxels), or else the density's detail (DensityField::detail_m).
+inline SampledSpectrum EmissionAlong(const Medium& medium, const DensityField& field,
+                                     const RayRecord& r, float depth0, float t0, float t1,
+                                     float u) {
+    SampledSpectrum sum(0.f);
+    const MediumEmission* emission = medium.emission();
+    if (emission == nullptr || !(t1 > t0)) return sum;
+    const SampledSpectrum sigma_a = medium.SigmaA(r.lambda);
+    if (sigma_a.IsZero()) return sum;
+    // Only where there is density: a stretch may run to infinity past the model.
+    if (!ClipRayToBounds(field.bounds(), r.origin, r.dir, t0, t1, &t0, &t1)) return sum;
+    const volumes::ScalarGrid* grid = emission->grid();
+    const double step = grid != nullptr ? grid->voxel_size() : field.detail_m();
+    if (!(step > 0)) return sum;
+    float s_before = t0, depth = depth0;
+    const auto add_points = [&](float a, float b) {
+        for (double k = std::ceil(double(a) / step - double(u));; k += 1) {
+            const float s = float((k + double(u)) * step);
+            if (!(s < b)) break;
+            if (s < a) continue;  // rounding
+            depth += field.Integral(r.origin, r.dir, s_before, s);
+            s_before = s;
+            const Vec3f p = r.origin + r.dir * s;
+            const float density = field.Density(p);
+            if (!(density > 0)) continue;
+            sum += NoScatterWeight(medium, r.lambda, depth) * sigma_a *
+                   emission->Radiance(p, r.lambda) * (density * float(step));
+        }
+    };
+    if (grid != nullptr) {
+        grid->March(r.origin, r.dir, t0, t1, [&](float a, float b, float value) {
+            if (value > 0) add_points(a, b);
+            return true;
+        });
+    } else {
+        add_points(t0, t1);
+    }
+    return sum;
+}
+
 /// Path or photon `r` reaching a surface without scattering in `medium` (null: none): its weight
 /// for the flight (NoScatterWeight), and what goes on from the surface is a new flight.
 inline void EndFlightAtSurface(const Medium* medium, RayRecord* r) {

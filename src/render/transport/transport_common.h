@@ -37,6 +37,8 @@ enum RngDim : uint32_t {
     // The path stream, as a ray starts: where it scatters in a medium (FlightDepth).
     kDimFlightChoice = 5,
     kDimFlightDistance,
+    // Where along its flight a path ray looks at what the medium emits (EmissionAlong).
+    kDimEmissionPoint,
     // Every scattering vertex: BSDF lobe and direction, Russian roulette.
     kDimBsdfChoice = 8,
     kDimBsdf0,

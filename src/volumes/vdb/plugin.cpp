@@ -55,6 +55,19 @@ class VdbScalarGrid final : public ScalarGrid {
     }
     uint64_t active_voxels() const override { return uint64_t(grid_->activeVoxelCount()); }
 
+    float voxel_size() const override { return float(voxel_m_); }
+
+    float Value(const Vec3f& p) const override {
+        // Outside the bounds every value is the background (0), and index coordinates there may
+        // overflow a voxel coordinate.
+        if (!spans_ || !bounds_.Contains(p)) return 0;
+        // Voxel ijk's cell is [ijk - 1/2, ijk + 1/2] in index space.
+        const openvdb::Vec3d x = grid_->worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+        const openvdb::Coord ijk(int32_t(std::floor(x.x() + 0.5)), int32_t(std::floor(x.y() + 0.5)),
+                                 int32_t(std::floor(x.z() + 0.5)));
+        return grid_->tree().getValue(ijk);
+    }
+
     void March(const Vec3f& o, const Vec3f& d, float t_begin, float t_end,
                const std::function<bool(float, float, float)>& visit) const override {
         if (!(t_end > t_begin) || !spans_) return;

@@ -12,6 +12,7 @@
 #include "src/render/bricks/density_field.h"
 #include "src/render/bricks/resident_brick.h"
 #include "src/render/scene/media/henyey_greenstein.h"
+#include "src/render/scene/media/medium_emission.h"
 
 namespace nave::render {
 
@@ -20,9 +21,15 @@ class Medium {
     /// The medium of `density` with absorption `sigma_a` and scattering `sigma_s` at density 1
     /// (m^-1, non-negative) and phase function asymmetry `g` in (-1, 1). A null `density` is the
     /// grid stored in the bricks: each brick's piece comes with the brick (ResidentBrick::medium).
+    /// `emission` (null: none) is what it emits where its density is (medium_emission.h).
     Medium(std::shared_ptr<const DensityField> density, const Spectrum& sigma_a,
-           const Spectrum& sigma_s, float g)
-        : density_(std::move(density)), sigma_a_(sigma_a), sigma_s_(sigma_s), phase_(g) {}
+           const Spectrum& sigma_s, float g,
+           std::shared_ptr<const MediumEmission> emission = nullptr)
+        : density_(std::move(density)),
+          sigma_a_(sigma_a),
+          sigma_s_(sigma_s),
+          phase_(g),
+          emission_(std::move(emission)) {}
 
     /// The density a ray meets while it is processed in `brick` (null: outside every brick, before
     /// it enters the first): the medium's own field, which holds everywhere, or the brick's piece
@@ -34,7 +41,12 @@ class Medium {
     }
     bool in_bricks() const { return density_ == nullptr; }
     const HenyeyGreenstein& phase() const { return phase_; }
-    /// σs and σt at density 1.
+    /// What it emits; null: nothing.
+    const MediumEmission* emission() const { return emission_.get(); }
+    /// σa, σs and σt at density 1.
+    SampledSpectrum SigmaA(const SampledWavelengths& lambda) const {
+        return sigma_a_.Sample(lambda);
+    }
     SampledSpectrum SigmaS(const SampledWavelengths& lambda) const {
         return sigma_s_.Sample(lambda);
     }
@@ -49,6 +61,7 @@ class Medium {
     std::shared_ptr<const DensityField> density_;
     Spectrum sigma_a_, sigma_s_;
     HenyeyGreenstein phase_;
+    std::shared_ptr<const MediumEmission> emission_;
 };
 
 }  // namespace nave::render
