@@ -56,13 +56,14 @@ class LayoutReader final : public openvdb::io::Archive {
             return Error("{} lists {} entries at byte {}, more than the {} bytes left can hold", of,
                          count, Position() - 4, Left());
         for (uint32_t i = 0; i < count; ++i) {
-            NAVE_RETURN_IF_ERROR(SkipString(of + " entry " + std::to_string(i) + "'s name"));
+            const std::string entry = fmt::format("{} entry {}", of, i);
+            NAVE_RETURN_IF_ERROR(SkipString(entry + "'s name"));
             const uint32_t type_length = ReadU32();
-            NAVE_RETURN_IF_ERROR(CheckLength(type_length, of + " entry " + std::to_string(i)));
+            NAVE_RETURN_IF_ERROR(CheckLength(type_length, entry));
             std::string type(type_length, '\0');
             if (type_length > 0) in_.read(type.data(), type_length);
             const uint32_t value_bytes = ReadU32();
-            const std::string value = of + " entry " + std::to_string(i) + " (" + type + ")";
+            const std::string value = fmt::format("{} ({})", entry, type);
             NAVE_RETURN_IF_ERROR(CheckLength(value_bytes, value));
             if (openvdb::Metadata::isRegisteredType(type)) {
                 const uint32_t fixed = openvdb::Metadata::createMetadata(type)->size();
