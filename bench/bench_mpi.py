@@ -41,6 +41,8 @@ def main():
     nb.add_abbey_run_arguments(ap, "/tmp/nave-bench-mpi")
     ap.add_argument("--memory", default="", help="each rank's --memory (default: in-core)")
     ap.add_argument("--runs", default="1x2,2x1,4x1", help="RANKSxTHREADS, comma separated; 1x... is one process")
+    ap.add_argument("--pack-rays", default="on", choices=["on", "off"],
+                    help="nave render --pack-rays: LZ4 on the rays sent between ranks (default on)")
     args = ap.parse_args()
     os.makedirs(args.dir, exist_ok=True)
     os.environ.update(MPI_ENV)
@@ -56,7 +58,7 @@ def main():
         if args.memory:
             cmd += ["--memory", args.memory]
         if ranks > 1:
-            cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd
+            cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd + ["--pack-rays", args.pack_rays]
         t = nb.run_timed(cmd, log)
         stats = nb.read_statistics(out) if t.ok else {}
         same = ""
@@ -71,6 +73,8 @@ def main():
             "wall_s": t.elapsed_s, "peak_rss_gib": round(t.peak_rss_bytes / 2**30, 2) if t.peak_rss_bytes else "",
             "rays": stats.get("rays", ""), "rays_between_ranks": stats.get("rays_between_ranks", 0),
             "messages": stats.get("messages_between_ranks", 0), "bytes": stats.get("bytes_between_ranks", 0),
+            "bytes_per_ray": round(stats.get("bytes_between_ranks", 0) / stats["rays_between_ranks"], 1)
+            if stats.get("rays_between_ranks") else "",
             "idle_s": stats.get("ranks_idle", ""), "loads_rank0": stats.get("brick_loads", ""),
             "same_rgb": same,
         }

@@ -5,6 +5,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <limits>
+#include <random>
+
 #include "src/core/progress.h"
 #include "src/render/bricks/brick_source.h"
 #include "src/render/bricks/grid_bricks.h"
@@ -14,6 +17,7 @@
 #include "src/render/integrators/render_streams.h"
 #include "src/render/scene/scene.h"
 #include "src/render/scene/scene_config.h"
+#include "src/render/stream/ray_message.h"
 
 namespace nave::render {
 namespace {
@@ -174,6 +178,46 @@ void BM_Photons(benchmark::State& state) {
     state.counters["photons/s"] = benchmark::Counter(double(photons), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Photons)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+/// Packing a message of rays for the wire (PackRayMessage) and unpacking it: raw bytes/s each way
+/// and the packed size. The rays are a brick's batch at its worst for LZ4: origins anywhere in a
+/// 10 m box, directions, wavelengths and throughputs at random, pixels anywhere in a 960x640 image
+/// (real batches, whose rays share origins and pixels, pack smaller: docs/distributed.md).
+void BM_PackRayMessage(benchmark::State& state) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    std::vector<RayRecord> rays(8000);
+    for (RayRecord& r : rays) {
+        r.origin = Vec3f(10 * u(rng), 10 * u(rng), 10 * u(rng));
+        r.dir = Normalize(Vec3f(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f));
+        r.t_max = std::numeric_limits<float>::infinity();
+        r.t_enter = u(rng);
+        r.t_exit = r.t_enter + 3 * u(rng);
+        r.pixel = uint32_t(u(rng) * 960 * 640);
+        r.sample = uint32_t(u(rng) * 4);
+        r.depth = uint8_t(1 + u(rng) * 4);
+        r.vertex = r.depth;
+        r.prev_pdf = u(rng);
+        r.cone_width = 0.01f * u(rng);
+        r.cone_spread = 0.002f;
+        r.lambda = SampledWavelengths::SampleVisible(u(rng));
+        for (int i = 0; i < kNumWavelengths; ++i) r.beta[i] = u(rng);
+    }
+    RayMessage message;
+    message.Append(3, rays);
+    const std::vector<std::byte> raw = message.Take();
+    size_t packed_bytes = 0;
+    std::vector<std::byte> unpacked;
+    for (auto _ : state) {
+        const std::vector<std::byte> packed = PackRayMessage(raw);
+        packed_bytes = packed.size();
+        if (!UnpackRayMessage(packed, raw.size(), "bench", &unpacked).ok())
+            state.SkipWithError("unpack failed");
+    }
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(raw.size()));
+    state.counters["bytes/ray packed"] = double(packed_bytes) / double(rays.size());
+}
+BENCHMARK(BM_PackRayMessage)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace nave::render

@@ -6,8 +6,8 @@ The trace (`nave render --trace`, one process, one thread) gives, brick by brick
 time its loads took and the rays each batch sent to every other brick, and the bricks' depth-first order. For R
 ranks the bricks are cut into R runs of that order by measured work, as a distributed render re-balances them
 (StreamScheduler::Rebalance). A rank's time is its work over its threads' speed-up, or the time its network
-takes to send and receive the rays crossing to and from other ranks (128 bytes each, messages of up to 1 MiB,
-sent while it traces), whichever is longer, plus the rounds that find the end of each pass (a latency per
+takes to send and receive the rays crossing to and from other ranks (the bytes per ray the --measured runs
+sent, packed by LZ4; 128 unpacked; or --ray-bytes; messages of up to 1 MiB of unpacked rays, sent while it traces), whichever is longer, plus the rounds that find the end of each pass (a latency per
 round, log2 R deep). The job takes its slowest rank's time.
 
 Threads: the speed-up of T threads on one node follows the universal scalability law (Gunther 1993, "A simple
@@ -52,8 +52,21 @@ PAPER_TABLE = {
 PAPER_SEQUENTIAL_S = 90 * 60
 # "more than one billion light-rays are used for the simulation" (the paper, section 4).
 PAPER_RAYS = 1e9
-RAY_BYTES = 128  # a ray record on the wire (ray_message.h)
+RAY_BYTES = 128  # a ray record unpacked (ray_message.h); packed, what --measured runs sent (--pack-rays)
 MESSAGE_BYTES = 1 << 20  # a message goes out once it holds this much (mpi_ray_exchange.h)
+
+
+def read_trace_triangles(path):
+    """-> triangles per brick (from the trace's loads): what a render's first ownership divides (BrickOwners
+    cuts by estimated memory, which the triangles dominate)."""
+    with open(path) as f:
+        events = json.load(f)["traceEvents"]
+    bricks = next(int(e["args"]["bricks"]) for e in events if e.get("name") == "bricks" and e.get("ph") == "i")
+    triangles = [0] * bricks
+    for e in events:
+        if e.get("ph") == "X" and e.get("name") == "load" and "triangles" in e.get("args", {}):
+            triangles[int(e["args"]["brick"]) % bricks] = int(e["args"]["triangles"])
+    return triangles
 
 
 def read_trace(path):
@@ -111,19 +124,26 @@ class Model:
     LOADERS = 2  # the pager's loader threads (pager.h)
 
     def __init__(self, batch_us, load_us, sent, order, sigma, kappa, scale, ray_scale, bandwidth, latency,
-                 passes):
-        """`scale`: what the batches' time is multiplied by; `ray_scale`: the rays sent."""
+                 passes, ray_bytes=RAY_BYTES):
+        """`scale`: what the batches' time is multiplied by; `ray_scale`: the rays sent; `ray_bytes`: a ray's
+        bytes on the wire."""
         self.batch_s = [w * 1e-6 for w in batch_us]
         self.load_s = [w * 1e-6 for w in load_us]
         self.sent, self.order = sent, order
         self.sigma, self.kappa, self.scale, self.ray_scale = sigma, kappa, scale, ray_scale
         self.bandwidth, self.latency, self.passes = bandwidth, latency, passes
+        self.ray_bytes = ray_bytes
 
-    def predict(self, ranks, threads_per_rank, cpu_share=1.0):
+    def predict(self, ranks, threads_per_rank, cpu_share=1.0, triangles=None):
         """-> (seconds, rays between ranks) for `ranks` ranks of `threads_per_rank` threads; `cpu_share`: the
-        share of a core each thread gets (below 1 where the ranks' threads exceed the cores)."""
-        owner = owners_by_work(self.order, [b * self.scale + l for b, l in zip(self.batch_s, self.load_s)],
-                               ranks)
+        share of a core each thread gets (below 1 where the ranks' threads exceed the cores). `triangles` per
+        brick: the bricks keep the first ownership, cut by memory, as a render too short to re-balance does
+        (re-balancing starts at pass 4: StreamScheduler::Rebalance); else they are cut by measured work."""
+        if triangles is not None:
+            owner = owners_by_work(self.order, [float(t) for t in triangles], ranks)
+        else:
+            owner = owners_by_work(self.order, [b * self.scale + l for b, l in zip(self.batch_s, self.load_s)],
+                                   ranks)
         batch, load = [0.0] * ranks, [0.0] * ranks
         for b in range(len(self.batch_s)):
             batch[owner[b]] += self.batch_s[b] * self.scale
@@ -133,15 +153,16 @@ class Model:
         for (a, b), n in self.sent.items():
             if owner[a] != owner[b]:
                 crossing += n
-                out[owner[a]] += n * RAY_BYTES * self.ray_scale
-                into[owner[b]] += n * RAY_BYTES * self.ray_scale
+                out[owner[a]] += n * self.ray_bytes * self.ray_scale
+                into[owner[b]] += n * self.ray_bytes * self.ray_scale
         speed = usl(threads_per_rank, self.sigma, self.kappa) * cpu_share
         worst = 0.0
         for r in range(ranks):
             # The loaders load ahead while the workers trace (pager.h): the longer of the two.
             compute = max(batch[r] / speed, load[r] / (self.LOADERS * cpu_share))
             moved = max(out[r], into[r])
-            network = moved / self.bandwidth + math.ceil(moved / MESSAGE_BYTES) * self.latency
+            messages = math.ceil(moved * RAY_BYTES / self.ray_bytes / MESSAGE_BYTES)
+            network = moved / self.bandwidth + messages * self.latency
             worst = max(worst, compute, network)
         rounds = self.passes * 2 * max(1, math.ceil(math.log2(ranks))) if ranks > 1 else 0
         return worst + rounds * self.latency, crossing * self.ray_scale
@@ -180,6 +201,8 @@ def main():
     ap.add_argument("--local-bandwidth", type=float, default=2e9, help="this machine's shared memory, bytes/s")
     ap.add_argument("--local-latency", type=float, default=5e-6)
     ap.add_argument("--measured", default="", help="bench_mpi.py's CSV of real runs to check against")
+    ap.add_argument("--ray-bytes", type=float, default=0,
+                    help="a ray's bytes on the wire (default: what the --measured runs sent per ray, else 128)")
     ap.add_argument("--reuse", action="store_true", help="the trace and times of the last run in --dir")
     args = ap.parse_args()
     os.makedirs(args.dir, exist_ok=True)
@@ -216,6 +239,17 @@ def main():
           f"{runs[1]['wall_s']:.1f} s; {sum(sent.values())} rays sent between bricks; batches at 2 threads "
           f"{speedup:.2f}x faster: sigma {sigma:.3f}", file=sys.stderr)
 
+    measured = []
+    if args.measured:
+        with open(args.measured) as f:
+            measured = [r for r in csv.DictReader(f) if r.get("status") == "ok"]
+    ray_bytes = args.ray_bytes
+    if not ray_bytes:
+        moved = [(float(r["bytes"]), float(r["rays_between_ranks"])) for r in measured
+                 if int(r["ranks"]) > 1 and float(r.get("rays_between_ranks") or 0) > 0]
+        ray_bytes = sum(b for b, _ in moved) / sum(n for _, n in moved) if moved else RAY_BYTES
+    print(f"{ray_bytes:.1f} bytes a ray on the wire", file=sys.stderr)
+
     paper_sigma, kappa, scale = fit_one_domain(batch_s)
     rays = float(nb.read_statistics(os.path.join(args.dir, "replay_t1.exr")).get("rays", 0)) or 1.0
     ray_scale = PAPER_RAYS / rays
@@ -225,7 +259,7 @@ def main():
     for name, bandwidth, latency in (("Gigabit Ethernet, the paper's network", args.bandwidth, args.latency),
                                      ("10 Gigabit Ethernet", 10 * args.bandwidth, args.latency / 2)):
         paper = Model(batch_us, load_us, sent, order, paper_sigma, kappa, scale, ray_scale, bandwidth, latency,
-                      args.spp)
+                      args.spp, ray_bytes)
         rows, errors = [], []
         for domains, times in PAPER_TABLE.items():
             row = [f"{domains} {'domain' if domains == 1 else 'sub-domains'}"]
@@ -244,19 +278,19 @@ def main():
 
     if args.measured:
         local = Model(batch_us, load_us, sent, order, sigma, 0.0, 1.0, 1.0, args.local_bandwidth,
-                      args.local_latency, args.spp)
+                      args.local_latency, args.spp, ray_bytes)
         cores = os.cpu_count() or 1
-        with open(args.measured) as f:
-            measured = [r for r in csv.DictReader(f) if r.get("status") == "ok"]
         # Start, bookkeeping, the image: what one process of one thread takes beyond the model, from the
         # measured run of 1 x 1 where there is one (a traced run is slower), else the traced run.
         one = [float(r["wall_s"]) for r in measured if r["ranks"] == "1" and r["threads"] == "1"]
         fixed = max(0.0, (one[0] if one else runs[1]["wall_s"]) - local.predict(1, 1)[0])
+        # Renders of fewer than 5 passes never re-balance: they keep the ownership by memory.
+        triangles = read_trace_triangles(runs[1]["trace"]) if args.spp <= 4 else None
         check = []
         for r in measured:
             ranks, threads = int(r["ranks"]), int(r["threads"])
             share = min(1.0, cores / (ranks * threads))
-            seconds, crossing = local.predict(ranks, threads, share)
+            seconds, crossing = local.predict(ranks, threads, share, triangles)
             seconds += fixed
             wall = float(r["wall_s"])
             check.append([f"{ranks} x {threads}", f"{wall:.1f}", f"{seconds:.1f}",

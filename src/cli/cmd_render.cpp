@@ -49,6 +49,7 @@ struct RenderOptions {
     std::string trace;       // --trace FILE.json
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     std::string rank_timeout = "10m";  // --rank-timeout: under mpirun, the longest wait for rays
+    std::string pack_rays = "on";      // --pack-rays: under mpirun, LZ4 on the rays sent
     bool no_textures = false;
     std::string lod;
     bool no_lod = false;         // --no-lod: --lod full
@@ -280,7 +281,8 @@ Status RunRender(const RenderOptions& o) {
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, BuildConfig(o));
     NAVE_ASSIGN_OR_RETURN(const double rank_timeout_s,
                           ParseDuration(o.rank_timeout, "--rank-timeout"));
-    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks, JoinRanks(rank_timeout_s));
+    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks,
+                          JoinRanks(rank_timeout_s, o.pack_rays == "on"));
     std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
@@ -400,6 +402,12 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                     "Under mpirun: how long a rank with no ray to trace waits for rays or for the "
                     "others to finish their batches before it ends the job as hung, as 90s, 10m "
                     "or 1h (0: for ever; docs/distributed.md). Default 10m");
+    cmd->add_option("--pack-rays", opts->pack_rays,
+                    "Under mpirun: pack the rays sent between ranks (each message's records "
+                    "transposed byte by byte, then LZ4: a few times fewer bytes for a little CPU "
+                    "time), on or off (off for an interconnect faster than LZ4, ~1 GB/s a core; "
+                    "docs/distributed.md). Default on")
+        ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option(
         "--temp-dir", opts->temp_dir,
         "Where spill files go under --memory (the brick cache; docs/pager.md). They have no name "

@@ -43,7 +43,7 @@ int LaunchedRanks() {
     return 1;
 }
 
-StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s) {
+StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s, bool pack_rays) {
     if (LaunchedRanks() <= 1) return static_cast<render::RankGroup*>(nullptr);
 #ifdef NAVE_HAVE_MPI
     Distributed& state = State();
@@ -54,6 +54,7 @@ StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s) {
         state.host = state.runtime->host();
         render::MpiExchangeOptions exchange;
         exchange.stall_timeout_s = rank_timeout_s;
+        exchange.pack_messages = pack_rays;
         NAVE_ASSIGN_OR_RETURN(state.group, render::MpiRankGroup::Create(exchange));
         // One terminal for the job: rank 0 reports progress and the summary, the others only
         // their errors (which name the rank).
@@ -65,6 +66,7 @@ StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s) {
     return static_cast<render::RankGroup*>(state.group.get());
 #else
     (void)rank_timeout_s;
+    (void)pack_rays;
     return UnsupportedError(
         "started by mpirun as one of {} ranks, but this nave was built without MPI: install "
         "libopenmpi-dev and openmpi-bin (scripts/setup-debian.sh does) and build again, or run "

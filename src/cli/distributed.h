@@ -16,8 +16,9 @@ int LaunchedRanks();
 
 /// The ranks of this job, MPI initialized on the first call (and finalized at exit); null when
 /// this process is the only one. Errors: a job of several ranks and a nave built without MPI
-/// (names what to install), MPI that cannot start.
-StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s = 600);
+/// (names what to install), MPI that cannot start. `pack_rays`: messages of rays packed for the
+/// wire (MpiExchangeOptions::pack_messages).
+StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s = 600, bool pack_rays = true);
 
 /// Where a failed rank is named: "rank 2 of 4 on node7" ("" outside a distributed render).
 std::string RankName();

@@ -27,6 +27,10 @@ std::vector<RayRecord> Rays(uint32_t first, uint32_t count) {
         rays[i].pixel = first + i;
         rays[i].depth = uint16_t(i % 7);
         rays[i].origin = Vec3f(float(i), -float(i), 0.5f);
+        // Wavelengths as camera paths draw them, some with their secondaries terminated (pdfs
+        // that are not SampleVisible's: PackRayMessage must keep them too).
+        rays[i].lambda = SampledWavelengths::SampleVisible(float(i % 13) / 13.f);
+        if (i % 5 == 0) rays[i].lambda.TerminateSecondary();
     }
     return rays;
 }
@@ -107,6 +111,49 @@ TEST(RayMessage, DamagedMessagesAreRefusedWholeNamingTheSender) {
     int visited = 0;
     (void)ForEachRayGroup(cut, 6, "x", [&](uint32_t, std::span<const RayRecord>) { ++visited; });
     EXPECT_EQ(visited, 0);
+}
+
+// Packed for the wire (records transposed byte by byte, then LZ4), a message unpacks to the same
+// bytes, and rays alike in most of their bytes, as a batch of one brick's rays is, take a few
+// times fewer bytes.
+TEST(RayMessage, PackedMessagesUnpackToTheSameBytesAndAreSmaller) {
+    RayMessage message;
+    message.Append(3, Rays(1000, 700));
+    message.Append(1, Rays(5000, 1));
+    message.Append(7, Rays(9000, 300));
+    const std::vector<std::byte> raw = message.Take();
+    const std::vector<std::byte> packed = PackRayMessage(raw);
+    EXPECT_TRUE(IsPackedRayMessage(packed));
+    EXPECT_FALSE(IsPackedRayMessage(raw));
+    EXPECT_LT(packed.size() * 3, raw.size()) << "similar rays should pack at least 3x";
+    std::vector<std::byte> unpacked;
+    const Status status = UnpackRayMessage(packed, raw.size(), "rays from rank 3", &unpacked);
+    ASSERT_TRUE(status.ok()) << status.ToString();
+    ASSERT_EQ(unpacked.size(), raw.size());
+    EXPECT_EQ(std::memcmp(unpacked.data(), raw.data(), raw.size()), 0);
+    // An empty message too.
+    const std::vector<std::byte> none = RayMessage().Take();
+    ASSERT_TRUE(UnpackRayMessage(PackRayMessage(none), 64, "x", &unpacked).ok());
+    EXPECT_EQ(unpacked, none);
+}
+
+TEST(RayMessage, DamagedPackedMessagesAreRefusedNamingTheSender) {
+    RayMessage message;
+    message.Append(2, Rays(0, 40));
+    const std::vector<std::byte> raw = message.Take();
+    const std::vector<std::byte> packed = PackRayMessage(raw);
+    std::vector<std::byte> out;
+    ExpectError(UnpackRayMessage(packed, raw.size() - 1, "rays from rank 3", &out),
+                StatusCode::kDataLoss, {"rays from rank 3", "unpacks to", "at most"});
+    std::vector<std::byte> cut(packed.begin(), packed.end() - 5);
+    ExpectError(UnpackRayMessage(cut, raw.size(), "rays from rank 3", &out), StatusCode::kDataLoss,
+                {"rays from rank 3", "does not unpack"});
+    ExpectError(UnpackRayMessage(raw, raw.size(), "rays from rank 3", &out), StatusCode::kDataLoss,
+                {"rays from rank 3", "not a packed ray message"});
+    // A raw message whose group does not fit unpacks to bytes ForEachRayGroup refuses.
+    std::vector<std::byte> short_raw(raw.begin(), raw.end() - 128);
+    ASSERT_TRUE(UnpackRayMessage(PackRayMessage(short_raw), raw.size(), "x", &out).ok());
+    ExpectError(Read(out, 6).status(), StatusCode::kDataLoss, {"group 0", "message ends"});
 }
 
 }  // namespace

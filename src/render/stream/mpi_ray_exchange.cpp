@@ -96,6 +96,7 @@ struct MpiRayExchange::Impl {
     uint64_t last_sums[2] = {0, 0};
     bool have_last_sums = false;
     std::vector<std::byte> receive_buffer;
+    std::vector<std::byte> unpacked;  ///< a packed message's raw bytes (UnpackRayMessage)
     // Progress sharing (ShareProgress); the exchange's thread only.
     ProgressBar* bar = nullptr;
     uint64_t reported = 0;  // the bar's count at the last report
@@ -213,7 +214,7 @@ Status MpiRayExchange::Impl::PostReady(bool all) {
                 if (!progressed) std::this_thread::sleep_for(std::chrono::microseconds(50));
             }
             Posted& p = posted[size_t(dest)].emplace_back();
-            p.bytes = std::move(m.bytes);
+            p.bytes = options.pack_messages ? PackRayMessage(m.bytes) : std::move(m.bytes);
             NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE,
                                                      dest, kRaysTag, rays_comm, &p.request),
                                            "MPI_Isend"));
@@ -258,10 +259,18 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
                       "MPI_Recv"));
         const std::string what =
             fmt::format("rays from rank {} to rank {}", status.MPI_SOURCE, rank);
+        std::span<const std::byte> message = receive_buffer;
+        if (IsPackedRayMessage(message)) {
+            // A sender's raw message is about its message_bytes (the same option as this rank's),
+            // a few group headers more.
+            NAVE_RETURN_IF_ERROR(
+                UnpackRayMessage(message, 2 * options.message_bytes + (1 << 16), what, &unpacked));
+            message = unpacked;
+        }
         // Whole and for this rank's bricks only, before any ray is queued: a damaged message
         // delivers nothing.
         uint32_t foreign_slot = UINT32_MAX;
-        NAVE_RETURN_IF_ERROR(ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
+        NAVE_RETURN_IF_ERROR(ForEachRayGroup(message, uint32_t(owners.size()), what,
                                              [&](uint32_t slot, std::span<const RayRecord>) {
                                                  if (owners[slot] != rank) foreign_slot = slot;
                                              })
@@ -271,7 +280,7 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
                                  foreign_slot, owners[foreign_slot]);
         }
         NAVE_ASSIGN_OR_RETURN(const uint64_t rays,
-                              ForEachRayGroup(receive_buffer, uint32_t(owners.size()), what,
+                              ForEachRayGroup(message, uint32_t(owners.size()), what,
                                               [&](uint32_t slot, std::span<const RayRecord> group) {
                                                   queues.Push(slot, group.data(), group.size());
                                               }));

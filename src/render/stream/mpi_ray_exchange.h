@@ -29,6 +29,10 @@ struct MpiExchangeOptions {
     /// Sends to one rank posted and not yet complete, at most: past it, Progress waits (receiving
     /// meanwhile), so a slow rank holds its senders back instead of their memory filling up.
     int max_sends_in_flight = 8;
+    /// Pack messages for the wire (PackRayMessage: records transposed byte by byte, then LZ4), a
+    /// few times fewer bytes for a little CPU time: for networks slower than the ranks' tracing
+    /// (Gigabit Ethernet; docs/distributed.md, "Replay").
+    bool pack_messages = true;
     /// A rank with no ray to trace that waits this long with nothing arriving and no round of the
     /// end-of-drain sum completing ends the job with an error naming itself and the wait (a rank
     /// that stopped, or a batch longer than this): a job never hangs. 0: waits for ever.

@@ -1,5 +1,9 @@
 #include "src/render/stream/ray_message.h"
 
+#include <lz4.h>
+
+#include <bit>
+#include <cstddef>
 #include <cstring>
 #include <type_traits>
 
@@ -17,7 +21,93 @@ uint32_t GetU32(const std::byte* at) {
     return v;
 }
 
+/// Where a record's wavelengths and their pdfs lie (SampledWavelengths: four wavelengths, then four
+/// pdfs).
+constexpr size_t kLambdaAt = offsetof(RayRecord, lambda);
+constexpr size_t kPdfAt = kLambdaAt + kNumWavelengths * sizeof(float);
+static_assert(sizeof(SampledWavelengths) == 2 * kNumWavelengths * sizeof(float));
+
+/// XORs each pdf of record `r` with the pdf SampledWavelengths::SampleVisible gives its wavelength,
+/// which it almost always is: the pdfs, as random as the wavelengths, become zeros that LZ4 packs
+/// to nothing, and the same XOR brings them back (every rank runs the same nave).
+void XorPredictedPdfs(std::byte* r) {
+    for (int i = 0; i < kNumWavelengths; ++i) {
+        float lambda;
+        std::memcpy(&lambda, r + kLambdaAt + 4 * i, 4);
+        const uint32_t predicted = std::bit_cast<uint32_t>(VisibleWavelengthsPdf(lambda));
+        PutU32(r + kPdfAt + 4 * i, GetU32(r + kPdfAt + 4 * i) ^ predicted);
+    }
+}
+
+/// Transforms each group's records of message `m` in place for LZ4 (`pack`), or back: the pdfs
+/// XORed with their prediction (XorPredictedPdfs), then the bytes transposed (the bytes at one
+/// offset of every record side by side: kinds, depths, pixel rows, exponents), through `scratch`.
+/// Stops at the first group that does not fit: the raw message's checks (ForEachRayGroup) name it.
+void TransformGroups(std::span<std::byte> m, bool pack, std::vector<std::byte>* scratch) {
+    constexpr size_t kRecord = sizeof(RayRecord);
+    if (m.size() < kRayMessageHeaderBytes) return;
+    const uint32_t groups = GetU32(m.data() + 4);
+    size_t at = kRayMessageHeaderBytes;
+    for (uint32_t g = 0; g < groups && m.size() - at >= kRayGroupHeaderBytes; ++g) {
+        const uint64_t n = GetU32(m.data() + at + 4);
+        at += kRayGroupHeaderBytes;
+        if (m.size() - at < n * kRecord) return;
+        std::byte* block = m.data() + at;
+        scratch->assign(block, block + n * kRecord);
+        std::byte* copy = scratch->data();
+        if (pack) {
+            for (uint64_t i = 0; i < n; ++i) XorPredictedPdfs(copy + i * kRecord);
+            for (uint64_t i = 0; i < n; ++i)
+                for (size_t k = 0; k < kRecord; ++k) block[k * n + i] = copy[i * kRecord + k];
+        } else {
+            for (uint64_t i = 0; i < n; ++i)
+                for (size_t k = 0; k < kRecord; ++k) block[i * kRecord + k] = copy[k * n + i];
+            for (uint64_t i = 0; i < n; ++i) XorPredictedPdfs(block + i * kRecord);
+        }
+        at += n * kRecord;
+    }
+}
+
 }  // namespace
+
+std::vector<std::byte> PackRayMessage(std::span<const std::byte> raw) {
+    std::vector<std::byte> shuffled(raw.begin(), raw.end()), scratch;
+    TransformGroups(shuffled, /*pack=*/true, &scratch);
+    NAVE_CHECK_LE(raw.size(), size_t(LZ4_MAX_INPUT_SIZE)) << "a ray message too large for LZ4";
+    std::vector<std::byte> packed(8 + size_t(LZ4_compressBound(int(raw.size()))));
+    PutU32(packed.data(), kPackedRayMessageVersion);
+    PutU32(packed.data() + 4, uint32_t(raw.size()));
+    const int n = LZ4_compress_default(reinterpret_cast<const char*>(shuffled.data()),
+                                       reinterpret_cast<char*>(packed.data() + 8), int(raw.size()),
+                                       int(packed.size() - 8));
+    NAVE_CHECK_GT(n, 0) << "LZ4 failed on a ray message of " << raw.size() << " bytes";
+    packed.resize(8 + size_t(n));
+    return packed;
+}
+
+bool IsPackedRayMessage(std::span<const std::byte> message) {
+    return message.size() >= 8 && GetU32(message.data()) == kPackedRayMessageVersion;
+}
+
+Status UnpackRayMessage(std::span<const std::byte> packed, size_t max_raw_bytes,
+                        std::string_view what, std::vector<std::byte>* raw) {
+    if (!IsPackedRayMessage(packed))
+        return DataLossError("{}: not a packed ray message ({} bytes)", what, packed.size());
+    const uint32_t size = GetU32(packed.data() + 4);
+    if (size > max_raw_bytes || size > uint32_t(LZ4_MAX_INPUT_SIZE))
+        return DataLossError("{}: a packed message of {} bytes unpacks to {} (at most {})", what,
+                             packed.size(), size, max_raw_bytes);
+    raw->resize(size);
+    const int n = LZ4_decompress_safe(reinterpret_cast<const char*>(packed.data() + 8),
+                                      reinterpret_cast<char*>(raw->data()), int(packed.size() - 8),
+                                      int(size));
+    if (n != int(size))
+        return DataLossError("{}: its LZ4 block of {} bytes does not unpack to the {} it announces",
+                             what, packed.size() - 8, size);
+    std::vector<std::byte> scratch;
+    TransformGroups(*raw, /*pack=*/false, &scratch);
+    return Status::Ok();
+}
 
 RayMessage::RayMessage() { bytes_.resize(kRayMessageHeaderBytes); }
 

@@ -44,6 +44,23 @@ class RayMessage {
     uint64_t rays_ = 0;
 };
 
+/// The version word of a message packed for the wire (PackRayMessage).
+inline constexpr uint32_t kPackedRayMessageVersion = 2;
+
+/// `raw` (a RayMessage::Take) packed for the wire: each group's records transposed byte by byte
+/// (the bytes at one offset of every record side by side: kinds, depths, pixel rows, the exponents
+/// of nearby positions, which LZ4 then finds repeated), then LZ4 (one block):
+///
+///   u32 version (kPackedRayMessageVersion), u32 raw size, the LZ4 block.
+std::vector<std::byte> PackRayMessage(std::span<const std::byte> raw);
+/// Whether `message` is packed (PackRayMessage) rather than raw.
+bool IsPackedRayMessage(std::span<const std::byte> message);
+/// The raw message `packed` holds, into `raw`. Errors (kDataLoss, prefixed by `what`): a raw size
+/// over `max_raw_bytes`, a block LZ4 cannot decompress to it. Groups that do not fit are left for
+/// ForEachRayGroup to report.
+Status UnpackRayMessage(std::span<const std::byte> packed, size_t max_raw_bytes,
+                        std::string_view what, std::vector<std::byte>* raw);
+
 /// Calls `visit(slot, rays)` for each group of `message`, in order; returns the rays visited.
 /// Errors (kDataLoss, prefixed by `what`, e.g. "rays from rank 2"): another version, a message cut
 /// short or with bytes past its last group, a slot >= `slot_count`; nothing is visited then.
