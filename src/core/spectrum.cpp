@@ -89,6 +89,13 @@ float SampleVisibleWavelengths(float u) {
     return float(std::clamp(lambda, double(kLambdaMinNm), double(kLambdaMaxNm)));
 }
 
+float VisibleWavelengthsCdf(float lambda_nm) {
+    const VisibleSampling& v = Vis();
+    // ∫ p from 360 nm to λ = (tanh(a (λ - b)) - t0) / (t1 - t0).
+    const double t = std::tanh(kVisA * (double(lambda_nm) - kVisB));
+    return float(std::clamp((t - v.t0) / (v.t1 - v.t0), 0.0, 1.0));
+}
+
 SampledWavelengths SampledWavelengths::SampleUniform(float u, float lo_nm, float hi_nm) {
     NAVE_CHECK_LT(lo_nm, hi_nm);
     SampledWavelengths w;

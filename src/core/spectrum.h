@@ -138,6 +138,9 @@ std::ostream& operator<<(std::ostream& os, const SampledSpectrum& s);
 float VisibleWavelengthsPdf(float lambda_nm);
 /// Inverts the CDF of VisibleWavelengthsPdf: u in [0, 1) -> λ in [360, 830] nm.
 float SampleVisibleWavelengths(float u);
+/// The CDF of VisibleWavelengthsPdf: λ in [360, 830] nm -> u in [0, 1], SampleVisibleWavelengths'
+/// inverse (to a few float ulps).
+float VisibleWavelengthsCdf(float lambda_nm);
 
 /// The kNumWavelengths wavelengths one path carries and the pdf each was drawn with.
 /// Hero-wavelength sampling (Wilkie et al. 2014): the first is drawn from `u`, the others are

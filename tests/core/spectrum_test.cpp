@@ -59,6 +59,21 @@ TEST(SampledWavelengthsTest, SampleVisibleInvertsTheCdf) {
     }
 }
 
+// The CDF gives back the number a wavelength was drawn with (to float precision), and agrees with
+// the pdf's integral.
+TEST(SampledWavelengthsTest, TheCdfInvertsSampling) {
+    for (float u : {0.f, 0.013f, 0.25f, 0.5f, 0.77f, 0.999f}) {
+        EXPECT_NEAR(VisibleWavelengthsCdf(SampleVisibleWavelengths(u)), u, 2e-6f) << u;
+    }
+    double cdf = 0;
+    const double h = 0.01;
+    for (double x = kLambdaMinNm; x < 600; x += h)
+        cdf += h * VisibleWavelengthsPdf(float(x + 0.5 * h));
+    EXPECT_NEAR(VisibleWavelengthsCdf(600.f), cdf, 2e-4);
+    EXPECT_NEAR(VisibleWavelengthsCdf(kLambdaMinNm), 0.f, 1e-6f);
+    EXPECT_NEAR(VisibleWavelengthsCdf(kLambdaMaxNm), 1.f, 1e-6f);
+}
+
 TEST(SampledWavelengthsTest, StratifiedRotationsAndPdf) {
     SampledWavelengths w = SampledWavelengths::SampleVisible(0.3f);
     for (int i = 0; i < kNumWavelengths; ++i) {

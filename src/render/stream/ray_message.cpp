@@ -39,8 +39,26 @@ void XorPredictedPdfs(std::byte* r) {
     }
 }
 
+/// XORs the secondary wavelengths of record `r` with those SampledWavelengths::SampleVisible draws
+/// with the first: SampleVisible rotates one number u by quarters, so the first wavelength gives u
+/// back (VisibleWavelengthsCdf) and u the others, to a few ulps: their random-looking high bytes
+/// become zeros, and the same XOR, the first wavelength unchanged, brings them back.
+void XorPredictedSecondaries(std::byte* r) {
+    float first;
+    std::memcpy(&first, r + kLambdaAt, 4);
+    const float u = VisibleWavelengthsCdf(first);
+    for (int i = 1; i < kNumWavelengths; ++i) {
+        // As SampleVisible rotates u.
+        float up = u + float(i) / kNumWavelengths;
+        if (up >= 1.f) up -= 1.f;
+        const uint32_t predicted = std::bit_cast<uint32_t>(SampleVisibleWavelengths(up));
+        PutU32(r + kLambdaAt + 4 * i, GetU32(r + kLambdaAt + 4 * i) ^ predicted);
+    }
+}
+
 /// Transforms each group's records of message `m` in place for LZ4 (`pack`), or back: the pdfs
-/// XORed with their prediction (XorPredictedPdfs), then the bytes transposed (the bytes at one
+/// XORed with their prediction (XorPredictedPdfs), then the secondary wavelengths with theirs
+/// (XorPredictedSecondaries), then the bytes transposed (the bytes at one
 /// offset of every record side by side: kinds, depths, pixel rows, exponents), through `scratch`.
 /// Stops at the first group that does not fit: the raw message's checks (ForEachRayGroup) name it.
 void TransformGroups(std::span<std::byte> m, bool pack, std::vector<std::byte>* scratch) {
@@ -56,13 +74,20 @@ void TransformGroups(std::span<std::byte> m, bool pack, std::vector<std::byte>* 
         scratch->assign(block, block + n * kRecord);
         std::byte* copy = scratch->data();
         if (pack) {
-            for (uint64_t i = 0; i < n; ++i) XorPredictedPdfs(copy + i * kRecord);
+            for (uint64_t i = 0; i < n; ++i) {
+                // The pdfs' prediction reads the wavelengths: before those are changed.
+                XorPredictedPdfs(copy + i * kRecord);
+                XorPredictedSecondaries(copy + i * kRecord);
+            }
             for (uint64_t i = 0; i < n; ++i)
                 for (size_t k = 0; k < kRecord; ++k) block[k * n + i] = copy[i * kRecord + k];
         } else {
             for (uint64_t i = 0; i < n; ++i)
                 for (size_t k = 0; k < kRecord; ++k) block[i * kRecord + k] = copy[k * n + i];
-            for (uint64_t i = 0; i < n; ++i) XorPredictedPdfs(block + i * kRecord);
+            for (uint64_t i = 0; i < n; ++i) {
+                XorPredictedSecondaries(block + i * kRecord);
+                XorPredictedPdfs(block + i * kRecord);
+            }
         }
         at += n * kRecord;
     }
