@@ -143,6 +143,27 @@ BENCHMARK(BM_ReadBrick)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EncodeBrick)->Apply(Sizes)->Iterations(2);
 
+// What the occupancy grid (format 3.4) adds to EncodeBrick: the same brick with and without it.
+void BM_EncodeBrickOccupancy(benchmark::State& state) {
+    const Fixture& f = GetFixture(state);
+    EncodeOptions options;
+    options.draco_speed = int(state.range(1));
+    options.occupancy = state.range(3) != 0;
+    options.verify = false;  // as preprocess encodes most bricks (verify_every)
+    for (auto _ : state) {
+        auto e = EncodeBrick(f.mesh, {}, f.grid, options);
+        NAVE_CHECK(e.ok());
+        benchmark::DoNotOptimize(e->mesh_bytes.data());
+    }
+    SetCounters(state, f.encoded);
+}
+BENCHMARK(BM_EncodeBrickOccupancy)
+    ->Args({700'000, 6, 1, 0})
+    ->Args({700'000, 6, 1, 1})
+    ->ArgNames({"triangles", "speed", "irregular", "occupancy"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+
 }  // namespace
 }  // namespace nave::store
 

@@ -18,6 +18,7 @@
 
 #include "src/core/key_table.h"
 #include "store/face_shading.h"
+#include "store/occupancy_grid.h"
 
 namespace nave::store::codec {
 namespace {
@@ -248,6 +249,19 @@ StatusOr<EncodedMesh> EncodeMeshSection(const BrickMesh& mesh, const GlobalGrid&
     if (out.max_material_id > kMaxMaterialId) {
         return InvalidArgumentError("material id {} exceeds the largest storable id {}",
                                     out.max_material_id, kMaxMaterialId);
+    }
+
+    // Where the kept triangles lie, as they will decode (each corner dequantized from its grid
+    // point, as the reader does): the brick's occupancy grid (format 3.4), for its own grid only.
+    if (options.occupancy && grid_shift == 0 && !kept.empty()) {
+        std::vector<Vec3f> corners(3 * kept.size());
+        std::vector<uint32_t> corner_index(3 * kept.size());
+        for (size_t k = 0; k < kept.size(); ++k)
+            for (int c = 0; c < 3; ++c) {
+                corners[3 * k + c] = grid.Dequantize(q[mesh.indices[3 * kept[k] + c]]);
+                corner_index[3 * k + c] = uint32_t(3 * k + c);
+            }
+        out.occupancy = OccupancyGrid::Of(corners, corner_index).Encode();
     }
 
     // 4. Shading (docs/store-format.md, "Shading"; face_shading.h): faces whose normals are their

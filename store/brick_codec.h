@@ -56,6 +56,9 @@ struct EncodedMesh {
     uint32_t max_material_id = 0;
     bool has_normals = false;
     bool has_uvs = false;
+    /// OccupancyGrid::Encode of the triangles as they decode (options.occupancy, at the grid's
+    /// own step only; empty otherwise, and for a section of no triangles).
+    std::string occupancy;
     /// The section decoded, when options.verify decoded it to check it (else empty): what the
     /// store's reader will return for it.
     std::optional<BrickMesh> decoded;

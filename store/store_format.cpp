@@ -104,6 +104,7 @@ std::string EncodeHeader(const RawHeader& h) {
     PutSection(w, h.levels);  // 3.1
     // 3.3; a header too small for it (one relabelled older, in tests) ends before it.
     if (h.header_bytes >= kMediumHeaderBytes) PutSection(w, h.medium);
+    if (h.header_bytes >= kOccupancyHeaderBytes) PutSection(w, h.occupancy);  // 3.4
     NAVE_CHECK_LE(w.size(), size_t(h.header_bytes - 8));
     w.PutZeros(h.header_bytes - 8 - w.size());
     w.Put(Checksum64(w.bytes().data(), w.size()));
@@ -204,6 +205,15 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
         }
         NAVE_RETURN_IF_ERROR(GetSection(r, &h.medium));
     }
+    // Before 3.4 the header may end here: no occupancy table.
+    if (h.major > 3 || (h.major == 3 && h.minor >= 4)) {
+        if (h.header_bytes < kOccupancyHeaderBytes) {
+            return DataLossError(
+                "{} @0x{:x}: header size {}, too small for version {}.{} (at least {})", name, 12,
+                h.header_bytes, h.major, h.minor, kOccupancyHeaderBytes);
+        }
+        NAVE_RETURN_IF_ERROR(GetSection(r, &h.occupancy));
+    }
 
     // The checksum matched, so what follows catches writer bugs and files cut or extended after
     // writing.
@@ -230,11 +240,14 @@ StatusOr<RawHeader> DecodeHeader(std::string_view bytes, const std::string& name
         const char* what;
         const SectionInfo* ref;
     };
-    for (const Named& t : {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
-                           Named{"tree", &h.tree}, Named{"materials", &h.materials},
-                           Named{"levels", &h.levels}, Named{"medium", &h.medium}}) {
-        // No levels, or no medium.
-        if ((t.ref == &h.levels || t.ref == &h.medium) && t.ref->length == 0) continue;
+    for (const Named& t :
+         {Named{"provenance", &h.provenance}, Named{"directory", &h.directory},
+          Named{"tree", &h.tree}, Named{"materials", &h.materials}, Named{"levels", &h.levels},
+          Named{"medium", &h.medium}, Named{"occupancy", &h.occupancy}}) {
+        // No levels, no medium, or no occupancy grids.
+        if ((t.ref == &h.levels || t.ref == &h.medium || t.ref == &h.occupancy) &&
+            t.ref->length == 0)
+            continue;
         if (t.ref->offset < h.header_bytes || t.ref->offset > file_bytes ||
             t.ref->length > file_bytes - t.ref->offset) {
             return DataLossError(
@@ -422,20 +435,33 @@ std::string EncodeLevels(const std::vector<RawBrickEntry>& entries) {
     return std::move(w.bytes());
 }
 
-Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
-                    std::vector<RawBrickEntry>* entries) {
-    ByteReader r(bytes, name + " levels", h.levels.offset);
+/// Reads the prefix of a table with an entry per brick (u32 entry size, u32 brick count) and checks
+/// both: the entry size within [`min_entry`, kMaxHeaderBytes], the count the header's and
+/// `entries`'. Errors name the store, the table and its offset. Returns the entry size.
+StatusOr<uint32_t> ReadBrickTablePrefix(ByteReader& r, const RawHeader& h, const std::string& name,
+                                        const char* table, uint64_t offset, uint32_t min_entry,
+                                        size_t entries) {
     uint32_t entry_bytes = 0, brick_count = 0;
     NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
     NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
-    if (entry_bytes < kLevelEntryBytes || entry_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} levels @0x{:x}: level entry size {} out of range [{}, {}]", name,
-                             h.levels.offset, entry_bytes, kLevelEntryBytes, kMaxHeaderBytes);
+    if (entry_bytes < min_entry || entry_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} {} @0x{:x}: entry size {} out of range [{}, {}]", name, table,
+                             offset, entry_bytes, min_entry, kMaxHeaderBytes);
     }
-    if (brick_count != h.brick_count || brick_count != entries->size()) {
-        return DataLossError("{} levels @0x{:x}: the table has {} bricks, the header says {}", name,
-                             h.levels.offset, brick_count, h.brick_count);
+    if (brick_count != h.brick_count || brick_count != entries) {
+        return DataLossError("{} {} @0x{:x}: the table has {} bricks, the header says {}", name,
+                             table, offset, brick_count, h.brick_count);
     }
+    return entry_bytes;
+}
+
+Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
+                    std::vector<RawBrickEntry>* entries) {
+    ByteReader r(bytes, name + " levels", h.levels.offset);
+    NAVE_ASSIGN_OR_RETURN(const uint32_t entry_bytes,
+                          ReadBrickTablePrefix(r, h, name, "levels", h.levels.offset,
+                                               kLevelEntryBytes, entries->size()));
+    const uint32_t brick_count = h.brick_count;
     const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
     for (uint32_t i = 0; i < brick_count; ++i) {
         BrickInfo& b = (*entries)[i].info;
@@ -501,6 +527,48 @@ Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::strin
     return Status::Ok();
 }
 
+// ---- occupancy
+
+std::string EncodeOccupancy(const std::vector<RawBrickEntry>& entries) {
+    ByteWriter w;
+    w.Put(kOccupancyEntryBytes);
+    w.Put(uint32_t(entries.size()));
+    for (const RawBrickEntry& e : entries) PutSection(w, e.info.occupancy);
+    return std::move(w.bytes());
+}
+
+Status DecodeOccupancy(std::string_view bytes, const RawHeader& h, const std::string& name,
+                       std::vector<RawBrickEntry>* entries) {
+    ByteReader r(bytes, name + " occupancy", h.occupancy.offset);
+    NAVE_ASSIGN_OR_RETURN(const uint32_t entry_bytes,
+                          ReadBrickTablePrefix(r, h, name, "occupancy", h.occupancy.offset,
+                                               kOccupancyEntryBytes, entries->size()));
+    const uint32_t brick_count = h.brick_count;
+    if (r.remaining() != uint64_t(brick_count) * entry_bytes) {
+        return DataLossError(
+            "{} occupancy @0x{:x}: {} bytes of entries, expected {} bricks x {} = {}", name,
+            r.file_pos(), r.remaining(), brick_count, entry_bytes,
+            uint64_t(brick_count) * entry_bytes);
+    }
+    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    for (uint32_t i = 0; i < brick_count; ++i) {
+        SectionInfo& section = (*entries)[i].info.occupancy;
+        const uint64_t at = r.file_pos();
+        const size_t start = r.pos();
+        NAVE_RETURN_IF_ERROR(GetSection(r, &section));
+        NAVE_RETURN_IF_ERROR(r.Skip(entry_bytes - (r.pos() - start)));
+        if (section.length == 0) continue;
+        if (section.offset < h.header_bytes || section.offset > payload_end ||
+            section.length > payload_end - section.offset) {
+            return DataLossError(
+                "{} brick {} occupancy @0x{:x}: section [0x{:x}, +{}) lies outside the payload "
+                "area [0x{:x}, 0x{:x})",
+                name, i, at, section.offset, section.length, h.header_bytes, payload_end);
+        }
+    }
+    return Status::Ok();
+}
+
 // ---- medium
 
 std::string EncodeMedium(const std::string& grid_name, const std::vector<RawBrickEntry>& entries) {
@@ -524,17 +592,10 @@ std::string EncodeMedium(const std::string& grid_name, const std::vector<RawBric
 Status DecodeMedium(std::string_view bytes, const RawHeader& h, const std::string& name,
                     std::vector<RawBrickEntry>* entries, std::string* grid_name) {
     ByteReader r(bytes, name + " medium", h.medium.offset);
-    uint32_t entry_bytes = 0, brick_count = 0;
-    NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
-    NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
-    if (entry_bytes < kMediumEntryBytes || entry_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} medium @0x{:x}: entry size {} out of range [{}, {}]", name,
-                             h.medium.offset, entry_bytes, kMediumEntryBytes, kMaxHeaderBytes);
-    }
-    if (brick_count != h.brick_count || brick_count != entries->size()) {
-        return DataLossError("{} medium @0x{:x}: the table has {} bricks, the header says {}", name,
-                             h.medium.offset, brick_count, h.brick_count);
-    }
+    NAVE_ASSIGN_OR_RETURN(const uint32_t entry_bytes,
+                          ReadBrickTablePrefix(r, h, name, "medium", h.medium.offset,
+                                               kMediumEntryBytes, entries->size()));
+    const uint32_t brick_count = h.brick_count;
     NAVE_RETURN_IF_ERROR(r.GetString(grid_name));
     if (grid_name->empty())
         return DataLossError("{} medium @0x{:x}: the table names no grid", name, h.medium.offset);

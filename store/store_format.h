@@ -4,7 +4,7 @@
 // tables; the brick payloads (Draco + LZ4) are brick_codec's business.
 //
 //   [header, header_bytes]  [brick payloads ...]  [provenance] [directory] [tree] [materials]
-//   [levels (3.1)] [medium (3.3)]
+//   [levels (3.1)] [medium (3.3)] [occupancy (3.4)]
 //
 // The tables are written after the payloads and the header last, so a file cut anywhere fails to
 // open.
@@ -32,11 +32,13 @@ inline constexpr char kMagic[8] = {'N', 'A', 'V', 'E', 'S', 'T', 'O', 'R'};
 /// Size of the version 1.0 header, the smallest; the header itself records its size so a newer
 /// minor may grow it.
 inline constexpr uint32_t kHeaderBytes = 256;
-/// Size of the header this nave writes: 3.3 grew it by the medium table's section (older readers
-/// take the size from the header and skip what they do not know).
-inline constexpr uint32_t kCurrentHeaderBytes = 280;
+/// Size of the header this nave writes: 3.3 grew it by the medium table's section, 3.4 by the
+/// occupancy table's (older readers take the size from the header and skip what they do not know).
+inline constexpr uint32_t kCurrentHeaderBytes = 304;
 /// The smallest header of a 3.3 store: the one that holds the medium table's section.
 inline constexpr uint32_t kMediumHeaderBytes = 280;
+/// The smallest header of a 3.4 store: the one that holds the occupancy table's section.
+inline constexpr uint32_t kOccupancyHeaderBytes = 304;
 /// Bytes every version has at the start of the header: magic, major, minor, header size.
 inline constexpr uint32_t kHeaderPrefixBytes = 16;
 /// Size of one directory entry and one tree node in version 1.0 (recorded in the header).
@@ -55,6 +57,11 @@ inline constexpr uint32_t kMaxLevels = 16;
 /// grow it).
 inline constexpr uint32_t kMediumPrefixBytes = 8;
 inline constexpr uint32_t kMediumEntryBytes = 48;
+
+/// Bytes of the occupancy table's prefix (uint32 entry size, uint32 brick count) and of one
+/// brick's entry in version 3.4 (its section: offset, length, checksum).
+inline constexpr uint32_t kOccupancyPrefixBytes = 8;
+inline constexpr uint32_t kOccupancyEntryBytes = 24;
 
 /// Directory entry flags (also those of a level entry).
 inline constexpr uint32_t kBrickHasNormals = 1u << 0;
@@ -81,6 +88,7 @@ struct RawHeader {
     SectionInfo materials;
     SectionInfo levels;  ///< 3.1; length 0 in stores without levels (and zero in older headers)
     SectionInfo medium;  ///< 3.3; length 0 in stores without a medium (and zero in older headers)
+    SectionInfo occupancy;  ///< 3.4; length 0 in stores without occupancy grids
 };
 
 /// A directory entry as stored: BrickInfo plus flags.
@@ -174,6 +182,12 @@ Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::strin
 /// The medium table: the grid's name and every brick's piece of it (BrickInfo::medium), in brick
 /// order.
 std::string EncodeMedium(const std::string& grid_name, const std::vector<RawBrickEntry>& entries);
+/// The occupancy table: every brick's occupancy section (BrickInfo::occupancy), in brick order.
+std::string EncodeOccupancy(const std::vector<RawBrickEntry>& entries);
+/// Fills `entries[i].info.occupancy` from the table, checking the brick count, the entry size and
+/// that every section lies in the payload area. DataLoss naming `name`, the brick and the offset.
+Status DecodeOccupancy(std::string_view bytes, const RawHeader& h, const std::string& name,
+                       std::vector<RawBrickEntry>* entries);
 /// Fills `entries[i].info.medium` and `grid_name` from the table, checking the brick count, the
 /// name, that a piece has voxels and a finite majorant >= 0, that a brick without a piece has no
 /// counts, and that each piece's section lies in the payload area.

@@ -11,7 +11,9 @@
 namespace nave::store {
 
 /// Current format version. Readers refuse another major version; a newer minor version only adds
-/// fields. The version this nave writes. 3.3: a medium's density grid cut along the bricks (the
+/// fields. The version this nave writes. 3.4: each brick's occupancy grid (where its full mesh has
+/// triangles; the occupancy table; older readers ignore it and stores without it have none). 3.3:
+/// a medium's density grid cut along the bricks (the
 /// medium table; older readers ignore it and stores without it have no medium), and bricks without
 /// triangles that hold only a piece of it. 3.2: a level's mesh section may snap to a coarser grid.
 /// 3.1: levels of detail, coarser meshes of each brick (the
@@ -20,7 +22,7 @@ namespace nave::store {
 /// store no normals. 2.0: flat faces marked in the mesh section (no normals, shared corners). 1.1:
 /// material alpha_cutoff.
 inline constexpr uint16_t kFormatMajor = 3;
-inline constexpr uint16_t kFormatMinor = 3;
+inline constexpr uint16_t kFormatMinor = 4;
 /// The oldest major version this nave still reads (1.x stores decode as before).
 inline constexpr uint16_t kOldestReadableMajor = 1;
 
@@ -81,7 +83,12 @@ struct BrickInfo {
     /// a piece and no triangles: it stands for a cell of the tree where the medium is and no
     /// surface is.
     BrickMediumInfo medium;
-    /// The brick's own sections: its mesh, side and medium sections (not its levels').
+    /// Where the brick's full mesh has triangles (store/occupancy_grid.h: OccupancyGrid::Encode),
+    /// from the store's occupancy table (format 3.4); length 0: none (no triangles, or an older
+    /// store).
+    SectionInfo occupancy;
+    /// What a load of the brick reads: its mesh, side and medium sections (not its levels', nor
+    /// its occupancy grid, which a renderer reads once when it opens the store).
     uint64_t BytesOnDisk() const { return mesh.length + side.length + medium.grid.length; }
 };
 

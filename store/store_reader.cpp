@@ -115,6 +115,11 @@ StatusOr<std::unique_ptr<Store>> Store::Open(const std::filesystem::path& path) 
         NAVE_ASSIGN_OR_RETURN(std::string level_bytes, impl->ReadTable("levels", h.levels));
         NAVE_RETURN_IF_ERROR(format::DecodeLevels(level_bytes, h, name, &entries));
     }
+    if (h.occupancy.length > 0) {
+        NAVE_ASSIGN_OR_RETURN(std::string occupancy_bytes,
+                              impl->ReadTable("occupancy", h.occupancy));
+        NAVE_RETURN_IF_ERROR(format::DecodeOccupancy(occupancy_bytes, h, name, &entries));
+    }
     if (h.medium.length > 0) {
         NAVE_ASSIGN_OR_RETURN(std::string medium_bytes, impl->ReadTable("medium", h.medium));
         NAVE_RETURN_IF_ERROR(
@@ -226,10 +231,24 @@ StatusOr<std::vector<std::byte>> Store::ReadBrickMedium(uint32_t id) const {
     return bytes;
 }
 
+StatusOr<OccupancyGrid> Store::ReadBrickOccupancy(uint32_t id) const {
+    const Impl& s = *impl_;
+    if (id >= s.bricks.size()) {
+        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
+                             s.bricks.size());
+    }
+    const SectionInfo& section = s.bricks[id].occupancy;
+    if (section.length == 0) return NotFoundError("{}: brick {} has no occupancy grid", s.name, id);
+    NAVE_ASSIGN_OR_RETURN(std::string bytes, s.ReadSection(id, "occupancy", section));
+    return OccupancyGrid::Decode(
+        bytes, fmt::format("{} brick {} occupancy @0x{:x}", s.name, id, section.offset));
+}
+
 Status Store::VerifyBrick(uint32_t id) const {
     NAVE_ASSIGN_OR_RETURN(BrickMesh mesh, ReadBrick(id));
     const BrickInfo& info = impl_->bricks[id];
     if (info.medium.grid.length > 0) NAVE_RETURN_IF_ERROR(ReadBrickMedium(id).status());
+    if (info.occupancy.length > 0) NAVE_RETURN_IF_ERROR(ReadBrickOccupancy(id).status());
     Bounds3f box;
     for (const Vec3f& p : mesh.positions) box.Extend(p);
     if (mesh.TriangleCount() > 0 && !(box == info.geometry_bounds)) {

@@ -14,6 +14,7 @@
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
+#include "store/occupancy_grid.h"
 #include "store/store_info.h"
 
 namespace nave::store {
@@ -43,7 +44,13 @@ class Store {
     /// or holds no piece; DataLoss for a checksum that disagrees (naming the brick, the offset and
     /// both checksums).
     StatusOr<std::vector<std::byte>> ReadBrickMedium(uint32_t id) const;
-    /// Reads brick `id`, each of its levels and its piece of the medium, and checks their
+    /// Brick `id`'s occupancy grid (BrickInfo::occupancy, format 3.4: where its full mesh has
+    /// triangles), its checksum verified. Thread-safe. Adds the bytes read to bytes_read().
+    /// NotFound for a brick that does not exist or has none; DataLoss for a checksum that
+    /// disagrees or bytes that are not a grid (naming the brick and the offset).
+    StatusOr<OccupancyGrid> ReadBrickOccupancy(uint32_t id) const;
+    /// Reads brick `id`, each of its levels, its piece of the medium and its occupancy grid, and
+    /// checks their
     /// checksums and that the meshes decode to the tables' counts (the medium's decoding is the
     /// OpenVDB plugin's: `nave verify` does it).
     Status VerifyBrick(uint32_t id) const;

@@ -99,6 +99,7 @@ StatusOr<EncodedBrick> EncodeBrick(const BrickMesh& mesh, const Bounds3f& cell,
     brick.has_uvs = encoded.has_uvs;
     brick.max_material_id = encoded.max_material_id;
     brick.dropped_triangle_count = encoded.dropped_triangle_count;
+    brick.occupancy_bytes = std::move(encoded.occupancy);
     if (options.levels.relative_errors.empty()) return brick;
     NAVE_RETURN_IF_ERROR(ValidateLevelOptions(options.levels));
 
@@ -177,6 +178,11 @@ Status WriteTablesAndCommit(AtomicFile& file, format::RawHeader& h,
     // Likewise a store without a medium has no medium table (as in 3.2).
     if (!medium_grid.empty())
         NAVE_RETURN_IF_ERROR(write_table(format::EncodeMedium(medium_grid, entries), &h.medium));
+    // And one without occupancy grids none of those.
+    const bool any_occupancy = std::any_of(
+        entries.begin(), entries.end(), [](const auto& e) { return e.info.occupancy.length > 0; });
+    if (any_occupancy)
+        NAVE_RETURN_IF_ERROR(write_table(format::EncodeOccupancy(entries), &h.occupancy));
     h.file_bytes = file.size();
     const std::string header = format::EncodeHeader(h);
     NAVE_RETURN_IF_ERROR(file.WriteAt(0, header.data(), header.size()));
@@ -296,6 +302,11 @@ StatusOr<uint32_t> StoreWriter::Append(const EncodedBrick& brick) {
         e.info.side = {impl_->file.size(), brick.side_bytes.size(),
                        Checksum64(brick.side_bytes.data(), brick.side_bytes.size())};
         NAVE_RETURN_IF_ERROR(impl_->file.Write(brick.side_bytes));
+    }
+    if (!brick.occupancy_bytes.empty()) {
+        e.info.occupancy = {impl_->file.size(), brick.occupancy_bytes.size(),
+                            Checksum64(brick.occupancy_bytes.data(), brick.occupancy_bytes.size())};
+        NAVE_RETURN_IF_ERROR(impl_->file.Write(brick.occupancy_bytes));
     }
     impl_->entries.push_back(e);
     impl_->max_material_ids.push_back(brick.triangle_count > 0 ? max_material_id : 0);

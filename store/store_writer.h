@@ -38,6 +38,10 @@ struct EncodeOptions {
     /// Coarser levels of each brick to make and store beside it (brick_levels.h); no errors, the
     /// default here, makes none. `nave preprocess` makes LevelOptions' defaults.
     LevelOptions levels = {.relative_errors = {}};
+    /// Store each brick's occupancy grid (format 3.4; store/occupancy_grid.h): where its full mesh
+    /// has triangles, so that a renderer passes over the bricks a ray crosses only through air
+    /// without loading them. 32 KiB a brick before LZ4.
+    bool occupancy = true;
 };
 
 /// A level of a brick ready to be appended (format 3.1): its mesh section and table fields.
@@ -56,6 +60,8 @@ struct EncodedLevel {
 struct EncodedBrick {
     std::string mesh_bytes;  ///< mesh section: 16-byte position base, then the Draco bitstream
     std::string side_bytes;  ///< LZ4 side section (empty in format 1.0; see docs/store-format.md)
+    /// Occupancy section (format 3.4: OccupancyGrid::Encode); empty: none.
+    std::string occupancy_bytes;
     Bounds3f cell;
     Bounds3f geometry_bounds;     ///< box of the grid-snapped positions, exactly as they decode
     uint64_t triangle_count = 0;  ///< stored triangles (input minus dropped_triangle_count)

@@ -72,6 +72,16 @@ std::vector<LevelSummary> SummarizeLevels(const store::Store& s, uint64_t* level
     return out;
 }
 
+/// The bricks with an occupancy grid (format 3.4) and the bytes of those grids on disk.
+std::pair<uint64_t, uint64_t> SummarizeOccupancy(const store::Store& s) {
+    uint64_t bricks = 0, bytes = 0;
+    for (const store::BrickInfo& b : s.bricks()) {
+        bricks += b.occupancy.length > 0 ? 1 : 0;
+        bytes += b.occupancy.length;
+    }
+    return {bricks, bytes};
+}
+
 /// The medium's pieces over all bricks (format 3.3).
 struct MediumSummary {
     uint64_t voxels = 0, bytes = 0, decoded_bytes = 0, bricks = 0, bricks_without_triangles = 0;
@@ -212,6 +222,9 @@ void PrintJson(const store::Store& s, bool list_bricks) {
             JsonString(h.medium_grid), m.voxels, m.bytes, m.decoded_bytes, m.bricks,
             m.bricks_without_triangles, m.max_density);
     }
+    const auto [occupancy_bricks, occupancy_bytes] = SummarizeOccupancy(s);
+    out += fmt::format("  \"occupancy\": {{\"bricks\": {}, \"bytes\": {}}},\n", occupancy_bricks,
+                       occupancy_bytes);
     out += "  \"materials\": [";
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];
@@ -322,6 +335,11 @@ void PrintText(const store::Store& s, bool list_bricks) {
             h.medium_grid, FormatCount(double(m.voxels)), m.bricks, m.bricks_without_triangles,
             FormatBytes(m.bytes), FormatBytes(m.decoded_bytes), m.max_density);
     }
+    const auto [occupancy_bricks, occupancy_bytes] = SummarizeOccupancy(s);
+    out += occupancy_bricks == 0
+               ? std::string("  occupancy    none (rays load every brick they cross)\n")
+               : fmt::format("  occupancy    {} bricks' grids, {} on disk\n", occupancy_bricks,
+                             FormatBytes(occupancy_bytes));
     out += fmt::format("  materials    {}\n", s.materials().size());
     for (size_t i = 0; i < s.materials().size(); ++i) {
         const store::MaterialRecord& m = s.materials()[i];

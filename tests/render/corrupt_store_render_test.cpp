@@ -1,9 +1,9 @@
 // A store damaged anywhere and rendered: one byte flipped at positions spread over every section of
-// a small store (header, the four tables, each brick's mesh section), each rendered as `nave
-// render` does (StoreBrickSource, scene, streams). Each must end in an error naming the store and
-// the section the byte is in, or in the very image of the undamaged store; never a crash or a hang.
-// A few flips also go through the `nave` executable, for its exit code and message.
-// scripts/corrupt_store_trials.sh runs every byte of the file the same way, for longer.
+// a small store (header, the five tables, each brick's mesh section and occupancy grid), each
+// rendered as `nave render` does (StoreBrickSource, scene, streams). Each must end in an error
+// naming the store and the section the byte is in, or in the very image of the undamaged store;
+// never a crash or a hang. A few flips also go through the `nave` executable, for its exit code and
+// message. scripts/corrupt_store_trials.sh runs every byte of the file the same way, for longer.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -114,7 +114,8 @@ class CorruptStoreRender : public ::testing::Test {
             {"header", 10, header.header_bytes, {"header"}}};
         for (const auto& [name, ref] :
              {std::pair{"provenance", header.provenance}, std::pair{"directory", header.directory},
-              std::pair{"tree", header.tree}, std::pair{"materials", header.materials}}) {
+              std::pair{"tree", header.tree}, std::pair{"materials", header.materials},
+              std::pair{"occupancy", header.occupancy}}) {
             sections.push_back(
                 {name, ref.offset, ref.offset + ref.length, {std::string(name) + " table"}});
         }
@@ -127,6 +128,13 @@ class CorruptStoreRender : public ::testing::Test {
                 sections.push_back({"brick " + std::to_string(b.id) + " side",
                                     b.side.offset,
                                     b.side.offset + b.side.length,
+                                    {"brick " + std::to_string(b.id)}});
+            }
+            // Read when the store opens for a render: a damaged grid stops it, naming the brick.
+            if (b.occupancy.length > 0) {
+                sections.push_back({"brick " + std::to_string(b.id) + " occupancy",
+                                    b.occupancy.offset,
+                                    b.occupancy.offset + b.occupancy.length,
                                     {"brick " + std::to_string(b.id)}});
             }
         }
@@ -148,7 +156,8 @@ TEST_F(CorruptStoreRender, TheSectionsCoverTheWholeFile) {
         at = s.end;
     }
     EXPECT_EQ(at, std::filesystem::file_size(Good()));
-    EXPECT_GE(sections.size(), 11u);  // magic, version, header, 4 tables, 4 bricks
+    // magic, version, header, 5 tables, 4 bricks and their occupancy grids
+    EXPECT_GE(sections.size(), 16u);
 }
 
 TEST_F(CorruptStoreRender, EveryFlippedByteIsAnErrorNamingItsSectionOrTheSameImage) {

@@ -3,7 +3,7 @@
 // call the segments through a hollow room's air empty; the scheduler's Route passes over such
 // bricks.
 
-#include "src/render/bricks/occupancy_grid.h"
+#include "store/occupancy_grid.h"
 
 #include <gtest/gtest.h>
 
@@ -71,7 +71,7 @@ TEST(OccupancyGrid, ASegmentCalledEmptyMeetsNoTriangle) {
               c + Vec3f{small(rng), small(rng), small(rng)});
     }
     m.Add({0, 0, 0}, {10, 0, 3}, {0, 10, 7});
-    const OccupancyGrid grid = OccupancyGrid::Of(m.positions, m.indices);
+    const store::OccupancyGrid grid = store::OccupancyGrid::Of(m.positions, m.indices);
     EXPECT_GT(grid.MarkedFraction(), 0.0);
     EXPECT_LT(grid.MarkedFraction(), 0.5);
     std::uniform_real_distribution<float> around(-5.f, 15.f), unit(-1.f, 1.f), length(0.f, 20.f);
@@ -93,6 +93,27 @@ TEST(OccupancyGrid, ASegmentCalledEmptyMeetsNoTriangle) {
     }
     EXPECT_GT(hit, 100);
     EXPECT_GT(empty, 5000);
+
+    // As a store holds it (Encode, Decode): the same answers, the same marks; damage is named.
+    const std::string bytes = grid.Encode();
+    EXPECT_LT(bytes.size(), store::OccupancyGrid::kMemoryBytes);
+    StatusOr<store::OccupancyGrid> stored = store::OccupancyGrid::Decode(bytes, "brick 3");
+    ASSERT_TRUE(stored.ok()) << stored.status().ToString();
+    EXPECT_EQ(stored->MarkedFraction(), grid.MarkedFraction());
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3f o{around(rng), around(rng), around(rng)};
+        const Vec3f d = Normalize(Vec3f{unit(rng), unit(rng), unit(rng) + 1e-3f});
+        ASSERT_EQ(stored->SegmentEmpty(o, d, 0, 30), grid.SegmentEmpty(o, d, 0, 30)) << i;
+    }
+    std::string cut = bytes.substr(0, bytes.size() - 3);
+    EXPECT_NE(
+        store::OccupancyGrid::Decode(cut, "brick 3").status().message().find("brick 3: its bits"),
+        std::string::npos);
+    std::string other = bytes;
+    other[0] = char(32);
+    EXPECT_NE(store::OccupancyGrid::Decode(other, "brick 3").status().message().find("32 voxels"),
+              std::string::npos);
+    EXPECT_EQ(store::OccupancyGrid::Of({}, {}).Encode(), "");
 }
 
 TEST(OccupancyGrid, RaysThroughARoomsAirAreEmptyAndRaysToItsWallsAreNot) {
@@ -105,7 +126,7 @@ TEST(OccupancyGrid, RaysThroughARoomsAirAreEmptyAndRaysToItsWallsAreNot) {
     m.AddQuad({0, 0, 0}, {0, 10, 0}, {0, 0, 8});
     m.AddQuad({20, 0, 0}, {0, 10, 0}, {0, 0, 8});
     m.AddQuad({10, 4, 0}, {0, 2, 0}, {0, 0, 8});
-    const OccupancyGrid grid = OccupancyGrid::Of(m.positions, m.indices);
+    const store::OccupancyGrid grid = store::OccupancyGrid::Of(m.positions, m.indices);
     // Along the room, beside the screen, short of the end wall.
     EXPECT_TRUE(grid.SegmentEmpty({1, 2, 4}, {1, 0, 0}, 0, 18));
     EXPECT_TRUE(grid.SegmentEmpty({1, 2, 4}, Normalize(Vec3f{1, 0.1f, 0.1f}), 0, 15));
@@ -117,7 +138,7 @@ TEST(OccupancyGrid, RaysThroughARoomsAirAreEmptyAndRaysToItsWallsAreNot) {
     EXPECT_TRUE(grid.SegmentEmpty({1, 2, 20}, {1, 0, 0}, 0, 100));
     EXPECT_TRUE(grid.SegmentEmpty({-10, 2, 4}, {-1, 0, 0}, 0, 100));
     // A mesh with no triangles has nothing to meet.
-    EXPECT_TRUE(OccupancyGrid::Of({}, {}).SegmentEmpty({0, 0, 0}, {1, 0, 0}, 0, 1));
+    EXPECT_TRUE(store::OccupancyGrid::Of({}, {}).SegmentEmpty({0, 0, 0}, {1, 0, 0}, 0, 1));
     // An invalid segment is not called empty.
     EXPECT_FALSE(grid.SegmentEmpty({1, 2, 4}, {1, 0, 0}, 5, 1));
 }
@@ -166,7 +187,7 @@ TEST(OccupancyGrid, RoutePassesOverBricksCrossedInAir) {
     EXPECT_LT(route(down_the_row).first.max.x, 1.5f);
     scheduler.reset();
     PagerOptions skip_air;
-    skip_air.skip_air = true;
+    skip_air.skip_air = PagerOptions::SkipAir::kOn;
     {
         auto made = StreamScheduler::Create(*source, skip_air, {}, 1000);
         ASSERT_TRUE(made.ok()) << made.status().ToString();

@@ -20,6 +20,7 @@
 #include "render_test_util.h"
 #include "src/core/memory.h"
 #include "src/core/progress.h"
+#include "src/render/bricks/memory_brick_source.h"
 #include "src/render/bricks/procedural_meshes.h"
 #include "src/render/bricks/store_brick_source.h"
 #include "src/render/stream/memory_plan.h"
@@ -66,7 +67,8 @@ std::unique_ptr<BrickSource> BallGridSource() {
 /// The ball grid's config in `mode` (path, photon, "photon_gather": photon with final gathering
 /// and its guide, "path_guided": path guiding over 16 passes, "path_haze" and "photon_haze": with a
 /// medium over the model, or "path_water" and "photon_water": balls of water that scatters, in
-/// that haze; "path_glow": the water and the haze glow).
+/// that haze; "path_glow": the water and the haze glow; "path_air": path mode over bricks whose
+/// occupancy grids are known, so that rays pass over the bricks they cross in air).
 SceneConfig BallGridConfig(const std::string& mode) {
     const bool gather = mode == "photon_gather", guided = mode == "path_guided",
                glow = mode == "path_glow",
@@ -110,7 +112,10 @@ std::unique_ptr<TestRender> RenderBallGrid(const std::string& mode, const PagerO
     if (spp > 0) config.render.spp = spp;
     RunOptions run;
     run.paging = paging;
-    return BuildAndRender(BallGridSource(), std::move(config), run);
+    std::unique_ptr<BrickSource> source = BallGridSource();
+    // "path_air": every brick's occupancy grid known from the start, as a store holds them.
+    if (mode == "path_air") static_cast<MemoryBrickSource&>(*source).KnowOccupancy();
+    return BuildAndRender(std::move(source), std::move(config), run);
 }
 
 /// A budget of about 15 % of the in-core size, or the minimum if that is more.
@@ -224,6 +229,22 @@ TEST_F(PagerTest, PagedRenderEqualsInCoreThroughBallsOfWater) {
 // What media emit is gathered along each flight where it crosses a brick, resident or not.
 TEST_F(PagerTest, PagedRenderEqualsInCoreInGlowingMedia) {
     ExpectPagedEqualsInCore("path_glow", 1e-9);
+}
+
+// With every brick's occupancy grid known from the start (a store's, format 3.4), rays pass over
+// the bricks they cross in air the same way whatever the budget: the paged image is the in-core
+// one, and the rays did pass over bricks.
+TEST_F(PagerTest, PagedRenderEqualsInCoreWhenRaysPassOverBricksInAir) {
+    ExpectPagedEqualsInCore("path_air", 1e-9);
+    const auto over = RenderBallGrid("path_air", nullptr);
+    const auto through = RenderBallGrid("path", nullptr);
+    ASSERT_TRUE(over && through);
+    EXPECT_TRUE(over->source->occupancy_known());
+    EXPECT_FALSE(through->source->occupancy_known());
+    EXPECT_LT(over->stats.brick_moves, through->stats.brick_moves);
+    EXPECT_LT(over->stats.segments_traced, through->stats.segments_traced);
+    // The same surfaces met: the same image but for the order of the film's sums.
+    EXPECT_LT(MaxRelativeDifference(*over->film, *through->film), 1e-4);
 }
 
 TEST_F(PagerTest, PagedRenderEqualsInCorePhoton) { ExpectPagedEqualsInCore("photon", 1e-9); }
@@ -462,9 +483,11 @@ TEST_F(PagerTest, TunablesParseAndBadOnesAreNamed) {
     EXPECT_EQ(o.nearly_empty_rays, 100u);
     EXPECT_DOUBLE_EQ(o.prefer_resident, 0.5);
     ASSERT_TRUE(ParsePagerTunables("", &o).ok());
-    EXPECT_FALSE(o.skip_air);
+    EXPECT_EQ(o.skip_air, PagerOptions::SkipAir::kAuto);
     ASSERT_TRUE(ParsePagerTunables("brick_cache=off,brick_cache_limit=3G,skip_air=on", &o).ok());
-    EXPECT_TRUE(o.skip_air);
+    EXPECT_EQ(o.skip_air, PagerOptions::SkipAir::kOn);
+    ASSERT_TRUE(ParsePagerTunables("skip_air=off", &o).ok());
+    EXPECT_EQ(o.skip_air, PagerOptions::SkipAir::kOff);
     EXPECT_FALSE(o.brick_cache);
     EXPECT_EQ(o.brick_cache_limit_bytes, uint64_t(3) << 30);
     for (const char* bad : {"prefetch=maybe", "nearly_empty_rays=-3", "prefer_resident=x",

@@ -524,7 +524,10 @@ TEST_F(RenderTest, StoreSourceRendersTheSameImageFor1And64Bricks) {
         auto t = testing::BuildAndRender(std::move(*source), *config);
         ASSERT_TRUE(t != nullptr);
         ASSERT_TRUE(t->status.ok()) << t->status.ToString();
-        EXPECT_EQ(t->stats.residency.loads, t->source->brick_count());
+        // In core each brick loads once at most; rays pass over some they cross only in air
+        // (the store's occupancy grids), which then never load.
+        EXPECT_LE(t->stats.residency.loads, t->source->brick_count());
+        EXPECT_GT(t->stats.residency.loads, 0u);
         EXPECT_GT(t->stats.bytes_read, 0u);
         films.push_back(std::move(t->film));
     }

@@ -106,7 +106,8 @@ TEST_F(StoreCorruption, FlippedTableByteNamesTheTableAndItsOffset) {
     };
     for (const Case& c :
          {Case{"provenance", header_.provenance}, Case{"directory", header_.directory},
-          Case{"tree", header_.tree}, Case{"materials", header_.materials}}) {
+          Case{"tree", header_.tree}, Case{"materials", header_.materials},
+          Case{"occupancy", header_.occupancy}}) {
         SCOPED_TRACE(c.table);
         for (uint64_t at :
              {c.ref.offset, c.ref.offset + c.ref.length / 2, c.ref.offset + c.ref.length - 1}) {
@@ -129,6 +130,24 @@ TEST_F(StoreCorruption, FlippedBrickByteIsReportedWithBrickAndOffset) {
                 {bad_.string() + " brick 2 @" + Hex(b.mesh.offset) + ": mesh checksum",
                  "!= stored " + ChecksumHex(b.mesh.checksum)});
     EXPECT_EQ((*store)->VerifyBrick(2).code(), StatusCode::kDataLoss);
+}
+
+// A brick's occupancy grid (format 3.4) is read when a renderer opens the store: a damaged one is
+// named with its brick and offset, and `nave verify` (VerifyBrick) finds it too.
+TEST_F(StoreCorruption, FlippedOccupancyByteIsReportedWithBrickAndOffset) {
+    const BrickInfo& b = bricks_[1];
+    ASSERT_GT(b.occupancy.length, 0u) << "every brick with triangles has its grid";
+    auto good = Store::Open(good_);
+    ASSERT_TRUE(good.ok());
+    StatusOr<OccupancyGrid> grid = (*good)->ReadBrickOccupancy(1);
+    ASSERT_TRUE(grid.ok()) << grid.status().ToString();
+    EXPECT_GT(grid->MarkedFraction(), 0.0);
+    auto store = OpenBytes(Flipped(b.occupancy.offset + b.occupancy.length / 2));
+    ASSERT_TRUE(store.ok()) << store.status().ToString();
+    ExpectError((*store)->ReadBrickOccupancy(1).status(), StatusCode::kDataLoss,
+                {bad_.string() + " brick 1 @" + Hex(b.occupancy.offset) + ": occupancy checksum"});
+    EXPECT_EQ((*store)->VerifyBrick(1).code(), StatusCode::kDataLoss);
+    EXPECT_TRUE((*store)->VerifyBrick(0).ok());
 }
 
 // The checksums catch damage; this checks what is behind them. A payload changed and re-checksummed

@@ -101,7 +101,7 @@ TEST_F(StoreMedium, RoundTripKeepsPiecesAndBricksWithoutTriangles) {
     auto opened = Store::Open(good_);
     ASSERT_TRUE(opened.ok()) << opened.status().ToString();
     const Store& store = **opened;
-    EXPECT_EQ(store.header().minor, 3);
+    EXPECT_EQ(store.header().minor, kFormatMinor);
     EXPECT_EQ(store.header().medium_grid, "density");
     ASSERT_EQ(store.bricks().size(), 2u);
     const BrickInfo& surface = store.bricks()[0];

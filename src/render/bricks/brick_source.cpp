@@ -79,6 +79,12 @@ Status BrickSource::UseLevels(uint32_t max_levels) {
 
 BrickSource::~BrickSource() = default;
 
+void BrickSource::SetOccupancy(std::vector<std::unique_ptr<const store::OccupancyGrid>> grids) {
+    NAVE_CHECK_EQ(grids.size(), size_t(brick_count()));
+    known_occupancy_ = std::move(grids);
+    occupancy_known_ = true;
+}
+
 StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     if (id >= slots_.size()) {
         return InvalidArgumentError(
@@ -174,8 +180,8 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
     if (LevelOfSlot(id) == 0 && slot.occupancy_owned == nullptr &&
         make_occupancy_.load(std::memory_order_relaxed)) {
         const ResidentMesh& m = slot.brick->mesh();
-        slot.occupancy_owned =
-            std::make_unique<const OccupancyGrid>(OccupancyGrid::Of(m.positions, m.indices));
+        slot.occupancy_owned = std::make_unique<const store::OccupancyGrid>(
+            store::OccupancyGrid::Of(m.positions, m.indices));
         slot.occupancy.store(slot.occupancy_owned.get(), std::memory_order_release);
     }
     {

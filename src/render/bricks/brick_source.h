@@ -16,11 +16,11 @@
 #include "src/core/status.h"
 #include "src/core/vecmath.h"
 #include "src/render/bricks/embree_device.h"
-#include "src/render/bricks/occupancy_grid.h"
 #include "src/render/bricks/resident_brick.h"
 #include "store/brick_mesh.h"
 #include "store/brick_tree.h"
 #include "store/material_record.h"
+#include "store/occupancy_grid.h"
 
 namespace nave {
 class TraceRecorder;
@@ -127,10 +127,16 @@ class BrickSource {
     /// Whether each brick's first full-detail load from now on makes its occupancy grid (off by
     /// default: only renders that pass over bricks crossed in air read them). Thread-safe.
     void MakeOccupancyGrids(bool on) { make_occupancy_.store(on, std::memory_order_relaxed); }
-    /// Where brick `brick`'s full mesh has triangles (OccupancyGrid), once it has been loaded at
-    /// full detail with MakeOccupancyGrids on; null before. Kept when the brick is evicted:
-    /// OccupancyGrid::kMemoryBytes per brick, counted by the memory plan. Thread-safe.
-    const OccupancyGrid* Occupancy(uint32_t brick) const {
+    /// Whether every brick's occupancy grid is known from the start (SetOccupancy: a store's, or
+    /// one made from meshes held in memory), so that passing over bricks crossed in air routes
+    /// rays the same way in every run.
+    bool occupancy_known() const { return occupancy_known_; }
+    /// Where brick `brick`'s full mesh has triangles (store::OccupancyGrid): known from the start
+    /// (occupancy_known), or once it has been loaded at full detail with MakeOccupancyGrids on;
+    /// null before. Kept when the brick is evicted: store::OccupancyGrid::kMemoryBytes per brick,
+    /// counted by the memory plan. Thread-safe.
+    const store::OccupancyGrid* Occupancy(uint32_t brick) const {
+        if (occupancy_known_) return known_occupancy_[brick].get();
         return slots_[brick]->occupancy.load(std::memory_order_acquire);
     }
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
@@ -164,6 +170,9 @@ class BrickSource {
     BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree tree,
                 std::vector<Bounds3f> cells, std::vector<store::MaterialRecord> materials,
                 Bounds3f bounds);
+    /// Gives every brick its occupancy grid before anything loads: `grids[b]` brick b's (null for
+    /// a brick of no triangles, which no ray can meet); occupancy_known from then on.
+    void SetOccupancy(std::vector<std::unique_ptr<const store::OccupancyGrid>> grids);
     /// Reads and decodes slot `id` (no caching: the base class caches). Adds to `bytes_read`.
     virtual StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) = 0;
     /// What slot `id`'s mesh and BVH take once loaded (ResidentBrick::memory_bytes without a
@@ -214,8 +223,8 @@ class BrickSource {
         Status error;  // sticky load error
         // Level 0's only: where the full mesh has triangles, made at its first load and kept
         // through evictions (Occupancy).
-        std::unique_ptr<const OccupancyGrid> occupancy_owned;
-        std::atomic<const OccupancyGrid*> occupancy{nullptr};
+        std::unique_ptr<const store::OccupancyGrid> occupancy_owned;
+        std::atomic<const store::OccupancyGrid*> occupancy{nullptr};
     };
     std::shared_ptr<EmbreeDevice> device_;
     store::BrickTree tree_;
@@ -228,8 +237,11 @@ class BrickSource {
     BrickCache* brick_cache_ = nullptr;
     int decode_limit_ = 0;
     std::atomic<bool> make_occupancy_{false};  // MakeOccupancyGrids
-    std::optional<float> medium_scale_;        // UseStoredMedium's
-    std::mutex decode_mutex_;  // with decode_cv_: counts decodes_ under decode_limit_
+    bool occupancy_known_ = false;             // every brick's grid set before rendering
+    // SetOccupancy's grids, by brick (apart from the slots, which UseLevels makes again).
+    std::vector<std::unique_ptr<const store::OccupancyGrid>> known_occupancy_;
+    std::optional<float> medium_scale_;  // UseStoredMedium's
+    std::mutex decode_mutex_;            // with decode_cv_: counts decodes_ under decode_limit_
     std::condition_variable decode_cv_;
     int decodes_ = 0;
     uint32_t brick_count_ = 0;

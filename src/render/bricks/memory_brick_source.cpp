@@ -33,6 +33,16 @@ MemoryBrickSource::MemoryBrickSource(std::shared_ptr<EmbreeDevice> device,
     levels_ = std::move(levels);
 }
 
+void MemoryBrickSource::KnowOccupancy() {
+    std::vector<std::unique_ptr<const store::OccupancyGrid>> grids(meshes_.size());
+    for (size_t b = 0; b < meshes_.size(); ++b) {
+        if (meshes_[b].TriangleCount() == 0) continue;
+        grids[b] = std::make_unique<const store::OccupancyGrid>(
+            store::OccupancyGrid::Of(meshes_[b].positions, meshes_[b].indices));
+    }
+    SetOccupancy(std::move(grids));
+}
+
 const store::BrickMesh* MemoryBrickSource::MeshOf(uint32_t id) const {
     const uint32_t brick = BrickOfSlot(id), level = LevelOfSlot(id);
     if (level == 0) return &meshes_[brick];

@@ -27,6 +27,10 @@ class MemoryBrickSource final : public BrickSource {
     /// Holds `whole` as the medium cut into the bricks (UseStoredMedium): each brick's piece is its
     /// CellShare. Call before UseStoredMedium.
     void HoldMedium(std::shared_ptr<const DensityField> whole) { medium_ = std::move(whole); }
+    /// Makes every brick's occupancy grid now, as a store of format 3.4 holds them
+    /// (occupancy_known): rays then pass over bricks crossed in air from the start, as they do
+    /// over a store's. Call before rendering.
+    void KnowOccupancy();
 
   protected:
     StatusOr<store::BrickMesh> LoadMesh(uint32_t id, uint64_t* bytes_read) override;

@@ -17,8 +17,25 @@ StoreBrickSource::~StoreBrickSource() = default;
 StatusOr<std::unique_ptr<StoreBrickSource>> StoreBrickSource::Open(
     const std::filesystem::path& path, std::shared_ptr<EmbreeDevice> device) {
     NAVE_ASSIGN_OR_RETURN(std::unique_ptr<store::Store> st, store::Store::Open(path));
-    return std::unique_ptr<StoreBrickSource>(
+    std::unique_ptr<StoreBrickSource> source(
         new StoreBrickSource(std::move(st), std::move(device)));
+    NAVE_RETURN_IF_ERROR(source->ReadOccupancy());
+    return source;
+}
+
+Status StoreBrickSource::ReadOccupancy() {
+    const std::vector<store::BrickInfo>& bricks = store_->bricks();
+    // Known only if every brick a ray can meet has its grid (a store of format 3.4).
+    for (const store::BrickInfo& b : bricks)
+        if (b.triangle_count > 0 && b.occupancy.length == 0) return Status::Ok();
+    std::vector<std::unique_ptr<const store::OccupancyGrid>> grids(bricks.size());
+    for (uint32_t b = 0; b < bricks.size(); ++b) {
+        if (bricks[b].occupancy.length == 0) continue;
+        NAVE_ASSIGN_OR_RETURN(store::OccupancyGrid grid, store_->ReadBrickOccupancy(b));
+        grids[b] = std::make_unique<const store::OccupancyGrid>(std::move(grid));
+    }
+    SetOccupancy(std::move(grids));
+    return Status::Ok();
 }
 
 namespace {

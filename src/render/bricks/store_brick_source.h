@@ -36,6 +36,10 @@ class StoreBrickSource final : public BrickSource {
 
   private:
     StoreBrickSource(std::unique_ptr<store::Store> store, std::shared_ptr<EmbreeDevice> device);
+    /// Reads every brick's occupancy grid where the store holds them all (format 3.4), so that
+    /// rays pass over bricks crossed in air from the start (BrickSource::occupancy_known). Errors:
+    /// a grid whose checksum or bytes are wrong, naming the brick.
+    Status ReadOccupancy();
     std::unique_ptr<store::Store> store_;
 };
 

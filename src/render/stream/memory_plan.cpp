@@ -86,8 +86,10 @@ RenderMemoryInputs RenderMemoryInputs::Measure(const BrickSource& source,
     inputs.pager = pager;
     inputs.brick_count = source.slot_count();
     inputs.bricks = MinimumBrickBudget(source, pager.prefetch);
-    if (pager.skip_air)
-        inputs.occupancy_bytes = uint64_t(source.brick_count()) * OccupancyGrid::kMemoryBytes;
+    // Grids known from the start are held all along; with skip_air on, made as bricks load.
+    if (source.occupancy_known() || pager.skip_air == PagerOptions::SkipAir::kOn)
+        inputs.occupancy_bytes =
+            uint64_t(source.brick_count()) * store::OccupancyGrid::kMemoryBytes;
     // One decode at a time under a budget: the largest load's scratch is the most beside bricks.
     for (uint32_t b = 0; b < source.slot_count(); ++b) {
         inputs.load_scratch_bytes = std::max(inputs.load_scratch_bytes, source.LoadScratchBytes(b));

@@ -75,7 +75,7 @@ struct RenderMemoryInputs {
     BrickBudgetMinimum bricks;        ///< MinimumBrickBudget of the model under pager.prefetch
     uint64_t load_scratch_bytes = 0;  ///< the most one brick's load needs beside the brick
     /// The bricks' occupancy grids (BrickSource::Occupancy), each kept once its brick is loaded;
-    /// 0 unless pager.skip_air.
+    /// 0 unless the source knows them (BrickSource::occupancy_known) or pager.skip_air is on.
     uint64_t occupancy_bytes = 0;
     /// The process's resident size when the render is planned (code, libraries, the store's
     /// tables, the scene, the texture system if loaded).

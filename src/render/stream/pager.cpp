@@ -69,7 +69,13 @@ Status ParsePagerTunables(std::string_view text, PagerOptions* options) {
             }
             options->queue_memory_bytes = *bytes;
         } else if (key == "skip_air") {
-            NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->skip_air));
+            if (value == "auto") {
+                options->skip_air = PagerOptions::SkipAir::kAuto;
+            } else {
+                bool on = false;
+                NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &on));
+                options->skip_air = on ? PagerOptions::SkipAir::kOn : PagerOptions::SkipAir::kOff;
+            }
         } else if (key == "bvh_compact") {
             NAVE_RETURN_IF_ERROR(ParseOnOff(key, value, &options->bvh.compact));
         } else if (key == "evict") {

@@ -78,11 +78,14 @@ struct PagerOptions {
     /// Where spill files go (the brick cache, the ray queues). Empty: the current directory.
     std::filesystem::path spill_dir;
     /// Pass over the full-detail bricks a ray crosses only through empty voxels of their occupancy
-    /// grids (docs/pager.md, "Rays that cross a brick's air"). Off by default: a grid exists once
-    /// its brick has loaded, which depends on timing, so rays take different ways through the
-    /// queues from run to run; each image is as correct, but renders are no longer reproducible
-    /// bit for bit (nor a resumed render equal to an uninterrupted one).
-    bool skip_air = false;
+    /// grids (docs/pager.md, "Rays that cross a brick's air"). kAuto, the default: where every
+    /// brick's grid is known from the start (BrickSource::occupancy_known: a store of format 3.4,
+    /// or meshes held in memory), so that every run, budget and rank routes rays alike. kOn: also
+    /// where the grids are made as bricks first load, which depends on timing: rays then take
+    /// different ways through the queues from run to run; each image is as correct, but renders
+    /// are no longer reproducible bit for bit. kOff: never.
+    enum class SkipAir { kAuto, kOn, kOff };
+    SkipAir skip_air = SkipAir::kAuto;
     /// The whole process's memory (the user's --memory; 0: none). Before each load, when the
     /// process's resident size plus the brick's estimate would pass it, the allocator gives its
     /// free pages back (ResidentSizeGuard): freed pages are otherwise kept for the next loads to
@@ -96,7 +99,7 @@ struct PagerOptions {
 inline constexpr std::string_view kPagerTunables =
     "prefetch=on|off, loaders=N, nearly_empty_rays=RAYS, prefer_resident=FRACTION, "
     "evict=lru|traffic, wave_overlap=FRACTION, bvh=low|medium|high, bvh_compact=on|off, "
-    "brick_cache=on|off, brick_cache_limit=SIZE, queue_memory=SIZE, skip_air=on|off";
+    "brick_cache=on|off, brick_cache_limit=SIZE, queue_memory=SIZE, skip_air=auto|on|off";
 
 /// Parses "prefetch=off,nearly_empty_rays=4096,prefer_resident=0.25" (any subset, comma separated)
 /// into `options`. Errors name the key or value and list the accepted keys.

@@ -54,7 +54,9 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
             ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
-    scheduler->skip_air_allowed_ = paging.skip_air;
+    scheduler->skip_air_allowed_ =
+        paging.skip_air == PagerOptions::SkipAir::kOn ||
+        (paging.skip_air == PagerOptions::SkipAir::kAuto && source.occupancy_known());
     NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
     return scheduler;
 }
@@ -161,7 +163,7 @@ uint32_t StreamScheduler::Route(RayRecord& r, float from_t, uint32_t current) co
         const uint32_t level = LevelOfSegment(r, s.brick);
         if (level == 0 && skip_air_) {
             // At full detail a segment ends where TraceInBrick's does (SegmentEnd, no overlap).
-            const OccupancyGrid* grid = source_.Occupancy(s.brick);
+            const store::OccupancyGrid* grid = source_.Occupancy(s.brick);
             if (grid != nullptr &&
                 grid->SegmentEmpty(r.origin, r.dir, s.t_enter,
                                    std::min(SegmentEndWithSlack(s.t_exit), r.t_max))) {

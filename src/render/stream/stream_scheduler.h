@@ -138,10 +138,11 @@ class StreamScheduler {
     /// (docs/pager.md, "Rays that cross a brick's air"): for renders without a medium, whose rays
     /// do nothing between surfaces (a medium's flight over a passed brick would be drawn over
     /// another stretch).
-    /// The bricks' grids are made from then on (BrickSource::MakeOccupancyGrids) only then.
+    /// Where the source does not know the bricks' grids, they are made from then on
+    /// (BrickSource::MakeOccupancyGrids), and only then.
     void SkipBricksCrossedInAir() {
         skip_air_ = skip_air_allowed_;
-        source_.MakeOccupancyGrids(skip_air_);
+        source_.MakeOccupancyGrids(skip_air_ && !source_.occupancy_known());
     }
     /// Whether this process makes ray `r`, one of the rays made outside a batch (a camera ray or
     /// a photon, `index` its pixel or photon): every process makes them all in the same way and
@@ -267,7 +268,7 @@ class StreamScheduler {
     uint32_t LevelOfSegment(const RayRecord& r, uint32_t brick) const;
 
     bool count_rounds_ = false;
-    bool skip_air_allowed_ = false;  // PagerOptions::skip_air
+    bool skip_air_allowed_ = false;  // PagerOptions::skip_air, with what the source knows
     bool skip_air_ = false;          // SkipBricksCrossedInAir
     std::array<std::atomic<int64_t>, kRounds> waiting_by_round_{};
 };

@@ -9,11 +9,13 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "src/core/status.h"
 #include "src/core/vecmath.h"
 
-namespace nave::render {
+namespace nave::store {
 
 class OccupancyGrid {
   public:
@@ -27,6 +29,16 @@ class OccupancyGrid {
     /// triangle) overlap, each box grown by a thousandth of a voxel so that a triangle on a
     /// voxel's face marks both sides. Cost: one pass over the triangles.
     static OccupancyGrid Of(std::span<const Vec3f> positions, std::span<const uint32_t> indices);
+
+    /// The grid as a store's occupancy section holds it (format 3.4; docs/store-format.md,
+    /// "Occupancy"): its box, then its bits, LZ4-compressed. Empty for a grid of no triangles.
+    std::string Encode() const;
+    /// A grid from Encode's bytes. DataLoss naming `what` (e.g. "abbey.nave brick 12 occupancy")
+    /// for bytes that are not one: another resolution, a box that is not finite, bits that do not
+    /// decompress to the grid's size.
+    static StatusOr<OccupancyGrid> Decode(std::string_view bytes, const std::string& what);
+    /// Whether no triangle marked it (Of over an empty mesh): every segment is empty.
+    bool empty() const { return empty_box_; }
 
     /// Whether o + t d for t in [t0, t1] crosses no marked voxel: no triangle of the mesh lies on
     /// it. False where unsure (a degenerate direction, a box of no extent). Thread-safe.
@@ -47,4 +59,4 @@ class OccupancyGrid {
     std::vector<uint64_t> bits_;
 };
 
-}  // namespace nave::render
+}  // namespace nave::store

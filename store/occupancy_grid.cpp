@@ -1,9 +1,12 @@
-#include "src/render/bricks/occupancy_grid.h"
+#include "store/occupancy_grid.h"
+
+#include <lz4.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
-namespace nave::render {
+namespace nave::store {
 namespace {
 
 constexpr int kN = OccupancyGrid::kResolution;
@@ -145,10 +148,64 @@ bool OccupancyGrid::SegmentEmpty(const Vec3f& of, const Vec3f& df, float t0, flo
     }
 }
 
+namespace {
+
+/// Bytes before the LZ4 block of an occupancy section: u32 resolution, u32 bytes of the bits once
+/// decompressed, the box's lower corner and voxel size (3 + 3 doubles).
+constexpr size_t kSectionHeadBytes = 8 + 6 * sizeof(double);
+
+}  // namespace
+
+std::string OccupancyGrid::Encode() const {
+    if (empty_box_) return std::string();
+    const size_t raw = bits_.size() * sizeof(uint64_t);
+    std::string out(kSectionHeadBytes + size_t(LZ4_compressBound(int(raw))), '\0');
+    const uint32_t head[2] = {uint32_t(kN), uint32_t(raw)};
+    const double box[6] = {origin_.x,     origin_.y,     origin_.z,
+                           voxel_size_.x, voxel_size_.y, voxel_size_.z};
+    std::memcpy(out.data(), head, sizeof head);
+    std::memcpy(out.data() + sizeof head, box, sizeof box);
+    const int n = LZ4_compress_default(reinterpret_cast<const char*>(bits_.data()),
+                                       out.data() + kSectionHeadBytes, int(raw),
+                                       int(out.size() - kSectionHeadBytes));
+    NAVE_CHECK_GT(n, 0) << "LZ4 failed on an occupancy grid";
+    out.resize(kSectionHeadBytes + size_t(n));
+    return out;
+}
+
+StatusOr<OccupancyGrid> OccupancyGrid::Decode(std::string_view bytes, const std::string& what) {
+    if (bytes.size() < kSectionHeadBytes)
+        return DataLossError("{}: {} bytes, fewer than an occupancy grid's {}-byte head", what,
+                             bytes.size(), kSectionHeadBytes);
+    uint32_t head[2];
+    double box[6];
+    std::memcpy(head, bytes.data(), sizeof head);
+    std::memcpy(box, bytes.data() + sizeof head, sizeof box);
+    const uint32_t raw = uint32_t(kN) * kN * kN / 8;
+    if (head[0] != uint32_t(kN) || head[1] != raw)
+        return DataLossError("{}: a grid of {} voxels a side and {} bytes (expected {} and {})",
+                             what, head[0], head[1], kN, raw);
+    for (int a = 0; a < 6; ++a)
+        if (!std::isfinite(box[a]) || (a >= 3 && !(box[a] > 0)))
+            return DataLossError("{}: its box ({}, {}, {}) + voxels of ({}, {}, {}) is not one",
+                                 what, box[0], box[1], box[2], box[3], box[4], box[5]);
+    OccupancyGrid g;
+    g.bits_.assign(raw / sizeof(uint64_t), 0);
+    const int n = LZ4_decompress_safe(bytes.data() + kSectionHeadBytes,
+                                      reinterpret_cast<char*>(g.bits_.data()),
+                                      int(bytes.size() - kSectionHeadBytes), int(raw));
+    if (n != int(raw))
+        return DataLossError("{}: its bits do not decompress to the grid's {} bytes", what, raw);
+    g.origin_ = Vec3d(box[0], box[1], box[2]);
+    g.voxel_size_ = Vec3d(box[3], box[4], box[5]);
+    g.empty_box_ = false;
+    return g;
+}
+
 double OccupancyGrid::MarkedFraction() const {
     uint64_t marked = 0;
     for (uint64_t w : bits_) marked += uint64_t(__builtin_popcountll(w));
     return double(marked) / double(uint64_t(kN) * kN * kN);
 }
 
-}  // namespace nave::render
+}  // namespace nave::store
