@@ -30,6 +30,49 @@ Status GetSection(ByteReader& r, SectionInfo* s) {
 
 bool FiniteBounds(const Bounds3f& b) { return IsFinite(b.min) && IsFinite(b.max); }
 
+/// Whether section `s` lies in the payload area, from the header's end to the first table (the
+/// tables follow the payloads).
+bool InPayloadArea(const SectionInfo& s, const RawHeader& h) {
+    const uint64_t end = h.provenance.offset;
+    return s.offset >= h.header_bytes && s.offset <= end && s.length <= end - s.offset;
+}
+
+/// The error for section `s` outside the payload area, `prefix` naming the store, the brick, the
+/// entry and the section ("abbey.nave brick 3 medium @0x1c0: ").
+Status OutsidePayloadArea(const SectionInfo& s, const RawHeader& h, const std::string& prefix) {
+    return DataLossError("{}section [0x{:x}, +{}) lies outside the payload area [0x{:x}, 0x{:x})",
+                         prefix, s.offset, s.length, h.header_bytes, h.provenance.offset);
+}
+
+/// Checks that the entries after a per-brick table's prefix fill the rest of it exactly.
+Status CheckEntriesFill(const ByteReader& r, const std::string& name, const char* table,
+                        uint32_t brick_count, uint32_t entry_bytes) {
+    if (r.remaining() == uint64_t(brick_count) * entry_bytes) return Status::Ok();
+    return DataLossError("{} {} @0x{:x}: {} bytes of entries, expected {} bricks x {} = {}", name,
+                         table, r.file_pos(), r.remaining(), brick_count, entry_bytes,
+                         uint64_t(brick_count) * entry_bytes);
+}
+
+/// Reads the prefix of a table with an entry per brick (u32 entry size, u32 brick count) and checks
+/// both: the entry size within [`min_entry`, kMaxHeaderBytes], the count the header's and
+/// `entries`'. Errors name the store, the table and its offset. Returns the entry size.
+StatusOr<uint32_t> ReadBrickTablePrefix(ByteReader& r, const RawHeader& h, const std::string& name,
+                                        const char* table, uint64_t offset, uint32_t min_entry,
+                                        size_t entries) {
+    uint32_t entry_bytes = 0, brick_count = 0;
+    NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
+    NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
+    if (entry_bytes < min_entry || entry_bytes > kMaxHeaderBytes) {
+        return DataLossError("{} {} @0x{:x}: entry size {} out of range [{}, {}]", name, table,
+                             offset, entry_bytes, min_entry, kMaxHeaderBytes);
+    }
+    if (brick_count != h.brick_count || brick_count != entries) {
+        return DataLossError("{} {} @0x{:x}: the table has {} bricks, the header says {}", name,
+                             table, offset, brick_count, h.brick_count);
+    }
+    return entry_bytes;
+}
+
 }  // namespace
 
 void ByteWriter::PutBounds(const Bounds3f& b) {
@@ -324,7 +367,6 @@ std::string EncodeDirectory(const std::vector<RawBrickEntry>& entries) {
 StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, const RawHeader& h,
                                                      const std::string& name) {
     std::vector<RawBrickEntry> entries(h.brick_count);
-    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
     for (uint32_t i = 0; i < h.brick_count; ++i) {
         const uint64_t entry_offset = h.directory.offset + uint64_t(i) * h.directory_entry_bytes;
         ByteReader r(bytes.substr(size_t(i) * h.directory_entry_bytes, h.directory_entry_bytes),
@@ -348,14 +390,9 @@ StatusOr<std::vector<RawBrickEntry>> DecodeDirectory(std::string_view bytes, con
         for (const auto& [what, s] :
              {std::pair<const char*, const SectionInfo*>{"mesh", &e.info.mesh},
               std::pair<const char*, const SectionInfo*>{"side", &e.info.side}}) {
-            if (s->length == 0) continue;
-            if (s->offset < h.header_bytes || s->offset > payload_end ||
-                s->length > payload_end - s->offset) {
-                return DataLossError(
-                    "{} brick {} @0x{:x}: {} section [0x{:x}, +{}) lies outside the payload area "
-                    "[0x{:x}, 0x{:x})",
-                    name, i, entry_offset, what, s->offset, s->length, h.header_bytes, payload_end);
-            }
+            if (s->length > 0 && !InPayloadArea(*s, h))
+                return OutsidePayloadArea(
+                    *s, h, fmt::format("{} brick {} @0x{:x}: {} ", name, i, entry_offset, what));
         }
         if (e.info.mesh.length == 0 && e.info.triangle_count > 0) {
             return DataLossError("{} brick {} @0x{:x}: {} triangles but no mesh section", name, i,
@@ -435,26 +472,6 @@ std::string EncodeLevels(const std::vector<RawBrickEntry>& entries) {
     return std::move(w.bytes());
 }
 
-/// Reads the prefix of a table with an entry per brick (u32 entry size, u32 brick count) and checks
-/// both: the entry size within [`min_entry`, kMaxHeaderBytes], the count the header's and
-/// `entries`'. Errors name the store, the table and its offset. Returns the entry size.
-StatusOr<uint32_t> ReadBrickTablePrefix(ByteReader& r, const RawHeader& h, const std::string& name,
-                                        const char* table, uint64_t offset, uint32_t min_entry,
-                                        size_t entries) {
-    uint32_t entry_bytes = 0, brick_count = 0;
-    NAVE_RETURN_IF_ERROR(r.Get(&entry_bytes));
-    NAVE_RETURN_IF_ERROR(r.Get(&brick_count));
-    if (entry_bytes < min_entry || entry_bytes > kMaxHeaderBytes) {
-        return DataLossError("{} {} @0x{:x}: entry size {} out of range [{}, {}]", name, table,
-                             offset, entry_bytes, min_entry, kMaxHeaderBytes);
-    }
-    if (brick_count != h.brick_count || brick_count != entries) {
-        return DataLossError("{} {} @0x{:x}: the table has {} bricks, the header says {}", name,
-                             table, offset, brick_count, h.brick_count);
-    }
-    return entry_bytes;
-}
-
 Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::string& name,
                     std::vector<RawBrickEntry>* entries) {
     ByteReader r(bytes, name + " levels", h.levels.offset);
@@ -462,7 +479,6 @@ Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::strin
                           ReadBrickTablePrefix(r, h, name, "levels", h.levels.offset,
                                                kLevelEntryBytes, entries->size()));
     const uint32_t brick_count = h.brick_count;
-    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
     for (uint32_t i = 0; i < brick_count; ++i) {
         BrickInfo& b = (*entries)[i].info;
         uint32_t count = 0;
@@ -511,13 +527,9 @@ Status DecodeLevels(std::string_view bytes, const RawHeader& h, const std::strin
                     "vertices and {} triangles",
                     name, i, k, at, l.decoded_bytes, expected, l.vertex_count, l.triangle_count);
             }
-            if (l.mesh.length == 0 || l.mesh.offset < h.header_bytes ||
-                l.mesh.offset > payload_end || l.mesh.length > payload_end - l.mesh.offset) {
-                return DataLossError(
-                    "{} brick {} level {} @0x{:x}: mesh section [0x{:x}, +{}) lies outside the "
-                    "payload area [0x{:x}, 0x{:x})",
-                    name, i, k, at, l.mesh.offset, l.mesh.length, h.header_bytes, payload_end);
-            }
+            if (l.mesh.length == 0 || !InPayloadArea(l.mesh, h))
+                return OutsidePayloadArea(
+                    l.mesh, h, fmt::format("{} brick {} level {} @0x{:x}: mesh ", name, i, k, at));
         }
     }
     if (r.remaining() != 0) {
@@ -544,27 +556,16 @@ Status DecodeOccupancy(std::string_view bytes, const RawHeader& h, const std::st
                           ReadBrickTablePrefix(r, h, name, "occupancy", h.occupancy.offset,
                                                kOccupancyEntryBytes, entries->size()));
     const uint32_t brick_count = h.brick_count;
-    if (r.remaining() != uint64_t(brick_count) * entry_bytes) {
-        return DataLossError(
-            "{} occupancy @0x{:x}: {} bytes of entries, expected {} bricks x {} = {}", name,
-            r.file_pos(), r.remaining(), brick_count, entry_bytes,
-            uint64_t(brick_count) * entry_bytes);
-    }
-    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    NAVE_RETURN_IF_ERROR(CheckEntriesFill(r, name, "occupancy", brick_count, entry_bytes));
     for (uint32_t i = 0; i < brick_count; ++i) {
         SectionInfo& section = (*entries)[i].info.occupancy;
         const uint64_t at = r.file_pos();
         const size_t start = r.pos();
         NAVE_RETURN_IF_ERROR(GetSection(r, &section));
         NAVE_RETURN_IF_ERROR(r.Skip(entry_bytes - (r.pos() - start)));
-        if (section.length == 0) continue;
-        if (section.offset < h.header_bytes || section.offset > payload_end ||
-            section.length > payload_end - section.offset) {
-            return DataLossError(
-                "{} brick {} occupancy @0x{:x}: section [0x{:x}, +{}) lies outside the payload "
-                "area [0x{:x}, 0x{:x})",
-                name, i, at, section.offset, section.length, h.header_bytes, payload_end);
-        }
+        if (section.length > 0 && !InPayloadArea(section, h))
+            return OutsidePayloadArea(section, h,
+                                      fmt::format("{} brick {} occupancy @0x{:x}: ", name, i, at));
     }
     return Status::Ok();
 }
@@ -599,12 +600,7 @@ Status DecodeMedium(std::string_view bytes, const RawHeader& h, const std::strin
     NAVE_RETURN_IF_ERROR(r.GetString(grid_name));
     if (grid_name->empty())
         return DataLossError("{} medium @0x{:x}: the table names no grid", name, h.medium.offset);
-    if (r.remaining() != uint64_t(brick_count) * entry_bytes) {
-        return DataLossError("{} medium @0x{:x}: {} bytes of entries, expected {} bricks x {} = {}",
-                             name, r.file_pos(), r.remaining(), brick_count, entry_bytes,
-                             uint64_t(brick_count) * entry_bytes);
-    }
-    const uint64_t payload_end = h.provenance.offset;  // tables start right after the payloads
+    NAVE_RETURN_IF_ERROR(CheckEntriesFill(r, name, "medium", brick_count, entry_bytes));
     for (uint32_t i = 0; i < brick_count; ++i) {
         BrickMediumInfo& m = (*entries)[i].info.medium;
         const uint64_t at = r.file_pos();
@@ -625,13 +621,9 @@ Status DecodeMedium(std::string_view bytes, const RawHeader& h, const std::strin
             }
             continue;
         }
-        if (m.grid.offset < h.header_bytes || m.grid.offset > payload_end ||
-            m.grid.length > payload_end - m.grid.offset) {
-            return DataLossError(
-                "{} brick {} medium @0x{:x}: section [0x{:x}, +{}) lies outside the payload area "
-                "[0x{:x}, 0x{:x})",
-                name, i, at, m.grid.offset, m.grid.length, h.header_bytes, payload_end);
-        }
+        if (!InPayloadArea(m.grid, h))
+            return OutsidePayloadArea(m.grid, h,
+                                      fmt::format("{} brick {} medium @0x{:x}: ", name, i, at));
         if (m.active_voxels == 0 || !std::isfinite(m.max_density) || m.max_density < 0) {
             return DataLossError(
                 "{} brick {} medium @0x{:x}: {} voxels, majorant {} (expected at least 1 voxel "

@@ -57,6 +57,14 @@ struct Store::Impl {
         NAVE_RETURN_IF_ERROR(ReadSectionInto(id, what, s, bytes.data()));
         return bytes;
     }
+
+    /// Brick `id`'s entry, or NotFound for a brick that does not exist.
+    StatusOr<const BrickInfo*> Brick(uint32_t id) const {
+        if (id >= bricks.size())
+            return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", name, id,
+                                 bricks.size());
+        return &bricks[id];
+    }
 };
 
 namespace {
@@ -179,11 +187,8 @@ uint64_t Store::bytes_read() const { return impl_->bytes_read.load(std::memory_o
 
 StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
     const Impl& s = *impl_;
-    if (id >= s.bricks.size()) {
-        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
-                             s.bricks.size());
-    }
-    const BrickInfo& info = s.bricks[id];
+    NAVE_ASSIGN_OR_RETURN(const BrickInfo* brick, s.Brick(id));
+    const BrickInfo& info = *brick;
     if (level > info.levels.size()) {
         return NotFoundError("{}: brick {} has no level {} (its levels are 0 to {})", s.name, id,
                              level, info.levels.size());
@@ -217,11 +222,8 @@ StatusOr<BrickMesh> Store::ReadBrick(uint32_t id, uint32_t level) const {
 
 StatusOr<std::vector<std::byte>> Store::ReadBrickMedium(uint32_t id) const {
     const Impl& s = *impl_;
-    if (id >= s.bricks.size()) {
-        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
-                             s.bricks.size());
-    }
-    const SectionInfo& section = s.bricks[id].medium.grid;
+    NAVE_ASSIGN_OR_RETURN(const BrickInfo* brick, s.Brick(id));
+    const SectionInfo& section = brick->medium.grid;
     if (section.length == 0) {
         return NotFoundError("{}: brick {} holds no piece of a medium{}", s.name, id,
                              s.header.medium_grid.empty() ? " (the store has none)" : "");
@@ -233,11 +235,8 @@ StatusOr<std::vector<std::byte>> Store::ReadBrickMedium(uint32_t id) const {
 
 StatusOr<OccupancyGrid> Store::ReadBrickOccupancy(uint32_t id) const {
     const Impl& s = *impl_;
-    if (id >= s.bricks.size()) {
-        return NotFoundError("{}: brick {} does not exist (the store has {} bricks)", s.name, id,
-                             s.bricks.size());
-    }
-    const SectionInfo& section = s.bricks[id].occupancy;
+    NAVE_ASSIGN_OR_RETURN(const BrickInfo* brick, s.Brick(id));
+    const SectionInfo& section = brick->occupancy;
     if (section.length == 0) return NotFoundError("{}: brick {} has no occupancy grid", s.name, id);
     NAVE_ASSIGN_OR_RETURN(std::string bytes, s.ReadSection(id, "occupancy", section));
     return OccupancyGrid::Decode(
