@@ -40,6 +40,7 @@ BrickSource::BrickSource(std::shared_ptr<EmbreeDevice> device, store::BrickTree 
       level_errors_(cells_.size(), 0.f) {
     slots_.reserve(cells_.size());
     for (size_t i = 0; i < cells_.size(); ++i) slots_.push_back(std::make_unique<Slot>());
+    occupancy_ = std::make_unique<BrickOccupancy[]>(cells_.size());
 }
 
 uint32_t BrickSource::LevelsOf(uint32_t brick) const {
@@ -81,7 +82,10 @@ BrickSource::~BrickSource() = default;
 
 void BrickSource::SetOccupancy(std::vector<std::unique_ptr<const store::OccupancyGrid>> grids) {
     NAVE_CHECK_EQ(grids.size(), size_t(brick_count()));
-    known_occupancy_ = std::move(grids);
+    for (uint32_t b = 0; b < brick_count_; ++b) {
+        occupancy_[b].owned = std::move(grids[b]);
+        occupancy_[b].grid.store(occupancy_[b].owned.get(), std::memory_order_release);
+    }
     occupancy_known_ = true;
 }
 
@@ -177,12 +181,15 @@ StatusOr<BrickHandle> BrickSource::Acquire(uint32_t id) {
         return slot.error;
     }
     slot.brick = std::move(built).value();
-    if (LevelOfSlot(id) == 0 && slot.occupancy_owned == nullptr &&
-        make_occupancy_.load(std::memory_order_relaxed)) {
-        const ResidentMesh& m = slot.brick->mesh();
-        slot.occupancy_owned = std::make_unique<const store::OccupancyGrid>(
-            store::OccupancyGrid::Of(m.positions, m.indices));
-        slot.occupancy.store(slot.occupancy_owned.get(), std::memory_order_release);
+    if (LevelOfSlot(id) == 0 && make_occupancy_.load(std::memory_order_relaxed)) {
+        // Level 0's slot lock is held: one writer per brick.
+        BrickOccupancy& o = occupancy_[BrickOfSlot(id)];
+        if (o.owned == nullptr) {
+            const ResidentMesh& m = slot.brick->mesh();
+            o.owned = std::make_unique<const store::OccupancyGrid>(
+                store::OccupancyGrid::Of(m.positions, m.indices));
+            o.grid.store(o.owned.get(), std::memory_order_release);
+        }
     }
     {
         std::lock_guard<std::mutex> stats_lock(stats_mutex_);

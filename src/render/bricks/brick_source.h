@@ -136,8 +136,7 @@ class BrickSource {
     /// null before. Kept when the brick is evicted: store::OccupancyGrid::kMemoryBytes per brick,
     /// counted by the memory plan. Thread-safe.
     const store::OccupancyGrid* Occupancy(uint32_t brick) const {
-        if (occupancy_known_) return known_occupancy_[brick].get();
-        return slots_[brick]->occupancy.load(std::memory_order_acquire);
+        return occupancy_[brick].grid.load(std::memory_order_acquire);
     }
     /// The Embree device the bricks are built on (for small auxiliary scenes, like the photon
     /// portals).
@@ -221,10 +220,12 @@ class BrickSource {
         std::unique_ptr<ResidentBrick> brick;
         std::atomic<uint32_t> pins{0};
         Status error;  // sticky load error
-        // Level 0's only: where the full mesh has triangles, made at its first load and kept
-        // through evictions (Occupancy).
-        std::unique_ptr<const store::OccupancyGrid> occupancy_owned;
-        std::atomic<const store::OccupancyGrid*> occupancy{nullptr};
+    };
+    // A brick's occupancy grid (Occupancy): set before rendering (SetOccupancy) or made at its
+    // first full-detail load (MakeOccupancyGrids), and kept through evictions.
+    struct BrickOccupancy {
+        std::unique_ptr<const store::OccupancyGrid> owned;
+        std::atomic<const store::OccupancyGrid*> grid{nullptr};
     };
     std::shared_ptr<EmbreeDevice> device_;
     store::BrickTree tree_;
@@ -238,8 +239,8 @@ class BrickSource {
     int decode_limit_ = 0;
     std::atomic<bool> make_occupancy_{false};  // MakeOccupancyGrids
     bool occupancy_known_ = false;             // every brick's grid set before rendering
-    // SetOccupancy's grids, by brick (apart from the slots, which UseLevels makes again).
-    std::vector<std::unique_ptr<const store::OccupancyGrid>> known_occupancy_;
+    // By brick, apart from the slots (which UseLevels makes again).
+    std::unique_ptr<BrickOccupancy[]> occupancy_;
     std::optional<float> medium_scale_;  // UseStoredMedium's
     std::mutex decode_mutex_;            // with decode_cv_: counts decodes_ under decode_limit_
     std::condition_variable decode_cv_;
