@@ -90,6 +90,11 @@ StatusOr<std::unique_ptr<TestScene>> BuildTestScene(std::unique_ptr<BrickSource>
     return t;
 }
 
+std::string ConfigError(const std::string& config_text, const std::string& file) {
+    StatusOr<SceneConfig> c = ParseSceneConfig(config_text, file);
+    return c.ok() ? std::string() : std::string(c.status().message());
+}
+
 std::string LampSceneError(const std::string& config_text, const std::string& file) {
     StatusOr<SceneConfig> config = ParseSceneConfig(config_text, file);
     EXPECT_TRUE(config.ok()) << config.status().message();

@@ -130,6 +130,9 @@ struct TestScene {
 StatusOr<std::unique_ptr<TestScene>> BuildTestScene(std::unique_ptr<BrickSource> source,
                                                     SceneConfig config);
 
+/// The error of parsing `config_text` as file `file` ("" if it parses).
+std::string ConfigError(const std::string& config_text, const std::string& file);
+
 /// The error of building a scene of LampMesh (one brick, material "lamp") from `config_text`, read
 /// as file `file` ("" if it builds). A config that does not parse fails the test and gives "".
 std::string LampSceneError(const std::string& config_text, const std::string& file);
