@@ -1,9 +1,12 @@
 // `nave`: one executable, one subcommand per tool. Exit codes: 0 success, 1 bad data or failed
 // work, 2 bad usage (unknown option, invalid argument), 130 interrupted.
 
+#include <oneapi/tbb/global_control.h>
+
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <new>
 #include <string>
 
 #include "src/cli/commands.h"
@@ -88,7 +91,12 @@ int main(int argc, char** argv) {
         nave::log::SetLevel(nave::log::Level::kDebug);
     }
     if (!run) return 0;
+    // TBB's worker threads otherwise end on their own after main returns, while exit's handlers
+    // run; joining them here ends the process with one thread (LeakSanitizer's exit-time check,
+    // which stops every thread, crashed on a worker ending under it).
+    oneapi::tbb::task_scheduler_handle tbb_workers{oneapi::tbb::attach{}};
     nave::Status status = run();
+    oneapi::tbb::finalize(tbb_workers, std::nothrow);
     if (!status.ok()) {
         const std::string rank = nave::cli::RankName();
         std::fprintf(stderr, "nave: error%s: %s\n", rank.empty() ? "" : (" on " + rank).c_str(),

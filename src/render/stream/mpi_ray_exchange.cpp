@@ -73,6 +73,9 @@ struct MpiRayExchange::Impl {
     StatusOr<bool> CompleteSends(std::deque<Posted>& list);
     // Receives and queues every message that has arrived; returns whether any did.
     StatusOr<bool> Receive();
+    // Completes the receipt of a probed message of `bytes` from `source` into receive_buffer,
+    // within the stall timeout.
+    Status ReceiveMatched(MPI_Message* matched, int bytes, int source);
     // One step of progress with nothing else to do: sends and receipts.
     StatusOr<bool> Step();
     // Progress reports: a rank other than 0 sends what its bar gained since its last report (at
@@ -247,16 +250,15 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
     while (true) {
         int arrived = 0;
         MPI_Status status;
-        NAVE_RETURN_IF_ERROR(MpiStatus(
-            MPI_Iprobe(MPI_ANY_SOURCE, kRaysTag, rays_comm, &arrived, &status), "MPI_Iprobe"));
+        MPI_Message matched = MPI_MESSAGE_NULL;
+        NAVE_RETURN_IF_ERROR(
+            MpiStatus(MPI_Improbe(MPI_ANY_SOURCE, kRaysTag, rays_comm, &arrived, &matched, &status),
+                      "MPI_Improbe"));
         if (!arrived) return any;
         int bytes = 0;
         NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Get_count(&status, MPI_BYTE, &bytes), "MPI_Get_count"));
         receive_buffer.resize(size_t(std::max(bytes, 0)));
-        NAVE_RETURN_IF_ERROR(
-            MpiStatus(MPI_Recv(receive_buffer.data(), bytes, MPI_BYTE, status.MPI_SOURCE, kRaysTag,
-                               rays_comm, MPI_STATUS_IGNORE),
-                      "MPI_Recv"));
+        NAVE_RETURN_IF_ERROR(ReceiveMatched(&matched, bytes, status.MPI_SOURCE));
         const std::string what =
             fmt::format("rays from rank {} to rank {}", status.MPI_SOURCE, rank);
         std::span<const std::byte> message = receive_buffer;
@@ -308,6 +310,27 @@ Status MpiRayExchange::Impl::Report(bool now) {
     last_report = std::chrono::steady_clock::now();
     ++reports_sent;
     return Status::Ok();
+}
+
+Status MpiRayExchange::Impl::ReceiveMatched(MPI_Message* matched, int bytes, int source) {
+    // Not MPI_Mrecv: a large message comes in pieces that its sender pushes as it progresses, and
+    // a sender stopped mid-message would hold a blocking receive (and this rank's timeout) forever.
+    MPI_Request request = MPI_REQUEST_NULL;
+    NAVE_RETURN_IF_ERROR(MpiStatus(
+        MPI_Imrecv(receive_buffer.data(), bytes, MPI_BYTE, matched, &request), "MPI_Imrecv"));
+    const auto start = std::chrono::steady_clock::now();
+    for (int spins = 0;; ++spins) {
+        int done = 0;
+        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
+        if (done) return Status::Ok();
+        if (options.stall_timeout_s > 0 && SecondsSince(start) > options.stall_timeout_s) {
+            return InternalError(
+                "rank {} of {} waited {:.0f} s for the rest of a batch of rays from rank {}, and "
+                "it never came: that rank has stopped or hangs (--rank-timeout sets this wait)",
+                rank, size, SecondsSince(start), source);
+        }
+        if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
 }
 
 Status MpiRayExchange::Impl::ReceiveReports() {
