@@ -11,6 +11,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <numeric>
 #include <thread>
 
@@ -399,17 +401,24 @@ TEST_F(PagerTest, ForEachBrickVisitsEveryBrickInOrderWithTheLoadersAhead) {
     EXPECT_EQ(last, 3u);
 }
 
-// Eviction order: emptiest queue first, least recently used on ties; pinned bricks stay.
-TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
-    auto source = BallGridSource();
-    // Four bricks of the same size: balls (1, 1), (1, 2), (2, 1), (2, 2) have the same triangles.
-    std::vector<uint32_t> same;
+// The largest bricks of the ball grid that share one estimated size, at least four of them (balls
+// (1, 1), (1, 2), (2, 1), (2, 2) have the same triangles): two of them make a budget that passes
+// the pager's minimum.
+std::vector<uint32_t> BricksOfOneSize(const BrickSource& source) {
     std::map<uint64_t, std::vector<uint32_t>> by_size;
-    for (uint32_t b = 0; b < source->brick_count(); ++b)
-        by_size[source->EstimatedResidentBytes(b)].push_back(b);
+    for (uint32_t b = 0; b < source.brick_count(); ++b)
+        by_size[source.EstimatedResidentBytes(b)].push_back(b);
+    std::vector<uint32_t> same;
     for (const auto& [bytes, ids] : by_size) {
         if (ids.size() >= 4) same = ids;
     }
+    return same;
+}
+
+// Eviction order: emptiest queue first, least recently used on ties; pinned bricks stay.
+TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
+    auto source = BallGridSource();
+    const std::vector<uint32_t> same = BricksOfOneSize(*source);
     ASSERT_GE(same.size(), 4u);
     const uint64_t size = source->EstimatedResidentBytes(same[0]);
     std::vector<size_t> waiting(source->brick_count(), 0);
@@ -448,6 +457,73 @@ TEST_F(PagerTest, EvictsEmptiestThenLeastRecentlyUsedAndNeverPinned) {
     EXPECT_EQ(s.loads, 5u);
     EXPECT_EQ(s.reloads, 1u);
     EXPECT_LE(s.peak_resident_bytes, options.brick_budget_bytes);
+}
+
+// What a loader prefetched stays until the scheduler has traced it, unless the brick a prefetch
+// makes room for has more rays waiting: two loaders otherwise took turns loading and evicting the
+// same nearly empty bricks. The scheduler's own loads may evict any unpinned brick.
+TEST_F(PagerTest, APrefetchKeepsAFreshBrickForABrickWithNoMoreRays) {
+    auto source = BallGridSource();
+    const std::vector<uint32_t> same = BricksOfOneSize(*source);
+    ASSERT_GE(same.size(), 4u);
+    const uint32_t a = same[0], b = same[1], c = same[2], d = same[3];
+    std::mutex mutex;  // the loader reads the queues too
+    std::vector<size_t> waiting(source->brick_count(), 0);
+    PagerOptions options;
+    options.loaders = 1;
+    options.brick_budget_bytes = 2 * source->EstimatedResidentBytes(a);
+    auto pager = Pager::Create(*source, options, [&](uint32_t id) {
+        std::lock_guard<std::mutex> lock(mutex);
+        return waiting[id];
+    });
+    ASSERT_TRUE(pager.ok()) << pager.status().ToString();
+    auto set_waiting = [&](uint32_t id, size_t rays) {
+        std::lock_guard<std::mutex> lock(mutex);
+        waiting[id] = rays;
+    };
+    // The scheduler's view for a prefetch names one brick, so that the loader loads that one.
+    auto prefetch = [&](uint32_t id, size_t rays) {
+        set_waiting(id, rays);
+        std::vector<size_t> view(waiting.size(), 0);
+        view[id] = rays;
+        (*pager)->Prefetch(view, store::kNoBrick, 0);
+    };
+    auto resident_soon = [&](uint32_t id) {
+        for (int i = 0; i < 2000 && !source->IsResident(id); ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        return source->IsResident(id);
+    };
+    ASSERT_TRUE((*pager)->Acquire(a).ok());  // traced by the scheduler, then unpinned
+    set_waiting(a, 100);                     // every queue here is nearly empty
+    prefetch(b, 50);
+    ASSERT_TRUE(resident_soon(b));
+    // c (40 rays) needs room: b is emptier than a but fresh, with more rays than c.
+    prefetch(c, 40);
+    ASSERT_TRUE(resident_soon(c));
+    EXPECT_FALSE(source->IsResident(a));
+    EXPECT_TRUE(source->IsResident(b));
+    // d (45 rays) may evict the fresh c (40), not b (50).
+    set_waiting(a, 0);
+    prefetch(d, 45);
+    ASSERT_TRUE(resident_soon(d));
+    EXPECT_FALSE(source->IsResident(c));
+    EXPECT_TRUE(source->IsResident(b));
+    // c again, with fewer rays than either fresh brick: the loader waits instead of taking turns
+    // with itself.
+    prefetch(c, 40);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_FALSE(source->IsResident(c));
+    EXPECT_TRUE(source->IsResident(b) && source->IsResident(d));
+    // The scheduler traces b: at the batch's end the loader may evict it for c.
+    ASSERT_TRUE((*pager)->Acquire(b).ok());
+    (*pager)->BatchDone();
+    ASSERT_TRUE(resident_soon(c));
+    EXPECT_FALSE(source->IsResident(b));
+    EXPECT_TRUE(source->IsResident(d));
+    // A load the scheduler cannot avoid evicts a fresh brick all the same.
+    ASSERT_TRUE((*pager)->Acquire(a).ok());
+    EXPECT_TRUE(source->IsResident(a));
+    EXPECT_LE((*pager)->stats().peak_resident_bytes, options.brick_budget_bytes);
 }
 
 TEST_F(PagerTest, PickPrefersAResidentBrickWithEnoughRays) {

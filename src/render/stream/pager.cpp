@@ -207,6 +207,7 @@ Pager::Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting
       traffic_(source.slot_count(), 0),
       load_count_(source.slot_count(), 0),
       kept_(source.slot_count(), false),
+      unused_prefetch_(source.slot_count(), false),
       prefetch_current_(store::kNoBrick) {
     estimate_.reserve(source.slot_count());
     for (uint32_t b = 0; b < source.slot_count(); ++b)
@@ -331,18 +332,19 @@ void Pager::Loaded(uint32_t id, uint64_t bytes, bool prefetched) {
                 id, bytes, bytes_[id]);
         }
         // Keep the budget on real numbers: make up for the difference at once.
-        MakeRoom(0, id, false);
+        MakeRoom(0, id, std::nullopt);
     }
     state_[id] = State::kResident;
     bytes_[id] = bytes;
     last_used_[id] = ++tick_;
+    unused_prefetch_[id] = prefetched;
     stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, committed_bytes_);
     ++stats_.loads;
     if (prefetched) ++stats_.prefetch_loads;
     if (++load_count_[id] > 1) ++stats_.reloads;
 }
 
-bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
+bool Pager::MakeRoom(uint64_t need, uint32_t exclude, std::optional<size_t> for_prefetch_of_rays) {
     const uint64_t budget = options_.brick_budget_bytes;
     if (committed_bytes_ + need <= budget) return true;
     struct Candidate {
@@ -355,7 +357,14 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only) {
     for (uint32_t b = 0; b < state_.size(); ++b) {
         if (state_[b] != State::kResident || b == exclude || kept_[b]) continue;
         size_t w = waiting_ ? waiting_(b) : 0;
-        if (nearly_empty_only && w >= options_.nearly_empty_rays) continue;
+        const bool prefetch = for_prefetch_of_rays.has_value();
+        if (prefetch && w >= options_.nearly_empty_rays) continue;
+        // Nor does a prefetch evict what a prefetch loaded and nobody has traced yet for a brick
+        // with no more rays waiting: the fresh brick's load has not paid for itself, and the new
+        // one would pay less. Loaders evicting each other's fresh bricks (a thousand rays each)
+        // took turns loading the same three bricks twenty times over while the scheduler drained
+        // other bricks (docs/pager.md, "Policy").
+        if (prefetch && unused_prefetch_[b] && w >= *for_prefetch_of_rays) continue;
         // Nearly empty queues count as empty when traffic decides: their few rays matter less than
         // how busy the brick is.
         const bool by_traffic = options_.evict == PagerOptions::Evict::kTraffic;
@@ -390,6 +399,7 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
     const auto start = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
     last_used_[id] = ++tick_;
+    unused_prefetch_[id] = false;
     ++stats_.acquires;
     if (state_[id] == State::kResident) ++stats_.resident_hits;
     bool waited = false;
@@ -414,7 +424,7 @@ StatusOr<BrickHandle> Pager::Acquire(uint32_t id) {
             }
         }
         const uint64_t need = estimate_[id];
-        if (!MakeRoom(need, id, false)) {
+        if (!MakeRoom(need, id, std::nullopt)) {
             const bool loader_loading =
                 std::any_of(loaders_.begin(), loaders_.end(), [&](const Loader& l) {
                     return l.target != store::kNoBrick && l.target != id &&
@@ -527,7 +537,7 @@ void Pager::LoaderLoop(size_t index) {
         bool reserved = false;
         for (;;) {
             if (stop_ || self.cancel) break;  // given up, or taken over by the scheduler
-            if (!scheduler_needs_room_ && MakeRoom(need, target, true)) {
+            if (!scheduler_needs_room_ && MakeRoom(need, target, prefetch_waiting_[target])) {
                 Reserve(target, need);
                 reserved = true;
                 break;

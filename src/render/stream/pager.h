@@ -15,6 +15,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -202,9 +203,10 @@ class Pager {
     enum class State : uint8_t { kAbsent, kLoading, kResident };
     Pager(BrickSource& source, const PagerOptions& options, WaitingFn waiting);
     /// Evicts resident, unpinned bricks other than `exclude` until `need` more bytes fit; with
-    /// `nearly_empty_only`, only bricks whose queue is nearly empty. Returns whether they fit.
-    /// Holds mutex_.
-    bool MakeRoom(uint64_t need, uint32_t exclude, bool nearly_empty_only);
+    /// `for_prefetch_of_rays` (a prefetch, for a brick with that many rays waiting), only bricks
+    /// whose queue is nearly empty, and of those a brick a prefetch loaded and nobody has traced
+    /// since only if fewer rays wait for it. Returns whether they fit. Holds mutex_.
+    bool MakeRoom(uint64_t need, uint32_t exclude, std::optional<size_t> for_prefetch_of_rays);
     /// Records a finished load of `id` (real size `bytes`). Holds mutex_.
     void Loaded(uint32_t id, uint64_t bytes, bool prefetched);
     void Reserve(uint32_t id, uint64_t bytes);
@@ -232,6 +234,8 @@ class Pager {
     std::vector<uint64_t> traffic_;    // rays taken from the brick's queue so far
     std::vector<uint32_t> load_count_;
     std::vector<bool> kept_;  // KeptResident: never evicted
+    std::vector<bool>
+        unused_prefetch_;  // loaded by a loader, not acquired since: prefetches keep it
     uint64_t tick_ = 0;
     uint64_t committed_bytes_ = 0;
     // The last Prefetch call's view: rays waiting per brick and the brick being traced. Loaders
