@@ -318,19 +318,12 @@ Status MpiRayExchange::Impl::ReceiveMatched(MPI_Message* matched, int bytes, int
     MPI_Request request = MPI_REQUEST_NULL;
     NAVE_RETURN_IF_ERROR(MpiStatus(
         MPI_Imrecv(receive_buffer.data(), bytes, MPI_BYTE, matched, &request), "MPI_Imrecv"));
-    const auto start = std::chrono::steady_clock::now();
-    for (int spins = 0;; ++spins) {
-        int done = 0;
-        NAVE_RETURN_IF_ERROR(MpiStatus(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test"));
-        if (done) return Status::Ok();
-        if (options.stall_timeout_s > 0 && SecondsSince(start) > options.stall_timeout_s) {
-            return InternalError(
-                "rank {} of {} waited {:.0f} s for the rest of a batch of rays from rank {}, and "
-                "it never came: that rank has stopped or hangs (--rank-timeout sets this wait)",
-                rank, size, SecondsSince(start), source);
-        }
-        if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
-    }
+    return WaitForRequest(&request, options.stall_timeout_s, [&](double waited) {
+        return InternalError(
+            "rank {} of {} waited {:.0f} s for the rest of a batch of rays from rank {}, and it "
+            "never came: that rank has stopped or hangs (--rank-timeout sets this wait)",
+            rank, size, waited, source);
+    });
 }
 
 Status MpiRayExchange::Impl::ReceiveReports() {

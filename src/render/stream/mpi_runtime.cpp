@@ -63,7 +63,8 @@ void MpiRuntime::AbortAll(int exit_code) {
     std::abort();  // MPI_Abort does not return; if it did, this rank still ends
 }
 
-Status WaitForCollective(MPI_Request* request, const char* what, MPI_Comm comm, double timeout_s) {
+Status WaitForRequest(MPI_Request* request, double timeout_s,
+                      const std::function<Status(double waited_s)>& timed_out) {
     const auto start = std::chrono::steady_clock::now();
     for (int spins = 0;; ++spins) {
         int done = 0;
@@ -71,18 +72,23 @@ Status WaitForCollective(MPI_Request* request, const char* what, MPI_Comm comm, 
         if (done) return Status::Ok();
         const double waited =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (timeout_s > 0 && waited > timeout_s) {
-            int rank = 0, size = 0;
-            MPI_Comm_rank(comm, &rank);
-            MPI_Comm_size(comm, &size);
-            return InternalError(
-                "rank {} of {} waited {:.0f} s in {} for the other ranks, and one never came: a "
-                "rank has stopped or hangs (--rank-timeout sets this wait)",
-                rank, size, waited, what);
-        }
-        // The first spins answer a collective the others have all joined at once.
+        if (timeout_s > 0 && waited > timeout_s) return timed_out(waited);
+        // The first spins answer an operation that completes at once (a collective every rank
+        // has joined, a message already whole).
         if (spins > 1000) std::this_thread::sleep_for(std::chrono::microseconds(50));
     }
+}
+
+Status WaitForCollective(MPI_Request* request, const char* what, MPI_Comm comm, double timeout_s) {
+    return WaitForRequest(request, timeout_s, [&](double waited) {
+        int rank = 0, size = 0;
+        MPI_Comm_rank(comm, &rank);
+        MPI_Comm_size(comm, &size);
+        return InternalError(
+            "rank {} of {} waited {:.0f} s in {} for the other ranks, and one never came: a "
+            "rank has stopped or hangs (--rank-timeout sets this wait)",
+            rank, size, waited, what);
+    });
 }
 
 }  // namespace nave::render
