@@ -354,10 +354,10 @@ bool Pager::MakeRoom(uint64_t need, uint32_t exclude, std::optional<size_t> for_
         uint32_t id;
     };
     std::vector<Candidate> candidates;
+    const bool prefetch = for_prefetch_of_rays.has_value();
     for (uint32_t b = 0; b < state_.size(); ++b) {
         if (state_[b] != State::kResident || b == exclude || kept_[b]) continue;
         size_t w = waiting_ ? waiting_(b) : 0;
-        const bool prefetch = for_prefetch_of_rays.has_value();
         if (prefetch && w >= options_.nearly_empty_rays) continue;
         // Nor does a prefetch evict what a prefetch loaded and nobody has traced yet for a brick
         // with no more rays waiting: the fresh brick's load has not paid for itself, and the new

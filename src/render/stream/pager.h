@@ -234,8 +234,8 @@ class Pager {
     std::vector<uint64_t> traffic_;    // rays taken from the brick's queue so far
     std::vector<uint32_t> load_count_;
     std::vector<bool> kept_;  // KeptResident: never evicted
-    std::vector<bool>
-        unused_prefetch_;  // loaded by a loader, not acquired since: prefetches keep it
+    // Loaded by a loader and not acquired since: a prefetch evicts it only for a fuller brick.
+    std::vector<bool> unused_prefetch_;
     uint64_t tick_ = 0;
     uint64_t committed_bytes_ = 0;
     // The last Prefetch call's view: rays waiting per brick and the brick being traced. Loaders
