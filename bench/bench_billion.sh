@@ -5,11 +5,12 @@
 #
 #     bash bench/bench_billion.sh                      # detail 1250 (1.02 G triangles), 4G, 1920x1080
 #     bash bench/bench_billion.sh --detail 1 --resolution 160x107 --spp 1 --memory 1G   # the script in a minute
-#     bash bench/bench_billion.sh --levels --noise 0.05  # levels of detail, rendered until relMSE 0.05
+#     bash bench/bench_billion.sh --levels --noise 0.05 --time-limit 60m  # levels, until relMSE 0.05 or an hour
 #
 # Defaults: detail 1250, --memory 4G for both phases, configs/abbey.toml, path mode, 1920x1080, 4 spp.
 # --levels preprocesses with levels of detail (a store of its own, abbey<detail>-levels.nave) and renders
-# with --lod auto; --noise T renders until the estimated relMSE is at most T (--spp is then the most).
+# with --lod auto; --noise T renders until the estimated relMSE is at most T (--spp is then the most);
+# --time-limit D stops the render after D (nave render --time-limit: 20m, 1h).
 # Everything goes under --dir (default /tmp/nave-billion): the store of detail 1250 takes 988 MiB
 # (1.01 bytes per triangle), the preprocess's temporary files 17.8 GiB at their peak (1.45 GiB at
 # detail 110), the render's brick cache 17.4 GiB and its spill files a few hundred MiB. On a RAM file
@@ -27,6 +28,7 @@ dir=/tmp/nave-billion
 fresh=0
 levels=0
 noise=""
+time_limit=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --detail) detail=$2; shift 2 ;;
@@ -39,7 +41,8 @@ while [ $# -gt 0 ]; do
     --fresh) fresh=1; shift ;;
     --levels) levels=1; shift ;;
     --noise) noise=$2; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --time-limit) time_limit=$2; shift 2 ;;
+    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_billion.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -63,6 +66,7 @@ if [ "$levels" = 1 ]; then
   render_args+=(--lod auto)
 fi
 if [ -n "$noise" ]; then render_args+=(--noise "$noise"); fi
+if [ -n "$time_limit" ]; then render_args+=(--time-limit "$time_limit"); fi
 
 # field LOG LABEL: the value after "LABEL:" in /usr/bin/time -v's report.
 field() { grep -F "$2:" "$1" | tail -1 | sed 's/.*: //'; }

@@ -43,12 +43,15 @@ def main():
     ap.add_argument("--runs", default="1x2,2x1,4x1", help="RANKSxTHREADS, comma separated; 1x... is one process")
     ap.add_argument("--pack-rays", default="on", choices=["on", "off"],
                     help="nave render --pack-rays: LZ4 on the rays sent between ranks (default on)")
+    ap.add_argument("--coarse-levels-everywhere", default="on", choices=["on", "off"],
+                    help="nave render --coarse-levels-everywhere, with --levels: every rank traces the rays "
+                         "that meet the coarse levels it keeps (default on)")
     args = ap.parse_args()
     os.makedirs(args.dir, exist_ok=True)
     os.environ.update(MPI_ENV)
     log = open(os.path.join(args.dir, "mpi.log"), "a")
     store, config = nb.abbey_store_and_view(args.nave, args.dir, args.detail, args.store, args.config, args.view,
-                                            log)
+                                            log, args.levels)
     rows, reference = [], None
     for run in args.runs.split(","):
         ranks, threads = (int(x) for x in run.split("x"))
@@ -58,7 +61,8 @@ def main():
         if args.memory:
             cmd += ["--memory", args.memory]
         if ranks > 1:
-            cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd + ["--pack-rays", args.pack_rays]
+            cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd + [
+                "--pack-rays", args.pack_rays, "--coarse-levels-everywhere", args.coarse_levels_everywhere]
         t = nb.run_timed(cmd, log)
         stats = nb.read_statistics(out) if t.ok else {}
         same = ""

@@ -251,12 +251,14 @@ def worst_region_ratio(result):
     return worst
 
 
-def abbey_store_and_view(nave, out_dir, detail, store, config, view, log):
-    """The store to render (`store`, or the procedural abbey of `detail` generated into `out_dir` once) and a
-    config for `view` written beside it from `config`: -> (store path, config path)."""
-    store = store or os.path.join(out_dir, f"abbey{detail}.nave")
+def abbey_store_and_view(nave, out_dir, detail, store, config, view, log, levels=False):
+    """The store to render (`store`, or the procedural abbey of `detail` generated into `out_dir` once, with
+    levels of detail if `levels`) and a config for `view` written beside it from `config`: -> (store path,
+    config path)."""
+    store = store or os.path.join(out_dir, f"abbey{detail}{'-levels' if levels else ''}.nave")
     if not os.path.exists(store):
-        p = run_logged([nave, "preprocess", "--generate", f"abbey:detail={detail}", "-q", "-o", store], log)
+        p = run_logged([nave, "preprocess", "--generate", f"abbey:detail={detail}", "-q", "-o", store]
+                       + (["--levels"] if levels else []), log)
         if p.returncode != 0:
             raise SystemExit(f"preprocess failed: see {log.name}")
     view_config = os.path.join(out_dir, f"{view}.toml")
@@ -273,6 +275,8 @@ def add_abbey_run_arguments(ap, out_dir):
     ap.add_argument("--nave", default=default_nave())
     ap.add_argument("--dir", default=out_dir)
     ap.add_argument("--detail", type=int, default=30)
+    ap.add_argument("--levels", action="store_true",
+                    help="the abbey preprocessed with levels of detail (rendered with them: --lod auto)")
     ap.add_argument("--store", default="")
     ap.add_argument("--config", default="configs/abbey.toml")
     ap.add_argument("--view", default="nave")

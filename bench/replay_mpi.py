@@ -57,44 +57,60 @@ MESSAGE_BYTES = 1 << 20  # a message goes out once it holds this much (mpi_ray_e
 
 
 def read_trace_triangles(path):
-    """-> triangles per brick (from the trace's loads): what a render's first ownership divides (BrickOwners
-    cuts by estimated memory, which the triangles dominate)."""
+    """-> triangles per brick (from the trace's loads of full meshes, or of the finest level loaded where the
+    full mesh never was): what a render's first ownership divides (BrickOwners cuts by the full meshes'
+    estimated memory, which the triangles dominate)."""
     with open(path) as f:
         events = json.load(f)["traceEvents"]
     bricks = next(int(e["args"]["bricks"]) for e in events if e.get("name") == "bricks" and e.get("ph") == "i")
-    triangles = [0] * bricks
+    full, finest = [0] * bricks, [0] * bricks
     for e in events:
         if e.get("ph") == "X" and e.get("name") == "load" and "triangles" in e.get("args", {}):
-            triangles[int(e["args"]["brick"]) % bricks] = int(e["args"]["triangles"])
-    return triangles
+            slot, n = int(e["args"]["brick"]), int(e["args"]["triangles"])
+            if slot < bricks:  # level 0: the full mesh
+                full[slot] = n
+            else:
+                finest[slot % bricks] = max(finest[slot % bricks], n)
+    return [f or c for f, c in zip(full, finest)]
 
 
-def read_trace(path):
-    """-> (batch_us per brick, load_us per brick, sent[(from, to)] rays, depth-first order)."""
-    with open(path) as f:
-        events = json.load(f)["traceEvents"]
-    bricks, order = None, None
-    for e in events:
-        if e.get("name") == "bricks" and e.get("ph") == "i":
-            bricks = int(e["args"]["bricks"])
-            order = [int(b) for b in e["args"]["depth_first"].split()]
-    if bricks is None:
-        raise SystemExit(f"{path}: no 'bricks' event: trace a render of this version of nave (--trace)")
-    batch, load = [0.0] * bricks, [0.0] * bricks
-    sent = {}
-    for e in events:
-        if e.get("ph") != "X":
-            continue
-        if e.get("name") == "batch":
-            b = int(e["args"]["brick"]) % bricks  # a slot: levels of a brick count as the brick
-            batch[b] += float(e["dur"])
-            for pair in e["args"].get("sent", "").split():
-                to, n = pair.split(":")
-                key = (b, int(to))
-                sent[key] = sent.get(key, 0) + int(n)
-        elif e.get("name") == "load" and "brick" in e.get("args", {}):
-            load[int(e["args"]["brick"]) % bricks] += float(e["dur"])
-    return batch, load, sent, order
+class Trace:
+    """A traced render, slot by slot (a slot is a brick at a level of detail: slot = level x bricks + brick):
+    batch_us and load_us per slot, sent[(from slot, to slot)] rays, the bricks' depth-first order and the
+    slots the pager kept resident (which every rank holds with --coarse-levels-everywhere)."""
+
+    def __init__(self, path):
+        with open(path) as f:
+            events = json.load(f)["traceEvents"]
+        self.bricks, self.order, self.kept = None, None, set()
+        for e in events:
+            if e.get("name") == "bricks" and e.get("ph") == "i":
+                self.bricks = int(e["args"]["bricks"])
+                self.order = [int(b) for b in e["args"]["depth_first"].split()]
+                self.kept = {int(s) for s in e["args"].get("kept", "").split()}
+        if self.bricks is None:
+            raise SystemExit(f"{path}: no 'bricks' event: trace a render of this version of nave (--trace)")
+        self.batch_us, self.load_us, self.sent = {}, {}, {}
+        for e in events:
+            if e.get("ph") != "X":
+                continue
+            if e.get("name") == "batch":
+                s = int(e["args"]["brick"])
+                self.batch_us[s] = self.batch_us.get(s, 0.0) + float(e["dur"])
+                for pair in e["args"].get("sent", "").split():
+                    to, n = pair.split(":")
+                    key = (s, int(to))
+                    self.sent[key] = self.sent.get(key, 0) + int(n)
+            elif e.get("name") == "load" and "brick" in e.get("args", {}):
+                s = int(e["args"]["brick"])
+                self.load_us[s] = self.load_us.get(s, 0.0) + float(e["dur"])
+
+    def per_brick(self, per_slot):
+        """A per-slot dict summed brick by brick (the levels of a brick count as the brick)."""
+        out = [0.0] * self.bricks
+        for s, v in per_slot.items():
+            out[s % self.bricks] += v
+        return out
 
 
 def owners_by_work(order, work, ranks):
@@ -110,6 +126,26 @@ def owners_by_work(order, work, ranks):
     return owner
 
 
+def spread_of_shared_work(made, shared):
+    """Row r: the fraction of the rays rank r's bricks send into the kept slots that each rank traces
+    (SpreadOfSharedWork, brick_owners.h): ranks above the mean hand their excess, at most their shared work, to
+    the ranks below it in proportion to what each lacks."""
+    n = len(made)
+    mean = sum(made) / n
+    lacking = sum(max(0.0, mean - m) for m in made)
+    spread = [[1.0 if d == r else 0.0 for d in range(n)] for r in range(n)]
+    for r in range(n):
+        excess = min(max(0.0, made[r] - mean), shared[r])
+        if excess <= 0 or lacking <= 0 or shared[r] <= 0:
+            continue
+        handed = excess / shared[r]
+        spread[r][r] = 1.0 - handed
+        for d in range(n):
+            if d != r:
+                spread[r][d] = handed * max(0.0, mean - made[d]) / lacking
+    return spread
+
+
 def usl(threads, sigma, kappa):
     """Universal scalability law: the speed-up of `threads` threads."""
     return threads / (1 + sigma * (threads - 1) + kappa * threads * (threads - 1))
@@ -119,42 +155,146 @@ class Model:
     """Seconds a job of R ranks takes: on its slowest rank, the longest of its batches over its threads'
     speed-up, its loads over its loaders (which load ahead while the workers trace) and its network, plus the
     rounds that find the ends of the passes. It has no term for a rank idling while the rays it waits for are
-    traced on another: a lower bound where ranks hand few rays back and forth many times."""
+    traced on another: a lower bound where ranks hand few rays back and forth many times.
+
+    With `everywhere` (--coarse-levels-everywhere), the slots the pager kept are held by every rank: a ray bound
+    for one is traced on the rank it is on, so its batches' time goes to the ranks in the shares of the rays
+    they send it (the rays of a kept slot are where the rays sending them were: found by iterating those
+    shares), and every rank loads every kept slot once."""
 
     LOADERS = 2  # the pager's loader threads (pager.h)
 
-    def __init__(self, batch_us, load_us, sent, order, sigma, kappa, scale, ray_scale, bandwidth, latency,
-                 passes, ray_bytes=RAY_BYTES):
+    def __init__(self, trace, sigma, kappa, scale, ray_scale, bandwidth, latency, passes, ray_bytes=RAY_BYTES,
+                 everywhere=True):
         """`scale`: what the batches' time is multiplied by; `ray_scale`: the rays sent; `ray_bytes`: a ray's
         bytes on the wire."""
-        self.batch_s = [w * 1e-6 for w in batch_us]
-        self.load_s = [w * 1e-6 for w in load_us]
-        self.sent, self.order = sent, order
+        self.trace = trace
+        self.everywhere = trace.kept if everywhere else set()
+        self.load_s = [w * 1e-6 for w in trace.per_brick(trace.load_us)]
+        self.order = trace.order
         self.sigma, self.kappa, self.scale, self.ray_scale = sigma, kappa, scale, ray_scale
         self.bandwidth, self.latency, self.passes = bandwidth, latency, passes
         self.ray_bytes = ray_bytes
+
+    def shares(self, owner, spread, ranks):
+        """-> {slot: [share of each rank]}: where each slot's rays are traced. A brick's own slots on its owner;
+        a kept slot (with `everywhere`) where the rays sending to it are: a brick's own slot hands its rays to
+        the ranks of its owner's row of `spread`, a kept slot keeps them (iterated until chains of kept slots
+        settle)."""
+        bricks = self.trace.bricks
+        slots = set(self.trace.batch_us) | {s for pair in self.trace.sent for s in pair}
+        share = {}
+        for s in slots:
+            if s in self.everywhere:
+                share[s] = [1.0 / ranks] * ranks
+            else:
+                share[s] = [0.0] * ranks
+                share[s][owner[s % bricks]] = 1.0
+        into = {}
+        for (a, b), n in self.trace.sent.items():
+            if b in self.everywhere and a != b:
+                into.setdefault(b, []).append((a, n))
+
+        def sender(a):
+            return share[a] if a in self.everywhere else spread[owner[a % bricks]]
+
+        for _ in range(30):
+            for b, senders in into.items():
+                total = sum(n for _, n in senders)
+                share[b] = [sum(n * sender(a)[r] for a, n in senders) / total for r in range(ranks)]
+        return share
+
+    def rank_work(self, owner, spread, ranks):
+        """-> (batch microseconds per rank, shares) for `owner` and `spread`."""
+        share = self.shares(owner, spread, ranks)
+        work = [0.0] * ranks
+        for s, us in self.trace.batch_us.items():
+            for r in range(ranks):
+                work[r] += share[s][r] * us
+        return work, share
+
+    def owners_rebalanced(self, ranks):
+        """-> (owner per brick, spread) as re-balancing leaves them (StreamScheduler::Rebalance, which looks at
+        passes 4, 8, 16...): while the busiest rank does more than 1.2x the mean, runs are cut by each brick's
+        work, its own slots' and, with `everywhere`, that of the rays it sends into the kept slots (the mean
+        work per ray entering them); then the ranks above the mean hand a share of the rays entering the kept
+        slots to those below it (spread_of_shared_work); kept if that makes the busiest lighter."""
+        t = self.trace
+        identity = [[1.0 if d == r else 0.0 for d in range(ranks)] for r in range(ranks)]
+        moving = t.per_brick({s: w for s, w in t.batch_us.items() if s not in self.everywhere})
+        into = [0.0] * t.bricks
+        for (a, b), n in t.sent.items():
+            if b in self.everywhere and a not in self.everywhere:
+                into[a % t.bricks] += n
+        shared_total = sum(w for s, w in t.batch_us.items() if s in self.everywhere)
+        per_entry = shared_total / sum(into) if sum(into) else 0.0
+        weight = [m + per_entry * i for m, i in zip(moving, into)]
+        owner = owners_by_work(self.order, [w * 1e-6 * self.scale + l for w, l in zip(moving, self.load_s)],
+                               ranks)
+        spread = identity
+        for _ in range(8):
+            did, _ = self.rank_work(owner, spread, ranks)
+            if max(did) <= 1.2 * sum(did) / ranks:
+                break
+            next_owner = owners_by_work(self.order, [w * 1e-6 * self.scale + l
+                                                     for w, l in zip(weight, self.load_s)], ranks)
+            made, shared = [0.0] * ranks, [0.0] * ranks
+            for b in range(t.bricks):
+                made[next_owner[b]] += weight[b]
+                shared[next_owner[b]] += per_entry * into[b]
+            next_spread = spread_of_shared_work(made, shared) if self.everywhere else identity
+            after = [made[r] - shared[r] for r in range(ranks)]
+            for r in range(ranks):
+                for d in range(ranks):
+                    after[d] += shared[r] * next_spread[r][d]
+            if max(after) >= max(did):
+                break
+            owner, spread = next_owner, next_spread
+        return owner, spread
 
     def predict(self, ranks, threads_per_rank, cpu_share=1.0, triangles=None):
         """-> (seconds, rays between ranks) for `ranks` ranks of `threads_per_rank` threads; `cpu_share`: the
         share of a core each thread gets (below 1 where the ranks' threads exceed the cores). `triangles` per
         brick: the bricks keep the first ownership, cut by memory, as a render too short to re-balance does
-        (re-balancing starts at pass 4: StreamScheduler::Rebalance); else they are cut by measured work."""
+        (re-balancing starts at pass 4: StreamScheduler::Rebalance); else they are as re-balancing leaves
+        them."""
+        t = self.trace
         if triangles is not None:
-            owner = owners_by_work(self.order, [float(t) for t in triangles], ranks)
+            owner = owners_by_work(self.order, [float(x) for x in triangles], ranks)
+            spread = [[1.0 if d == r else 0.0 for d in range(ranks)] for r in range(ranks)]
         else:
-            owner = owners_by_work(self.order, [b * self.scale + l for b, l in zip(self.batch_s, self.load_s)],
-                                   ranks)
-        batch, load = [0.0] * ranks, [0.0] * ranks
-        for b in range(len(self.batch_s)):
-            batch[owner[b]] += self.batch_s[b] * self.scale
-            load[owner[b]] += self.load_s[b]
+            owner, spread = self.owners_rebalanced(ranks)
+        work, share = self.rank_work(owner, spread, ranks)
+        batch = [w * 1e-6 * self.scale for w in work]
+        load = [0.0] * ranks
+        for s, us in t.load_us.items():
+            if s in self.everywhere:
+                for r in range(ranks):
+                    load[r] += us * 1e-6  # every rank loads every kept level once
+            else:
+                load[owner[s % t.bricks]] += us * 1e-6
         out, into = [0.0] * ranks, [0.0] * ranks
-        crossing = 0
-        for (a, b), n in self.sent.items():
-            if owner[a] != owner[b]:
-                crossing += n
-                out[owner[a]] += n * self.ray_bytes * self.ray_scale
-                into[owner[b]] += n * self.ray_bytes * self.ray_scale
+        crossing = 0.0
+
+        def move(n, src, dst):
+            nonlocal crossing
+            crossing += n
+            out[src] += n * self.ray_bytes * self.ray_scale
+            into[dst] += n * self.ray_bytes * self.ray_scale
+
+        for (a, b), n in t.sent.items():
+            if b in self.everywhere:
+                if a in self.everywhere:
+                    continue  # from one kept slot to another: stays where it is
+                r = owner[a % t.bricks]  # entering the kept slots: handed on by the owner's spread
+                for d in range(ranks):
+                    if d != r and spread[r][d] > 0:
+                        move(n * spread[r][d], r, d)
+                continue
+            dest = owner[b % t.bricks]
+            for r in range(ranks):
+                if r != dest and share[a][r] > 0:
+                    move(n * share[a][r], r, dest)
         speed = usl(threads_per_rank, self.sigma, self.kappa) * cpu_share
         worst = 0.0
         for r in range(ranks):
@@ -204,11 +344,14 @@ def main():
     ap.add_argument("--ray-bytes", type=float, default=0,
                     help="a ray's bytes on the wire (default: what the --measured runs sent per ray, else 128)")
     ap.add_argument("--reuse", action="store_true", help="the trace and times of the last run in --dir")
+    ap.add_argument("--coarse-levels-everywhere", default="on", choices=["on", "off"],
+                    help="with --levels: every rank traces the rays that meet the coarse levels it keeps, as "
+                         "nave render does by default (on), or sends them to the brick's owner (off)")
     args = ap.parse_args()
     os.makedirs(args.dir, exist_ok=True)
     log = open(os.path.join(args.dir, "replay.log"), "a")
     store, config = nb.abbey_store_and_view(args.nave, args.dir, args.detail, args.store, args.config, args.view,
-                                            log)
+                                            log, args.levels)
 
     # One process at 1 and 2 threads, each traced: the batches' speed-up gives sigma.
     runs = {}
@@ -229,15 +372,19 @@ def main():
         runs[threads] = {"wall_s": t.elapsed_s, "trace": trace}
     with open(runs_file, "w") as f:
         json.dump(runs, f)
-    batch_us, load_us, sent, order = read_trace(runs[1]["trace"])
-    batch2_us, _, _, _ = read_trace(runs[2]["trace"])
-    batch_s, load_s = sum(batch_us) * 1e-6, sum(load_us) * 1e-6
-    speedup = sum(batch_us) / sum(batch2_us)
+    trace = Trace(runs[1]["trace"])
+    trace2 = Trace(runs[2]["trace"])
+    batch_s, load_s = sum(trace.batch_us.values()) * 1e-6, sum(trace.load_us.values()) * 1e-6
+    speedup = sum(trace.batch_us.values()) / sum(trace2.batch_us.values())
     # S(2) = 2 / (1 + sigma): kappa's share is negligible at 2 threads.
     sigma = min(max(2 / speedup - 1, 0.0), 1.0)
-    print(f"trace: {len(order)} bricks, one thread: batches {batch_s:.1f} s, loads {load_s:.1f} s, wall "
-          f"{runs[1]['wall_s']:.1f} s; {sum(sent.values())} rays sent between bricks; batches at 2 threads "
-          f"{speedup:.2f}x faster: sigma {sigma:.3f}", file=sys.stderr)
+    everywhere = args.coarse_levels_everywhere == "on"
+    kept_rays = sum(n for (a, b), n in trace.sent.items() if b in trace.kept)
+    where = "traced where they are" if everywhere else "sent to the brick's owner"
+    print(f"trace: {len(trace.order)} bricks, one thread: batches {batch_s:.1f} s, loads {load_s:.1f} s, wall "
+          f"{runs[1]['wall_s']:.1f} s; {sum(trace.sent.values())} rays sent between slots, {kept_rays} of them "
+          f"to the {len(trace.kept)} kept coarse levels ({where}); batches at 2 threads {speedup:.2f}x faster: "
+          f"sigma {sigma:.3f}", file=sys.stderr)
 
     measured = []
     if args.measured:
@@ -258,8 +405,8 @@ def main():
           f"billion)", file=sys.stderr)
     for name, bandwidth, latency in (("Gigabit Ethernet, the paper's network", args.bandwidth, args.latency),
                                      ("10 Gigabit Ethernet", 10 * args.bandwidth, args.latency / 2)):
-        paper = Model(batch_us, load_us, sent, order, paper_sigma, kappa, scale, ray_scale, bandwidth, latency,
-                      args.spp, ray_bytes)
+        paper = Model(trace, paper_sigma, kappa, scale, ray_scale, bandwidth, latency, args.spp, ray_bytes,
+                      everywhere)
         rows, errors = [], []
         for domains, times in PAPER_TABLE.items():
             row = [f"{domains} {'domain' if domains == 1 else 'sub-domains'}"]
@@ -277,8 +424,8 @@ def main():
               f"largest {100 * max(errors):.0f} %")
 
     if args.measured:
-        local = Model(batch_us, load_us, sent, order, sigma, 0.0, 1.0, 1.0, args.local_bandwidth,
-                      args.local_latency, args.spp, ray_bytes)
+        local = Model(trace, sigma, 0.0, 1.0, 1.0, args.local_bandwidth, args.local_latency, args.spp,
+                      ray_bytes, everywhere)
         cores = os.cpu_count() or 1
         # Start, bookkeeping, the image: what one process of one thread takes beyond the model, from the
         # measured run of 1 x 1 where there is one (a traced run is slower), else the traced run.

@@ -50,6 +50,7 @@ struct RenderOptions {
     std::string temp_dir;    // --temp-dir DIR: spill files (default: beside the output)
     std::string rank_timeout = "10m";  // --rank-timeout: under mpirun, the longest wait for rays
     std::string pack_rays = "on";      // --pack-rays: under mpirun, LZ4 on the rays sent
+    std::string coarse_levels_everywhere = "on";  // --coarse-levels-everywhere: under mpirun
     bool no_textures = false;
     std::string lod;
     bool no_lod = false;         // --no-lod: --lod full
@@ -281,8 +282,11 @@ Status RunRender(const RenderOptions& o) {
     NAVE_ASSIGN_OR_RETURN(render::SceneConfig config, BuildConfig(o));
     NAVE_ASSIGN_OR_RETURN(const double rank_timeout_s,
                           ParseDuration(o.rank_timeout, "--rank-timeout"));
-    NAVE_ASSIGN_OR_RETURN(render::RankGroup * ranks,
-                          JoinRanks(rank_timeout_s, o.pack_rays == "on"));
+    NAVE_ASSIGN_OR_RETURN(
+        render::RankGroup * ranks,
+        JoinRanks({.rank_timeout_s = rank_timeout_s,
+                   .pack_rays = o.pack_rays == "on",
+                   .coarse_levels_everywhere = o.coarse_levels_everywhere == "on"}));
     std::optional<uint64_t> memory_bytes;  // --memory, in bytes
     if (!o.memory.empty()) {
         NAVE_ASSIGN_OR_RETURN(uint64_t bytes, ParseByteSize(o.memory));
@@ -407,6 +411,12 @@ void RegisterRenderCommand(CLI::App& app, CommandRun& run) {
                     "transposed byte by byte, then LZ4: a few times fewer bytes for a little CPU "
                     "time), on or off (off for an interconnect faster than LZ4, ~1 GB/s a core; "
                     "docs/distributed.md). Default on")
+        ->check(CLI::IsMember({"on", "off"}));
+    cmd->add_option("--coarse-levels-everywhere", opts->coarse_levels_everywhere,
+                    "Under mpirun, with levels of detail: every rank holds the coarse levels the "
+                    "pager keeps resident (within its --memory) and traces the rays that meet "
+                    "them itself instead of sending them to the brick's owner, on or off "
+                    "(docs/distributed.md). Default on")
         ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option(
         "--temp-dir", opts->temp_dir,

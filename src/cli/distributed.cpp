@@ -43,7 +43,7 @@ int LaunchedRanks() {
     return 1;
 }
 
-StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s, bool pack_rays) {
+StatusOr<render::RankGroup*> JoinRanks(const RankOptions& options) {
     if (LaunchedRanks() <= 1) return static_cast<render::RankGroup*>(nullptr);
 #ifdef NAVE_HAVE_MPI
     Distributed& state = State();
@@ -53,8 +53,9 @@ StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s, bool pack_rays) {
         state.runtime = std::make_unique<render::MpiRuntime>(std::move(runtime));
         state.host = state.runtime->host();
         render::MpiExchangeOptions exchange;
-        exchange.stall_timeout_s = rank_timeout_s;
-        exchange.pack_messages = pack_rays;
+        exchange.stall_timeout_s = options.rank_timeout_s;
+        exchange.pack_messages = options.pack_rays;
+        exchange.coarse_levels_everywhere = options.coarse_levels_everywhere;
         NAVE_ASSIGN_OR_RETURN(state.group, render::MpiRankGroup::Create(exchange));
         // One terminal for the job: rank 0 reports progress and the summary, the others only
         // their errors (which name the rank).
@@ -65,8 +66,7 @@ StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s, bool pack_rays) {
     }
     return static_cast<render::RankGroup*>(state.group.get());
 #else
-    (void)rank_timeout_s;
-    (void)pack_rays;
+    (void)options;
     return UnsupportedError(
         "started by mpirun as one of {} ranks, but this nave was built without MPI: install "
         "libopenmpi-dev and openmpi-bin (scripts/setup-debian.sh does) and build again, or run "

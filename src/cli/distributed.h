@@ -14,11 +14,20 @@ namespace nave::cli {
 /// OMPI_COMM_WORLD_SIZE, or PMI_SIZE of other launchers); 1 when not started by mpirun.
 int LaunchedRanks();
 
+/// How the ranks of a job exchange rays (`nave render`'s options under mpirun).
+struct RankOptions {
+    /// --rank-timeout (MpiExchangeOptions::stall_timeout_s).
+    double rank_timeout_s = 600;
+    /// --pack-rays: messages of rays packed for the wire (MpiExchangeOptions::pack_messages).
+    bool pack_rays = true;
+    /// --coarse-levels-everywhere (MpiExchangeOptions::coarse_levels_everywhere).
+    bool coarse_levels_everywhere = true;
+};
+
 /// The ranks of this job, MPI initialized on the first call (and finalized at exit); null when
 /// this process is the only one. Errors: a job of several ranks and a nave built without MPI
-/// (names what to install), MPI that cannot start. `pack_rays`: messages of rays packed for the
-/// wire (MpiExchangeOptions::pack_messages).
-StatusOr<render::RankGroup*> JoinRanks(double rank_timeout_s = 600, bool pack_rays = true);
+/// (names what to install), MPI that cannot start.
+StatusOr<render::RankGroup*> JoinRanks(const RankOptions& options = {});
 
 /// Where a failed rank is named: "rank 2 of 4 on node7" ("" outside a distributed render).
 std::string RankName();

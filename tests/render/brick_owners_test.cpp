@@ -92,9 +92,10 @@ TEST(BrickOwners, MeasuredWorkCutsRunsOfAboutEqualWork) {
               source->slot_count());
 }
 
-// For a trace (bench/replay_mpi.py): the rays a batch sent, per other brick, a level of a brick
-// counting as the brick, in brick order.
-TEST(SentPerBrick, CountsTheRaysSentToEachOtherBrick) {
+// For a trace (bench/replay_mpi.py): the rays a batch sent, per other slot (a brick at a level:
+// where every rank holds a coarse level, a ray moving to it from its brick's full mesh stays
+// home, and one moving back may not), in slot order.
+TEST(SentPerBrick, CountsTheRaysSentToEachOtherSlot) {
     const store::BrickMesh mesh = store::testing::MakeSurface({.quads_x = 64, .quads_y = 64});
     store::LevelOptions levels;
     levels.relative_errors = {0.02};
@@ -110,12 +111,50 @@ TEST(SentPerBrick, CountsTheRaysSentToEachOtherBrick) {
     for (int i = 0; i < 3; ++i) out.Send(source->SlotOf(2, 0), from, r);
     out.Send(source->SlotOf(2, 1), from, r);  // brick 2 at its coarse level
     out.Send(source->SlotOf(0, 1), from, r);
-    out.Send(source->SlotOf(1, 1), from, r);  // its own brick at another level: not sent elsewhere
+    out.Send(source->SlotOf(1, 1), from, r);  // its own brick at another level
     SentPerBrick sent;
     EXPECT_EQ(sent.Text(), "");
-    sent.Count(*source, from, out);
-    sent.Count(*source, source->SlotOf(1, 1), out);  // another task of a batch of the same brick
-    EXPECT_EQ(sent.Text(), "0:2 2:8");
+    sent.Count(from, out);
+    // The same rays from a batch of brick 1's coarse level: those to that slot are not moves.
+    sent.Count(source->SlotOf(1, 1), out);
+    // Slots 2 (brick 2), 4 (brick 0 at level 1), 5 (brick 1 at level 1), 6 (brick 2 at level 1).
+    EXPECT_EQ(sent.Text(), "2:6 4:2 5:1 6:2");
+}
+
+// The processes above the mean hand a share of the rays entering the slots every process holds to
+// those below it: each process then does the mean, where its shared work allows.
+TEST(SpreadOfSharedWork, HandsTheExcessToTheProcessesBelowTheMean) {
+    // Work made: 6, 1, 3, 2 (mean 3); shared work among it: 4, 0, 1, 2.
+    const std::vector<double> made = {6, 1, 3, 2}, shared = {4, 0, 1, 2};
+    const std::vector<std::vector<double>> spread = SpreadOfSharedWork(made, shared);
+    ASSERT_EQ(spread.size(), 4u);
+    // Process 0 hands 3 of its 4 to process 1 (lacks 2) and 3 (lacks 1): 2 and 1.
+    EXPECT_DOUBLE_EQ(spread[0][0], 0.25);
+    EXPECT_DOUBLE_EQ(spread[0][1], 0.5);
+    EXPECT_DOUBLE_EQ(spread[0][2], 0.0);
+    EXPECT_DOUBLE_EQ(spread[0][3], 0.25);
+    for (size_t r = 1; r < 4; ++r) {
+        for (size_t d = 0; d < 4; ++d) EXPECT_DOUBLE_EQ(spread[r][d], r == d ? 1.0 : 0.0);
+    }
+    std::vector<double> after(4, 0.0);
+    for (size_t r = 0; r < 4; ++r) {
+        after[r] += made[r] - shared[r];
+        for (size_t d = 0; d < 4; ++d) after[d] += shared[r] * spread[r][d];
+    }
+    for (double a : after) EXPECT_DOUBLE_EQ(a, 3.0);
+}
+
+// A process cannot hand on more than its shared work: above the mean with little of it shared, it
+// hands all of it and stays above.
+TEST(SpreadOfSharedWork, HandsAtMostItsSharedWork) {
+    const std::vector<std::vector<double>> spread = SpreadOfSharedWork({8, 0}, {1, 0});
+    EXPECT_DOUBLE_EQ(spread[0][0], 0.0);
+    EXPECT_DOUBLE_EQ(spread[0][1], 1.0);
+    EXPECT_DOUBLE_EQ(spread[1][1], 1.0);
+    // Balanced: nobody hands anything.
+    const std::vector<std::vector<double>> even = SpreadOfSharedWork({2, 2}, {2, 2});
+    EXPECT_DOUBLE_EQ(even[0][0], 1.0);
+    EXPECT_DOUBLE_EQ(even[1][1], 1.0);
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ struct Game {
     uint64_t id_sum_started = 0;
     uint64_t id_sum_ended = 0;
     uint64_t hops = 0;
+    uint64_t hops_kept_home = 0;  // hops into a brick every rank holds (kEveryRank)
 };
 
 // Drains this rank's queues as the scheduler would: batches of one brick at a time, each split
@@ -54,13 +55,12 @@ Status Play(MpiRayExchange& exchange, BrickQueues<RayRecord>& queues, Game* game
             ++batches;
             if (Mix(uint32_t(batches) * 7919u + uint32_t(exchange.rank())) % 4 == 0)
                 std::this_thread::sleep_for(std::chrono::microseconds(300));
-            std::atomic<uint64_t> ended{0}, id_sum{0}, hops{0};
+            std::atomic<uint64_t> ended{0}, id_sum{0}, hops{0}, kept_home{0};
             auto work = [&](size_t begin, size_t end) {
                 std::vector<RayRecord> next;
                 for (size_t i = begin; i < end; ++i) {
                     RayRecord r = batch[i];
-                    if (exchange.Owner(b) != exchange.rank())
-                        std::abort();  // a ray in the wrong rank
+                    if (!exchange.Owns(b)) std::abort();  // a ray in the wrong rank
                     if (r.depth == 0) {
                         ended += 1;
                         id_sum += r.pixel;
@@ -68,6 +68,7 @@ Status Play(MpiRayExchange& exchange, BrickQueues<RayRecord>& queues, Game* game
                     }
                     r.depth -= 1;
                     hops += 1;
+                    if (exchange.Owner(NextBrick(r)) == kEveryRank) kept_home += 1;
                     exchange.Send(NextBrick(r), std::span<const RayRecord>(&r, 1));
                 }
             };
@@ -78,6 +79,7 @@ Status Play(MpiRayExchange& exchange, BrickQueues<RayRecord>& queues, Game* game
             game->rays_ended += ended;
             game->id_sum_ended += id_sum;
             game->hops += hops;
+            game->hops_kept_home += kept_home;
             NAVE_RETURN_IF_ERROR(exchange.Progress());
         }
         if (any) continue;
@@ -105,11 +107,14 @@ uint64_t SumOverRanks(uint64_t v) {
     return sum;
 }
 
-void PlayWaves(const MpiExchangeOptions& options, int waves) {
+// With `everywhere`, every third brick is held by every rank (kEveryRank: a coarse level kept
+// everywhere), and the rays hopping into it stay where they are.
+void PlayWaves(const MpiExchangeOptions& options, int waves, bool everywhere = false) {
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     std::vector<int> owners(kBricks);
-    for (uint32_t b = 0; b < kBricks; ++b) owners[b] = int(b % uint32_t(size));
+    for (uint32_t b = 0; b < kBricks; ++b)
+        owners[b] = everywhere && b % 3 == 0 ? kEveryRank : int(b % uint32_t(size));
     BrickQueues<RayRecord> queues(kBricks);
     auto exchange = MpiRayExchange::Create(owners, queues, options);
     ASSERT_TRUE(exchange.ok()) << exchange.status().ToString();
@@ -127,9 +132,13 @@ void PlayWaves(const MpiExchangeOptions& options, int waves) {
     auto total = (*exchange)->TotalCounts();
     ASSERT_TRUE(total.ok()) << total.status().ToString();
     EXPECT_EQ(total->records_sent, total->records_received);
+    const uint64_t hops = SumOverRanks(game.hops), kept_home = SumOverRanks(game.hops_kept_home);
+    EXPECT_EQ(kept_home > 0, everywhere);
+    // A hop into a brick every rank holds never travels.
+    EXPECT_LE(total->records_sent, hops + SumOverRanks(game.rays_started) - kept_home);
     if (size > 1) {
-        // Most hops cross ranks: the rays did travel.
-        EXPECT_GT(total->records_sent, SumOverRanks(game.hops) / uint64_t(2 * size));
+        // Most other hops cross ranks: the rays did travel.
+        EXPECT_GT(total->records_sent, (hops - kept_home) / uint64_t(2 * size));
         EXPECT_GT(total->messages_sent, 0u);
     }
 }
@@ -138,6 +147,12 @@ TEST(MpiExchange, EveryRayEndsOnceOverSeveralWaves) { PlayWaves(MpiExchangeOptio
 
 // Messages of a few rays and one send in flight per rank: the exchange must wait for its sends to
 // complete while receiving, without a deadlock between two ranks sending to each other.
+// Bricks every rank holds (coarse levels kept everywhere): their rays are traced where they are,
+// and still every ray ends once.
+TEST(MpiExchange, BricksEveryRankHoldsKeepTheirRaysHome) {
+    PlayWaves(MpiExchangeOptions(), 2, /*everywhere=*/true);
+}
+
 TEST(MpiExchange, SmallMessagesAndOneSendInFlightStillEndEveryRay) {
     MpiExchangeOptions options;
     options.message_bytes = kRayMessageHeaderBytes + kRayGroupHeaderBytes + 4 * sizeof(RayRecord);
@@ -154,6 +169,8 @@ TEST(MpiExchange, BadOwnersAreRefused) {
     EXPECT_NE(wrong_rank.status().message().find("slot 1 owned by rank"), std::string::npos)
         << wrong_rank.status().ToString();
     EXPECT_FALSE(MpiRayExchange::Create({0, 0}, queues).ok());
+    EXPECT_TRUE(MpiRayExchange::Create({0, kEveryRank, 0}, queues).ok());
+    EXPECT_FALSE(MpiRayExchange::Create({0, kEveryRank - 1, 0}, queues).ok());
 }
 
 }  // namespace

@@ -332,16 +332,50 @@ TEST_F(MpiRender, RanksPageTheirBricksUnderTheirBudgets) {
 }
 
 // Levels of detail are slots of their bricks: they go to the brick's rank.
-TEST_F(MpiRender, LevelsOfDetailGiveTheSingleProcessImageToo) {
+// The rays sent between the ranks, from the summary's "ranks 2: 1.2 k rays sent between them";
+// -1 if absent.
+double RaysSentBetweenRanks(const std::string& output) {
+    const size_t at = output.find(" rays sent between them");
+    if (at == std::string::npos) return -1;
+    const size_t start = output.rfind(": ", at);
+    if (start == std::string::npos) return -1;
+    const std::string number = output.substr(start + 2, at - start - 2);  // "630", "1.2 k"
+    const double scale = number.ends_with(" k") ? 1e3 : number.ends_with(" M") ? 1e6 : 1;
+    return std::atof(number.c_str()) * scale;
+}
+
+// With levels of detail every rank holds the coarse levels its pager keeps and traces the rays
+// that meet them where they are (--coarse-levels-everywhere, on by default): fewer rays travel
+// between the ranks, and the image is the single process's, in path and photon mode (whose
+// photons go to the brick's owner, where the visible points they reach are), on or off.
+TEST_F(MpiRender, CoarseLevelsOnEveryRankKeepRaysHomeAndTheImage) {
     const std::string store = (*dir_ / "levels.nave").string();
     const test::CommandResult made = test::RunNave(
         "preprocess --generate abbey:detail=1 --brick-triangles 40000 --levels -q -o " + store);
     ASSERT_EQ(made.exit_code, 0) << made.output;
-    auto render = [&](const std::string& out) {
-        return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() +
-               " --mode path --lod auto --resolution 64x48 --spp 2 -q -o " + (*dir_ / out).string();
-    };
-    ExpectTwoRanksAsOneProcess(render, "levels");
+    for (const std::string mode : {"path", "photon"}) {
+        SCOPED_TRACE(mode);
+        auto render = [&](const std::string& out, const std::string& flags) {
+            return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() + " --mode " +
+                   mode + " --lod auto --resolution 64x48 --spp 2 --iterations 2 " +
+                   "--photons 50000 -o " + (*dir_ / out).string() + flags;
+        };
+        const test::CommandResult one = Shell(render(mode + "_one.exr", " -q"));
+        ASSERT_EQ(one.exit_code, 0) << one.output;
+        const std::vector<float> reference = Rgb(*dir_ / (mode + "_one.exr"));
+        ASSERT_FALSE(reference.empty());
+        double sent[2] = {-1, -1};
+        for (const bool everywhere : {true, false}) {
+            const std::string out = mode + (everywhere ? "_everywhere.exr" : "_owner.exr");
+            const test::CommandResult two =
+                Shell(Mpirun(2) + render(out, everywhere ? "" : " --coarse-levels-everywhere off"));
+            ASSERT_EQ(two.exit_code, 0) << two.output;
+            EXPECT_EQ(Rgb(*dir_ / out), reference) << out;
+            sent[everywhere] = RaysSentBetweenRanks(two.output);
+            EXPECT_GT(sent[everywhere], 0) << two.output;
+        }
+        EXPECT_LT(sent[true], sent[false]);
+    }
 }
 
 // Drifting dust cut into the bricks by preprocess (grid = "store"): each brick's piece comes with

@@ -113,12 +113,16 @@ StatusOr<int> SppmIntegrator::RenderRounds(int done, bool) {
     visible_->BeginIteration(uint64_t(scene_.settings.seed), iteration_, photons);
     // Visible points must all be in place before photons arrive: waves overlap within each pass
     // only. So the queues hold camera paths and their shadow rays, then photons, never both,
-    // and each pass is drained by its own processor.
+    // and each pass is drained by its own processor. The camera pass's rays may meet coarse
+    // levels in whichever process they are; a photon deposits at the visible points of the
+    // brick it meets, which only the brick's owner holds.
+    NAVE_RETURN_IF_ERROR(scheduler_.TraceCoarseLevelsHere(true));
     NAVE_RETURN_IF_ERROR(
         scheduler_.DrainInWaves(camera_pass_, pixels, wave, StreamScheduler::LastWave::kDrained,
                                 [&](uint64_t first, uint64_t last) {
                                     return camera_pass_.GenerateCameraRays(first, last, 0);
                                 }));
+    NAVE_RETURN_IF_ERROR(scheduler_.TraceCoarseLevelsHere(false));
     RankGroup* ranks = scheduler_.ranks();
     if (ranks != nullptr) {
         // Photons traced here reach the points in this process's bricks, wherever they were made.

@@ -61,4 +61,26 @@ std::vector<int> BrickOwnersByWork(const BrickSource& source, int ranks,
     return OwnersOfRuns(source, ranks, weight);
 }
 
+std::vector<std::vector<double>> SpreadOfSharedWork(const std::vector<double>& made,
+                                                    const std::vector<double>& shared) {
+    const size_t n = made.size();
+    std::vector<std::vector<double>> spread(n, std::vector<double>(n, 0.0));
+    double total = 0;
+    for (double m : made) total += m;
+    const double mean = n > 0 ? total / double(n) : 0.0;
+    double lacking = 0;
+    for (double m : made) lacking += std::max(0.0, mean - m);
+    for (size_t r = 0; r < n; ++r) {
+        spread[r][r] = 1.0;
+        const double excess = std::min(std::max(0.0, made[r] - mean), shared[r]);
+        if (!(excess > 0 && lacking > 0 && shared[r] > 0)) continue;
+        const double handed = excess / shared[r];  // the fraction of its shared rays it hands on
+        spread[r][r] = 1.0 - handed;
+        for (size_t d = 0; d < n; ++d) {
+            if (d != r) spread[r][d] = handed * std::max(0.0, mean - made[d]) / lacking;
+        }
+    }
+    return spread;
+}
+
 }  // namespace nave::render

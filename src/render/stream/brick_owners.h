@@ -24,4 +24,14 @@ std::vector<int> BrickOwners(const BrickSource& source, int ranks);
 std::vector<int> BrickOwnersByWork(const BrickSource& source, int ranks,
                                    const std::vector<uint64_t>& work);
 
+/// How the processes share the work on the slots every process holds (coarse levels kept
+/// everywhere, docs/distributed.md): row r gives, for the rays process r's bricks send into those
+/// slots, the fraction each process traces (row r sums to 1). `made[r]`: the work process r's
+/// bricks make, their own and that of the rays they send into the shared slots, `shared[r]` of
+/// it (at most made[r]), in any unit. A process above the mean hands its excess, at most all its
+/// shared work, to the processes below the mean, in proportion to what each lacks; the others
+/// keep their rays. Deterministic.
+std::vector<std::vector<double>> SpreadOfSharedWork(const std::vector<double>& made,
+                                                    const std::vector<double>& shared);
+
 }  // namespace nave::render

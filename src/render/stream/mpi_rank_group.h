@@ -18,6 +18,7 @@ class MpiRankGroup final : public RankGroup {
 
     int rank() const override { return rank_; }
     int size() const override { return size_; }
+    bool coarse_levels_everywhere() const override { return options_.coarse_levels_everywhere; }
     StatusOr<std::unique_ptr<RayExchange>> MakeExchange(std::vector<int> owners,
                                                         BrickQueues<RayRecord>& queues) override;
     Status SumEverywhere(std::span<double> values) override;

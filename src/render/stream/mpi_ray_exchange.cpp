@@ -30,13 +30,14 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Whether every slot's owner is one of the `ranks` ranks; the error names the first that is not.
+// Whether every slot's owner is one of the `ranks` ranks or kEveryRank; the error names the first
+// that is not.
 Status CheckOwners(const std::vector<int>& owners, int ranks) {
     for (size_t s = 0; s < owners.size(); ++s) {
-        if (owners[s] < 0 || owners[s] >= ranks) {
+        if ((owners[s] < 0 || owners[s] >= ranks) && owners[s] != kEveryRank) {
             return InvalidArgumentError(
-                "ray exchange: brick slot {} owned by rank {} (expected [0, {}))", s, owners[s],
-                ranks);
+                "ray exchange: brick slot {} owned by rank {} (expected [0, {}) or {}, every rank)",
+                s, owners[s], ranks, kEveryRank);
         }
     }
     return Status::Ok();
@@ -162,7 +163,11 @@ int MpiRayExchange::size() const { return impl_->size; }
 int MpiRayExchange::Owner(uint32_t slot) const { return impl_->owners[slot]; }
 
 void MpiRayExchange::Send(uint32_t slot, std::span<const RayRecord> rays) {
-    const int dest = impl_->owners[slot];
+    const int owner = impl_->owners[slot];
+    SendToRank(TracedBy(owner, impl_->rank) ? impl_->rank : owner, slot, rays);
+}
+
+void MpiRayExchange::SendToRank(int dest, uint32_t slot, std::span<const RayRecord> rays) {
     if (dest == impl_->rank) {
         impl_->queues.Push(slot, rays.data(), rays.size());
         return;
@@ -274,7 +279,8 @@ StatusOr<bool> MpiRayExchange::Impl::Receive() {
         uint32_t foreign_slot = UINT32_MAX;
         NAVE_RETURN_IF_ERROR(ForEachRayGroup(message, uint32_t(owners.size()), what,
                                              [&](uint32_t slot, std::span<const RayRecord>) {
-                                                 if (owners[slot] != rank) foreign_slot = slot;
+                                                 if (!TracedBy(owners[slot], rank))
+                                                     foreign_slot = slot;
                                              })
                                  .status());
         if (foreign_slot != UINT32_MAX) {

@@ -37,6 +37,10 @@ struct MpiExchangeOptions {
     /// end-of-drain sum completing ends the job with an error naming itself and the wait (a rank
     /// that stopped, or a batch longer than this): a job never hangs. 0: waits for ever.
     double stall_timeout_s = 600;
+    /// Every rank holds the coarse levels of detail kept resident and traces their rays where
+    /// they are (RankGroup::coarse_levels_everywhere): on the detail-30 abbey over 4 ranks, ??? of
+    /// the rays crossing between ranks stay home (docs/distributed.md).
+    bool coarse_levels_everywhere = true;
 };
 
 /// The exchange between the ranks of MPI_COMM_WORLD (on a duplicate of it, so that its messages
@@ -45,9 +49,10 @@ struct MpiExchangeOptions {
 /// MpiRuntime). Methods marked collective are called by every rank, in the same order.
 class MpiRayExchange final : public RayExchange {
   public:
-    /// `owners[s]`: the rank that owns brick slot s (the queues' index); rays of this rank's slots
-    /// are pushed onto `queues`, which must outlive the exchange. Errors: MPI not initialized, an
-    /// owner outside [0, ranks), a slot count other than the queues'. Collective.
+    /// `owners[s]`: the rank that owns brick slot s (the queues' index), or kEveryRank; rays of
+    /// the slots this rank traces are pushed onto `queues`, which must outlive the exchange.
+    /// Errors: MPI not initialized, an owner outside [0, ranks) other than kEveryRank, a slot
+    /// count other than the queues'. Collective.
     static StatusOr<std::unique_ptr<MpiRayExchange>> Create(std::vector<int> owners,
                                                             BrickQueues<RayRecord>& queues,
                                                             const MpiExchangeOptions& options = {});
@@ -59,13 +64,16 @@ class MpiRayExchange final : public RayExchange {
     int size() const;
     /// The rank that owns slot `slot`.
     int Owner(uint32_t slot) const override;
-    bool Owns(uint32_t slot) const override { return Owner(slot) == rank(); }
+    bool Owns(uint32_t slot) const override { return TracedBy(Owner(slot), rank()); }
     /// Errors: a slot count other than the queues', an owner outside [0, ranks), a message not yet
     /// sent.
     Status SetOwners(std::vector<int> owners) override;
 
     /// Queues rays of this rank's slots; appends the others to their owner's next message.
     void Send(uint32_t slot, std::span<const RayRecord> rays) override;
+    /// Appends rays of a slot every rank holds to rank `rank`'s next message (queues them if
+    /// `rank` is this one).
+    void SendToRank(int rank, uint32_t slot, std::span<const RayRecord> rays) override;
     /// Posts the messages that are full, completes finished sends and queues the rays that have
     /// arrived. Called between batches. Errors: a message that is not whole (names the sender),
     /// an MPI error.

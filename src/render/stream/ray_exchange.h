@@ -35,6 +35,13 @@ struct ExchangeCounts {
     double idle_seconds = 0;          ///< time waiting for rays with none to trace
 };
 
+/// The owner of a slot every process holds (a coarse level of detail kept resident on every rank,
+/// docs/distributed.md "Coarse levels on every rank"): rays bound for it are traced where they are.
+inline constexpr int kEveryRank = -1;
+
+/// Whether `rank` traces the rays of a slot owned by `owner`.
+inline bool TracedBy(int owner, int rank) { return owner == rank || owner == kEveryRank; }
+
 /// Delivers rays to the owner of the brick their next segment lies in.
 class RayExchange {
   public:
@@ -43,13 +50,17 @@ class RayExchange {
     /// are copied: the caller may reuse the span's storage after the call. Thread-safe: every
     /// worker flushing its outbox calls it.
     virtual void Send(uint32_t brick, std::span<const RayRecord> rays) = 0;
-    /// Whether this process owns brick `brick` (traces its rays).
+    /// Hands `rays`, bound for a slot every process holds (kEveryRank), to process `rank` to
+    /// trace: how an overloaded process shares that work (StreamScheduler::Rebalance). As Send.
+    virtual void SendToRank(int rank, uint32_t slot, std::span<const RayRecord> rays) = 0;
+    /// Whether this process traces the rays of brick `brick`: it owns it, or every process does.
     virtual bool Owns(uint32_t brick) const = 0;
-    /// The process that owns brick `brick` (0 in a render of one process).
+    /// The process that owns brick `brick` (0 in a render of one process; kEveryRank for a slot
+    /// every process holds).
     virtual int Owner(uint32_t brick) const = 0;
-    /// Hands the bricks to new owners (`owners[s]`: the process of slot s), the same in every
-    /// process. Only between drains, with no ray waiting or in flight anywhere. One process:
-    /// Unsupported (it owns every brick).
+    /// Hands the bricks to new owners (`owners[s]`: the process of slot s, or kEveryRank), the
+    /// same in every process. Only between drains, with no ray waiting or in flight anywhere. One
+    /// process: Unsupported (it owns every brick).
     virtual Status SetOwners(std::vector<int> owners) = 0;
     /// Delivers the rays that have arrived from elsewhere to their queues; called between batches.
     virtual Status Progress() { return Status::Ok(); }
@@ -80,7 +91,12 @@ class RankGroup {
     virtual ~RankGroup() = default;
     virtual int rank() const = 0;
     virtual int size() const = 0;
-    /// The exchange for `queues` (which must outlive it), brick slot s owned by rank owners[s].
+    /// Whether every process holds the coarse levels of detail the pager keeps resident and traces
+    /// the rays bound for them itself (kEveryRank), instead of sending them to the brick's owner
+    /// (docs/distributed.md, "Coarse levels on every rank").
+    virtual bool coarse_levels_everywhere() const = 0;
+    /// The exchange for `queues` (which must outlive it), brick slot s owned by rank owners[s]
+    /// (kEveryRank: by every one).
     virtual StatusOr<std::unique_ptr<RayExchange>> MakeExchange(std::vector<int> owners,
                                                                 BrickQueues<RayRecord>& queues) = 0;
     /// Replaces `values` by their sums over the processes, in every process.
@@ -107,6 +123,9 @@ class LocalRayExchange final : public RayExchange {
 
     void Send(uint32_t brick, std::span<const RayRecord> rays) override {
         queues_.Push(brick, rays.data(), rays.size());
+    }
+    void SendToRank(int /*rank*/, uint32_t slot, std::span<const RayRecord> rays) override {
+        Send(slot, rays);
     }
     bool Owns(uint32_t) const override { return true; }
     int Owner(uint32_t) const override { return 0; }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <tuple>
 
 #include "src/core/check.h"
 #include "src/core/log.h"
@@ -33,7 +34,8 @@ StreamScheduler::StreamScheduler(BrickSource& source, BrickPicker picker, uint64
       queues_(source.slot_count()),
       ranks_(ranks),
       max_batch_(MaxBatchRays(0)),
-      work_us_(source.slot_count(), 0) {}
+      work_us_(source.slot_count(), 0),
+      into_everywhere_(source.brick_count(), 0) {}
 
 StreamScheduler::~StreamScheduler() {
     pager_.reset();  // joins the loaders before the cache they use goes
@@ -49,9 +51,16 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
     std::unique_ptr<StreamScheduler> scheduler(
         new StreamScheduler(source, std::move(picker), wave_paths, ranks));
     if (ranks != nullptr) {
-        NAVE_ASSIGN_OR_RETURN(
-            scheduler->distributed_exchange_,
-            ranks->MakeExchange(BrickOwners(source, ranks->size()), scheduler->queues_));
+        scheduler->brick_owners_ = BrickOwners(source, ranks->size());
+        if (ranks->coarse_levels_everywhere()) {
+            // The levels each process's pager keeps (the same budget in every process): kept
+            // everywhere, their rays need not travel.
+            scheduler->everywhere_ = KeptLevels(source, MinimumBrickBudget(source, paging.prefetch),
+                                                paging.brick_budget_bytes);
+            scheduler->coarse_here_ = true;
+        }
+        NAVE_ASSIGN_OR_RETURN(scheduler->distributed_exchange_,
+                              ranks->MakeExchange(scheduler->SlotOwners(), scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
     scheduler->skip_air_allowed_ =
@@ -64,9 +73,26 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
 bool StreamScheduler::MakesHere(RayRecord r, uint64_t index) const {
     if (ranks_ == nullptr) return true;
     const uint32_t first = Route(r, 0, store::kNoBrick);
-    if (first == store::kNoBrick)
+    // A ray that meets no brick, or whose first brick every process holds, is made by one
+    // process chosen by its index.
+    if (first == store::kNoBrick || exchange_->Owner(first) == kEveryRank)
         return index % uint64_t(ranks_->size()) == uint64_t(ranks_->rank());
     return exchange_->Owns(first);
+}
+
+std::vector<int> StreamScheduler::SlotOwners() const {
+    std::vector<int> owners = brick_owners_;
+    if (coarse_here_) {
+        for (size_t s = 0; s < owners.size() && s < everywhere_.size(); ++s)
+            if (everywhere_[s]) owners[s] = kEveryRank;
+    }
+    return owners;
+}
+
+Status StreamScheduler::TraceCoarseLevelsHere(bool here) {
+    if (ranks_ == nullptr || everywhere_.empty() || here == coarse_here_) return Status::Ok();
+    coarse_here_ = here;
+    return exchange_->SetOwners(SlotOwners());
 }
 
 Status StreamScheduler::StartPaging(const PagerOptions& paging) {
@@ -98,14 +124,25 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
     if (trace_ != nullptr) {
         trace_->NameThread("scheduler");
         // For a replay of the render over several processes (bench/replay_mpi.py): the order in
-        // which BrickOwners cuts runs of bricks, and how many slots there are to a brick.
-        std::string order;
-        for (uint32_t b : BricksDepthFirst(source_)) {
-            if (!order.empty()) order += ' ';
-            order += std::to_string(b);
-        }
+        // which BrickOwners cuts runs of bricks, how many slots there are to a brick, and the
+        // slots the pager keeps resident (which processes may hold everywhere).
+        auto join = [](const auto& numbers) {
+            std::string text;
+            for (uint32_t n : numbers) {
+                if (!text.empty()) text += ' ';
+                text += std::to_string(n);
+            }
+            return text;
+        };
+        const std::vector<bool> kept = KeptLevels(
+            source_, MinimumBrickBudget(source_, paging.prefetch), paging.brick_budget_bytes);
+        std::vector<uint32_t> kept_slots;
+        for (uint32_t s = 0; s < kept.size(); ++s)
+            if (kept[s]) kept_slots.push_back(s);
         trace_->Instant("bricks", "scheduler",
-                        {{"bricks", source_.brick_count()}, {"depth_first", order}});
+                        {{"bricks", source_.brick_count()},
+                         {"depth_first", join(BricksDepthFirst(source_))},
+                         {"kept", join(kept_slots)}});
     }
     NAVE_ASSIGN_OR_RETURN(
         pager_, Pager::Create(source_, paging, [this](uint32_t b) { return queues_.Waiting(b); }));
@@ -126,10 +163,12 @@ Status StreamScheduler::ForEachBrick(
     const auto slot_of = [&](uint32_t b) {
         return source_.SlotOf(b, detail == ScanDetail::kFull ? 0 : source_.LevelsOf(b) - 1);
     };
-    // A process of a distributed render reads its own bricks only (the others read theirs).
+    // A process of a distributed render reads its own bricks only (the others read theirs), at
+    // whatever level: a brick is its full mesh's owner's, even where every process holds its
+    // coarse level.
     std::vector<uint32_t> bricks;
     for (uint32_t b = 0; b < count; ++b) {
-        if (exchange_->Owns(slot_of(b))) bricks.push_back(b);
+        if (exchange_->Owns(source_.SlotOf(b, 0))) bricks.push_back(b);
     }
     if (bricks.size() != count) progress.SetTotal(bricks.size());
     for (size_t i = 0; i < bricks.size(); ++i) {
@@ -188,12 +227,10 @@ uint32_t StreamScheduler::LevelOfSegment(const RayRecord& r, uint32_t brick) con
                                      ConeWidthAt(r, r.t_enter));
 }
 
-void SentPerBrick::Count(const BrickSource& source, uint32_t from_slot, const RayOutbox& out) {
-    const uint32_t from = source.BrickOfSlot(from_slot);
+void SentPerBrick::Count(uint32_t from_slot, const RayOutbox& out) {
     std::map<uint32_t, uint64_t> mine;
     for (const auto& [slot, ray] : out.rays) {
-        const uint32_t to = source.BrickOfSlot(slot);
-        if (to != from) ++mine[to];
+        if (slot != from_slot) ++mine[slot];
     }
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& [to, n] : mine) counts_[to] += n;
@@ -222,6 +259,52 @@ uint64_t StreamScheduler::WaitingBeforeRound(uint32_t round) const {
     for (size_t k = 0; k < std::min<size_t>(round, kRounds); ++k)
         n += waiting_by_round_[k].load(std::memory_order_relaxed);
     return uint64_t(std::max<int64_t>(n, 0));
+}
+
+namespace {
+
+/// A number in [0, 1) that looks random and depends on `r`'s path and depth only: which process a
+/// ray entering the shared slots goes to. The finalizer of SplitMix64 (Steele, Lea & Flood 2014,
+/// "Fast splittable pseudorandom number generators"; constants of Stafford's Mix13).
+double PathFraction(const RayRecord& r) {
+    uint64_t z = (uint64_t(r.pixel) << 32 | r.sample) + 0x9e3779b97f4a7c15ull * (r.depth + 1u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return double(z >> 11) * 0x1.0p-53;
+}
+
+}  // namespace
+
+uint64_t StreamScheduler::SpreadIntoEverywhere(RayOutbox& out) {
+    const int rank = ranks_->rank();
+    uint64_t entering = 0;
+    std::vector<std::tuple<int, uint32_t, RayRecord>> away;
+    auto kept = out.rays.begin();
+    for (auto it = out.rays.begin(); it != out.rays.end(); ++it) {
+        int dest = rank;
+        if (exchange_->Owner(it->first) == kEveryRank) {
+            ++entering;
+            if (!spread_.empty()) {
+                const double u = PathFraction(it->second);
+                double below = 0;
+                for (size_t d = 0; d < spread_.size(); ++d) {
+                    below += spread_[d];
+                    dest = int(d);
+                    if (u < below) break;
+                }
+            }
+        }
+        if (dest == rank) {
+            *kept++ = *it;
+        } else {
+            away.emplace_back(dest, it->first, it->second);
+        }
+    }
+    out.rays.erase(kept, out.rays.end());
+    for (const auto& [dest, slot, ray] : away)
+        exchange_->SendToRank(dest, slot, std::span<const RayRecord>(&ray, 1));
+    return entering;
 }
 
 void StreamScheduler::Flush(RayOutbox& out) {
@@ -308,6 +391,11 @@ Status StreamScheduler::DrainUntil(RayProcessor& processor, size_t stop_below,
         // Traced: the rays this batch sent to each other brick, which a replay of the render over
         // several processes needs (bench/replay_mpi.py).
         SentPerBrick sent;
+        // Rays this batch of a brick's own slot sends to the slots every process holds: the
+        // share of this process's work on those that Rebalance credits to the brick.
+        const bool held_everywhere = exchange_->Owner(b) == kEveryRank;
+        const bool count_into_everywhere = coarse_here_ && !held_everywhere;
+        std::atomic<uint64_t> into_everywhere{0};
         tbb::parallel_for(
             tbb::blocked_range<size_t>(0, batch.size(), kChunk),
             [&](const tbb::blocked_range<size_t>& range) {
@@ -315,14 +403,23 @@ Status StreamScheduler::DrainUntil(RayProcessor& processor, size_t stop_below,
                 processor.ProcessBatch(
                     b, brick,
                     std::span<const RayRecord>(batch).subspan(range.begin(), range.size()), out);
-                if (trace_ != nullptr) sent.Count(source_, b, out);
+                if (trace_ != nullptr) sent.Count(b, out);
+                if (count_into_everywhere) {
+                    into_everywhere.fetch_add(SpreadIntoEverywhere(out), std::memory_order_relaxed);
+                }
                 Flush(out);
             });
         if (trace_ != nullptr) span.AddArg({"sent", sent.Text()});
         handle.Reset();
-        work_us_[b] += uint64_t(std::chrono::duration_cast<std::chrono::microseconds>(
-                                    std::chrono::steady_clock::now() - batch_start)
-                                    .count());
+        const uint64_t batch_us = uint64_t(std::chrono::duration_cast<std::chrono::microseconds>(
+                                               std::chrono::steady_clock::now() - batch_start)
+                                               .count());
+        if (held_everywhere) {
+            everywhere_work_us_ += batch_us;
+        } else {
+            work_us_[b] += batch_us;
+            into_everywhere_[source_.BrickOfSlot(b)] += into_everywhere.load();
+        }
         pager_->BatchDone();
         NAVE_RETURN_IF_ERROR(exchange_->Progress());
     }
@@ -388,32 +485,58 @@ Status StreamScheduler::Rebalance() {
     if (ranks_ == nullptr) return Status::Ok();
     // Brick by brick (a brick's levels go together), summed over the processes: each brick's
     // owner measured it. Integers, so that every process sums the same and decides the same.
+    // One sum over the processes, in integers so that every process sums the same and decides
+    // the same: per brick the work of its own slots (a brick's levels go together; each brick's
+    // owner measured it) and the rays they sent into the slots every process holds, the work on
+    // those slots, and per process all it did.
     const uint32_t bricks = source_.brick_count();
-    std::vector<uint64_t> work(bricks, 0);
-    for (uint32_t s = 0; s < work_us_.size(); ++s) work[source_.BrickOfSlot(s)] += work_us_[s];
-    std::fill(work_us_.begin(), work_us_.end(), 0);
-    NAVE_RETURN_IF_ERROR(ranks_->SumEverywhere(std::span<uint64_t>(work)));
     const int n = ranks_->size();
-    auto loads = [&](auto owner_of_brick) {
-        std::vector<uint64_t> per_rank(size_t(n), 0);
-        for (uint32_t b = 0; b < bricks; ++b) per_rank[size_t(owner_of_brick(b))] += work[b];
-        return per_rank;
-    };
-    // Every level of a brick goes with it: level 0's slot names the owner.
-    const std::vector<uint64_t> before =
-        loads([&](uint32_t b) { return exchange_->Owner(source_.SlotOf(b, 0)); });
-    const uint64_t total = std::accumulate(before.begin(), before.end(), uint64_t(0));
-    const uint64_t busiest = *std::max_element(before.begin(), before.end());
+    std::vector<uint64_t> sums(2 * size_t(bricks) + 1 + size_t(n), 0);
+    const std::span<uint64_t> work(sums.data(), bricks), into(sums.data() + bricks, bricks),
+        did(sums.data() + 2 * size_t(bricks) + 1, size_t(n));
+    uint64_t& shared_work = sums[2 * size_t(bricks)];
+    for (uint32_t s = 0; s < work_us_.size(); ++s) work[source_.BrickOfSlot(s)] += work_us_[s];
+    for (uint32_t b = 0; b < bricks; ++b) into[b] = into_everywhere_[b];
+    shared_work = everywhere_work_us_;
+    did[size_t(ranks_->rank())] = std::accumulate(work.begin(), work.end(), everywhere_work_us_);
+    std::fill(work_us_.begin(), work_us_.end(), 0);
+    std::fill(into_everywhere_.begin(), into_everywhere_.end(), 0);
+    everywhere_work_us_ = 0;
+    NAVE_RETURN_IF_ERROR(ranks_->SumEverywhere(std::span<uint64_t>(sums)));
+    const uint64_t total = std::accumulate(did.begin(), did.end(), uint64_t(0));
+    const uint64_t busiest = *std::max_element(did.begin(), did.end());
     if (total == 0 || double(busiest) <= kRebalanceRatio * double(total) / n) return Status::Ok();
-    std::vector<int> next = BrickOwnersByWork(source_, n, work);
-    const std::vector<uint64_t> after =
-        loads([&](uint32_t b) { return next[source_.SlotOf(b, 0)]; });
-    const uint64_t busiest_after = *std::max_element(after.begin(), after.end());
-    if (busiest_after >= busiest) return Status::Ok();
-    for (uint32_t s = 0; s < next.size(); ++s) {
-        if (exchange_->Owns(s) && next[s] != ranks_->rank()) pager_->Evict(s);
+
+    // The work on the shared slots follows the rays into them: each brick is credited with the
+    // rays it sent there at the mean work a ray entering them brought.
+    const uint64_t entered = std::accumulate(into.begin(), into.end(), uint64_t(0));
+    const double per_entry = entered > 0 ? double(shared_work) / double(entered) : 0.0;
+    std::vector<uint64_t> weight(bricks);
+    for (uint32_t b = 0; b < bricks; ++b)
+        weight[b] = work[b] + uint64_t(per_entry * double(into[b]));
+    std::vector<int> next = BrickOwnersByWork(source_, n, weight);
+    std::vector<double> made(size_t(n), 0.0), shared(size_t(n), 0.0);
+    for (uint32_t b = 0; b < bricks; ++b) {
+        const size_t r = size_t(next[source_.SlotOf(b, 0)]);
+        made[r] += double(weight[b]);
+        shared[r] += per_entry * double(into[b]);
     }
-    NAVE_RETURN_IF_ERROR(exchange_->SetOwners(std::move(next)));
+    // Processes above the mean hand rays entering the shared slots to those below it.
+    const std::vector<std::vector<double>> spread = SpreadOfSharedWork(made, shared);
+    std::vector<double> after(size_t(n), 0.0);
+    for (size_t r = 0; r < size_t(n); ++r) {
+        after[r] += made[r] - shared[r];
+        for (size_t d = 0; d < size_t(n); ++d) after[d] += shared[r] * spread[r][d];
+    }
+    const double busiest_after = *std::max_element(after.begin(), after.end());
+    if (busiest_after >= double(busiest)) return Status::Ok();
+    spread_ = spread[size_t(ranks_->rank())];
+    brick_owners_ = std::move(next);
+    std::vector<int> owners = SlotOwners();
+    for (uint32_t s = 0; s < owners.size(); ++s) {
+        if (exchange_->Owns(s) && !TracedBy(owners[s], ranks_->rank())) pager_->Evict(s);
+    }
+    NAVE_RETURN_IF_ERROR(exchange_->SetOwners(std::move(owners)));
     log::Debug(
         "ranks: bricks re-balanced by measured work: the busiest rank had {:.2f}x the mean, "
         "now {:.2f}x",

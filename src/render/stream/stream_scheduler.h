@@ -61,13 +61,13 @@ struct RayOutbox {
     RayCounts counts;
 };
 
-/// For a trace: the rays one batch sent to each other brick (levels of a brick count as the
-/// brick). Count is thread-safe.
+/// For a trace: the rays one batch sent to each other slot (a brick at a level of detail). Count
+/// is thread-safe.
 class SentPerBrick {
   public:
     /// Counts the rays of `out`, made by a batch of slot `from_slot`.
-    void Count(const BrickSource& source, uint32_t from_slot, const RayOutbox& out);
-    /// "brick:rays brick:rays ...", by brick.
+    void Count(uint32_t from_slot, const RayOutbox& out);
+    /// "slot:rays slot:rays ...", by slot.
     std::string Text() const;
 
   private:
@@ -201,15 +201,25 @@ class StreamScheduler {
     Status SumStatsOverRanks(StreamStats* stats) const;
 
     /// In a distributed render, after a complete drain (collective): when the busiest process
-    /// spent more than kRebalanceRatio times the mean on its batches since the last call (their
-    /// time summed over the processes, brick by brick), the bricks go to new owners cut by that
-    /// work (BrickOwnersByWork), if that makes the busiest lighter; bricks a process no longer
-    /// owns leave its memory. One process: nothing to do.
+    /// spent more than kRebalanceRatio times the mean on its batches since the last call, the
+    /// bricks go to new owners cut by their work (BrickOwnersByWork; summed over the processes,
+    /// brick by brick, the work on the slots every process holds credited to the bricks whose
+    /// rays entered them) and the processes above the mean hand a share of the rays entering
+    /// those slots to the processes below it (SpreadOfSharedWork), if that makes the busiest
+    /// lighter; bricks a process no longer owns leave its memory. One process: nothing to do.
     Status Rebalance();
     /// The busiest process's work over the mean above which Rebalance moves bricks.
     static constexpr double kRebalanceRatio = 1.2;
     /// Times Rebalance moved bricks.
     int rebalances() const { return rebalances_; }
+
+    /// In a distributed render whose group holds coarse levels everywhere
+    /// (RankGroup::coarse_levels_everywhere): whether the rays bound for the coarse levels the
+    /// pager keeps resident are traced in the process they are in (`here`, the default) or sent
+    /// to their brick's owner from the next drain on. A photon pass needs the owner, whose
+    /// visible points its photons reach. Between complete drains, in every process at once. One
+    /// process, or a group that does not hold them everywhere: nothing to do.
+    Status TraceCoarseLevelsHere(bool here);
 
     /// The bricks the rays are scheduled over (slots: bricks at their levels of detail).
     const BrickSource& source() const { return source_; }
@@ -255,8 +265,26 @@ class StreamScheduler {
     std::unique_ptr<Pager> pager_;
     TraceRecorder* trace_ = nullptr;
     // Per slot, microseconds of this process's batches of it (pinning, loads waited for and
-    // tracing) since the last Rebalance: the work that re-balancing shares out.
+    // tracing) since the last Rebalance: the work that re-balancing shares out. The slots every
+    // process traces are summed apart, with the rays each brick's own slots sent them: Rebalance
+    // credits that work to the bricks whose rays it was.
     std::vector<uint64_t> work_us_;
+    uint64_t everywhere_work_us_ = 0;
+    std::vector<uint64_t> into_everywhere_;  // per brick
+    // The fraction of the rays this process's bricks send into the slots every process holds that
+    // each process traces (SpreadOfSharedWork; empty: all here), set by Rebalance.
+    std::vector<double> spread_;
+    /// Takes out of `out` the rays entering the slots every process holds that spread_ hands to
+    /// other processes, and sends them there; returns how many rays entered those slots.
+    uint64_t SpreadIntoEverywhere(RayOutbox& out);
+    // Distributed: each slot's owner by brick (BrickOwners, then Rebalance), the slots every
+    // process holds when coarse levels are traced where the rays are (KeptLevels; empty when the
+    // group does not), and whether they are now (TraceCoarseLevelsHere).
+    std::vector<int> brick_owners_;
+    std::vector<bool> everywhere_;
+    bool coarse_here_ = false;
+    /// brick_owners_ with the slots of everywhere_ owned by kEveryRank while coarse_here_.
+    std::vector<int> SlotOwners() const;
     int rebalances_ = 0;
     int rounds_overlapped_ = 0;
     std::atomic<uint64_t> segments_traced_{0}, shadow_segments_{0}, brick_moves_{0}, batches_{0},
