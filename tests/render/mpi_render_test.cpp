@@ -356,9 +356,11 @@ TEST_F(MpiRender, CoarseLevelsOnEveryRankKeepRaysHomeAndTheImage) {
     for (const std::string mode : {"path", "photon"}) {
         SCOPED_TRACE(mode);
         auto render = [&](const std::string& out, const std::string& flags) {
-            return std::string(NAVE_BINARY) + " render " + store + " -c " + Config() + " --mode " +
-                   mode + " --lod auto --resolution 64x48 --spp 2 --iterations 2 " +
-                   "--photons 50000 -o " + (*dir_ / out).string() + flags;
+            std::string command = std::string(NAVE_BINARY) + " render " + store;
+            command += " -c " + Config() + " --mode " + mode;
+            command += " --lod auto --resolution 64x48 --spp 2 --iterations 2 --photons 50000 -o ";
+            command += (*dir_ / out).string() + flags;
+            return command;
         };
         const test::CommandResult one = Shell(render(mode + "_one.exr", " -q"));
         ASSERT_EQ(one.exit_code, 0) << one.output;

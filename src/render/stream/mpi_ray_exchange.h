@@ -71,9 +71,9 @@ class MpiRayExchange final : public RayExchange {
 
     /// Queues rays of this rank's slots; appends the others to their owner's next message.
     void Send(uint32_t slot, std::span<const RayRecord> rays) override;
-    /// Appends rays of a slot every rank holds to rank `rank`'s next message (queues them if
-    /// `rank` is this one).
-    void SendToRank(int rank, uint32_t slot, std::span<const RayRecord> rays) override;
+    /// Appends rays of a slot every rank holds to rank `dest`'s next message (queues them if
+    /// `dest` is this one).
+    void SendToRank(int dest, uint32_t slot, std::span<const RayRecord> rays) override;
     /// Posts the messages that are full, completes finished sends and queues the rays that have
     /// arrived. Called between batches. Errors: a message that is not whole (names the sender),
     /// an MPI error.
