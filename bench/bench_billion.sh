@@ -5,12 +5,12 @@
 #
 #     bash bench/bench_billion.sh                      # detail 1250 (1.02 G triangles), 4G, 1920x1080
 #     bash bench/bench_billion.sh --detail 1 --resolution 160x107 --spp 1 --memory 1G   # the script in a minute
-#     bash bench/bench_billion.sh --levels --noise 0.05 --time-limit 60m  # levels, until relMSE 0.05 or an hour
+#     bash bench/bench_billion.sh --levels --noise 0.05 --time-limit 3600  # levels, until relMSE 0.05 or an hour
 #
 # Defaults: detail 1250, --memory 4G for both phases, configs/abbey.toml, path mode, 1920x1080, 4 spp.
 # --levels preprocesses with levels of detail (a store of its own, abbey<detail>-levels.nave) and renders
 # with --lod auto; --noise T renders until the estimated relMSE is at most T (--spp is then the most);
-# --time-limit D stops the render after D (nave render --time-limit: 20m, 1h).
+# --time-limit S stops the render after S seconds (nave render --time-limit).
 # Everything goes under --dir (default /tmp/nave-billion): the store of detail 1250 takes 988 MiB
 # (1.01 bytes per triangle), the preprocess's temporary files 17.8 GiB at their peak (1.45 GiB at
 # detail 110), the render's brick cache 17.4 GiB and its spill files a few hundred MiB. On a RAM file
