@@ -38,8 +38,8 @@ struct MpiExchangeOptions {
     /// that stopped, or a batch longer than this): a job never hangs. 0: waits for ever.
     double stall_timeout_s = 600;
     /// Every rank holds the coarse levels of detail kept resident and traces their rays where
-    /// they are (RankGroup::coarse_levels_everywhere): on the detail-30 abbey over 4 ranks, ??? of
-    /// the rays crossing between ranks stay home (docs/distributed.md).
+    /// they are (RankGroup::coarse_levels_everywhere): on the detail-30 abbey with levels, 4 ranks
+    /// sent 18.1 k rays to each other instead of 341 k (docs/distributed.md).
     bool coarse_levels_everywhere = true;
 };
 

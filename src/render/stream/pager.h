@@ -198,6 +198,8 @@ class Pager {
     bool Evict(uint32_t id);
     PagerStats stats() const;
     const PagerOptions& options() const { return options_; }
+    /// Per slot, whether it is never evicted once loaded (KeptLevels for this pager's budget).
+    const std::vector<bool>& kept() const { return kept_; }
 
   private:
     enum class State : uint8_t { kAbsent, kLoading, kResident };

@@ -50,23 +50,22 @@ StatusOr<std::unique_ptr<StreamScheduler>> StreamScheduler::Create(BrickSource& 
                                                                    RankGroup* ranks) {
     std::unique_ptr<StreamScheduler> scheduler(
         new StreamScheduler(source, std::move(picker), wave_paths, ranks));
+    scheduler->skip_air_allowed_ =
+        paging.skip_air == PagerOptions::SkipAir::kOn ||
+        (paging.skip_air == PagerOptions::SkipAir::kAuto && source.occupancy_known());
+    NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
     if (ranks != nullptr) {
         scheduler->brick_owners_ = BrickOwners(source, ranks->size());
         if (ranks->coarse_levels_everywhere()) {
             // The levels each process's pager keeps (the same budget in every process): kept
             // everywhere, their rays need not travel.
-            scheduler->everywhere_ = KeptLevels(source, MinimumBrickBudget(source, paging.prefetch),
-                                                paging.brick_budget_bytes);
+            scheduler->everywhere_ = scheduler->pager_->kept();
             scheduler->coarse_here_ = true;
         }
         NAVE_ASSIGN_OR_RETURN(scheduler->distributed_exchange_,
                               ranks->MakeExchange(scheduler->SlotOwners(), scheduler->queues_));
         scheduler->exchange_ = scheduler->distributed_exchange_.get();
     }
-    scheduler->skip_air_allowed_ =
-        paging.skip_air == PagerOptions::SkipAir::kOn ||
-        (paging.skip_air == PagerOptions::SkipAir::kAuto && source.occupancy_known());
-    NAVE_RETURN_IF_ERROR(scheduler->StartPaging(paging));
     return scheduler;
 }
 
@@ -121,8 +120,10 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
         max_batch_ = MaxBatchRays(queue_memory_);
     }
     trace_ = paging.trace;
+    if (trace_ != nullptr) trace_->NameThread("scheduler");
+    NAVE_ASSIGN_OR_RETURN(
+        pager_, Pager::Create(source_, paging, [this](uint32_t b) { return queues_.Waiting(b); }));
     if (trace_ != nullptr) {
-        trace_->NameThread("scheduler");
         // For a replay of the render over several processes (bench/replay_mpi.py): the order in
         // which BrickOwners cuts runs of bricks, how many slots there are to a brick, and the
         // slots the pager keeps resident (which processes may hold everywhere).
@@ -134,18 +135,14 @@ Status StreamScheduler::StartPaging(const PagerOptions& paging) {
             }
             return text;
         };
-        const std::vector<bool> kept = KeptLevels(
-            source_, MinimumBrickBudget(source_, paging.prefetch), paging.brick_budget_bytes);
         std::vector<uint32_t> kept_slots;
-        for (uint32_t s = 0; s < kept.size(); ++s)
-            if (kept[s]) kept_slots.push_back(s);
+        for (uint32_t s = 0; s < pager_->kept().size(); ++s)
+            if (pager_->kept()[s]) kept_slots.push_back(s);
         trace_->Instant("bricks", "scheduler",
                         {{"bricks", source_.brick_count()},
                          {"depth_first", join(BricksDepthFirst(source_))},
                          {"kept", join(kept_slots)}});
     }
-    NAVE_ASSIGN_OR_RETURN(
-        pager_, Pager::Create(source_, paging, [this](uint32_t b) { return queues_.Waiting(b); }));
     return Status::Ok();
 }
 
@@ -302,8 +299,19 @@ uint64_t StreamScheduler::SpreadIntoEverywhere(RayOutbox& out) {
         }
     }
     out.rays.erase(kept, out.rays.end());
-    for (const auto& [dest, slot, ray] : away)
-        exchange_->SendToRank(dest, slot, std::span<const RayRecord>(&ray, 1));
+    // One send per process and slot, as Flush sends one per slot.
+    std::stable_sort(away.begin(), away.end(), [](const auto& a, const auto& b) {
+        return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+    });
+    std::vector<RayRecord> group;
+    for (size_t i = 0; i < away.size();) {
+        const int dest = std::get<0>(away[i]);
+        const uint32_t slot = std::get<1>(away[i]);
+        group.clear();
+        for (; i < away.size() && std::get<0>(away[i]) == dest && std::get<1>(away[i]) == slot; ++i)
+            group.push_back(std::get<2>(away[i]));
+        exchange_->SendToRank(dest, slot, group);
+    }
     return entering;
 }
 
@@ -483,8 +491,6 @@ Status StreamScheduler::SpillQueues(const std::vector<size_t>& waiting) {
 
 Status StreamScheduler::Rebalance() {
     if (ranks_ == nullptr) return Status::Ok();
-    // Brick by brick (a brick's levels go together), summed over the processes: each brick's
-    // owner measured it. Integers, so that every process sums the same and decides the same.
     // One sum over the processes, in integers so that every process sums the same and decides
     // the same: per brick the work of its own slots (a brick's levels go together; each brick's
     // owner measured it) and the rays they sent into the slots every process holds, the work on
